@@ -1,0 +1,1 @@
+//! ms2-control (placeholder: being written).

@@ -1,0 +1,1 @@
+//! ms2-mpm (placeholder: being written).

@@ -1,0 +1,1 @@
+//! ms2-physics (placeholder: being written).

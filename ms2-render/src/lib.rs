@@ -1,0 +1,1 @@
+//! ms2-render (placeholder: being written).
