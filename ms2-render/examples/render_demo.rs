@@ -22,16 +22,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let checker: Vec<u8> = (0..64 * 64)
         .flat_map(|i| {
             let (x, y) = (i % 64 / 8, i / 64 / 8);
-            if (x + y) % 2 == 0 { [200, 200, 200, 255] } else { [90, 90, 90, 255] }
+            if (x + y) % 2 == 0 {
+                [200, 200, 200, 255]
+            } else {
+                [90, 90, 90, 255]
+            }
         })
         .collect();
-    let checker = renderer.add_texture(&TextureData { width: 64, height: 64, rgba8_srgb: checker })?;
+    let checker = renderer.add_texture(&TextureData {
+        width: 64,
+        height: 64,
+        rgba8_srgb: checker,
+    })?;
 
     let mut scene = Scene::new();
     let ids = |k| SegmentationIds { actor: k, link: k };
     scene.add_instance(Instance::new(
         ground,
-        Material { base_color: [1.0, 1.0, 1.0, 1.0], texture: Some(checker) },
+        Material {
+            base_color: [1.0, 1.0, 1.0, 1.0],
+            texture: Some(checker),
+        },
         Isometry3::identity(),
         ids(1),
     ));

@@ -9,7 +9,9 @@
 //!   ManiSkill2's camera mounts (e.g. the hand camera's mount offset).
 
 use crate::RenderError;
-use nalgebra::{Isometry3, Matrix3, Matrix3x4, Matrix4, Point3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{
+    Isometry3, Matrix3, Matrix3x4, Matrix4, Point3, Rotation3, UnitQuaternion, Vector3,
+};
 
 /// Rotation taking OpenGL camera axes to robotics axes: columns are the GL axes expressed in the
 /// robotics frame (GL x right = −y_robotics, GL y up = z_robotics, GL z back = −x_robotics).
@@ -75,7 +77,9 @@ impl Camera {
     /// z up), as ManiSkill2's camera mounts are.
     pub fn with_pose_robotics(self, pose_world_from_camera_robotics: Isometry3<f32>) -> Camera {
         let rot = UnitQuaternion::from_rotation_matrix(&rotation_robotics_from_gl());
-        self.with_pose_gl(pose_world_from_camera_robotics * Isometry3::from_parts(Default::default(), rot))
+        self.with_pose_gl(
+            pose_world_from_camera_robotics * Isometry3::from_parts(Default::default(), rot),
+        )
     }
 
     /// This camera placed at `eye`, looking at `target` (world frame, metres), with image-up
@@ -84,7 +88,11 @@ impl Camera {
         let forward = (target - eye).normalize();
         let mut up = up;
         if forward.cross(&up).norm() < 1e-6 {
-            up = if forward.z.abs() < 0.9 { Vector3::z() } else { Vector3::y() };
+            up = if forward.z.abs() < 0.9 {
+                Vector3::z()
+            } else {
+                Vector3::y()
+            };
         }
         let z_gl = -forward;
         let x_gl = up.cross(&z_gl).normalize();
@@ -198,7 +206,11 @@ mod tests {
     #[test]
     fn conventions_agree() {
         let eye = Point3::new(1.0, 2.0, 3.0);
-        let cam = Camera::new(8, 8, 1.0, 0.1, 10.0).looking_at(eye, Point3::new(1.0, 2.0, 0.0), Vector3::x());
+        let cam = Camera::new(8, 8, 1.0, 0.1, 10.0).looking_at(
+            eye,
+            Point3::new(1.0, 2.0, 0.0),
+            Vector3::x(),
+        );
         // Looking straight down with image-up along world x: OpenCV +z (forward) is world −z,
         // OpenCV +y (image down) is world −x.
         let cv = cam.pose_world_from_camera_cv();

@@ -74,7 +74,11 @@ impl FrameResources {
         let mut offset = 0u64;
         let mut targets = Vec::with_capacity(sizes.len());
         for &(width, height) in sizes {
-            let extent = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
+            let extent = wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            };
             let make = |format, usage, label| {
                 device.create_texture(&wgpu::TextureDescriptor {
                     label: Some(label),
@@ -90,12 +94,19 @@ impl FrameResources {
             let copyable = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
             let color = make(COLOR_FORMAT, copyable, "ms2-render colour");
             let gbuffer = make(GBUFFER_FORMAT, copyable, "ms2-render gbuffer");
-            let depth = make(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT, "ms2-render depth");
+            let depth = make(
+                DEPTH_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+                "ms2-render depth",
+            );
             let color_row_bytes = align_up(width as u64 * 4, row_align);
             let gbuffer_row_bytes = align_up(width as u64 * 16, row_align);
             let color_offset = offset;
             let gbuffer_offset = color_offset + color_row_bytes * height as u64;
-            offset = align_up(gbuffer_offset + gbuffer_row_bytes * height as u64, row_align);
+            offset = align_up(
+                gbuffer_offset + gbuffer_row_bytes * height as u64,
+                row_align,
+            );
             targets.push(Target {
                 color_view: color.create_view(&Default::default()),
                 gbuffer_view: gbuffer.create_view(&Default::default()),
@@ -203,11 +214,24 @@ fn camera_block(camera: &Camera, scene: &Scene) -> [u32; 64] {
     put(&mut words, 16, &[eye.x, eye.y, eye.z, 1.0]);
     put(&mut words, 20, &[forward.x, forward.y, forward.z, 0.0]);
     let l = &scene.lighting;
-    put(&mut words, 24, &[l.ambient[0], l.ambient[1], l.ambient[2], 0.0]);
-    for (k, light) in l.directional.iter().take(MAX_DIRECTIONAL_LIGHTS).enumerate() {
+    put(
+        &mut words,
+        24,
+        &[l.ambient[0], l.ambient[1], l.ambient[2], 0.0],
+    );
+    for (k, light) in l
+        .directional
+        .iter()
+        .take(MAX_DIRECTIONAL_LIGHTS)
+        .enumerate()
+    {
         let d = light.direction_world.normalize();
         put(&mut words, 28 + 4 * k, &[d.x, d.y, d.z, 0.0]);
-        put(&mut words, 44 + 4 * k, &[light.color[0], light.color[1], light.color[2], 0.0]);
+        put(
+            &mut words,
+            44 + 4 * k,
+            &[light.color[0], light.color[1], light.color[2], 0.0],
+        );
     }
     words[60] = l.directional.len().min(MAX_DIRECTIONAL_LIGHTS) as u32;
     words
@@ -246,9 +270,17 @@ impl Renderer {
             }
         }
         if cameras.is_empty() {
-            return Ok(PendingFrame { renderer: self.clone(), work: None, cameras });
+            return Ok(PendingFrame {
+                renderer: self.clone(),
+                work: None,
+                cameras,
+            });
         }
-        let store = self.inner.store.read().expect("resource store lock poisoned");
+        let store = self
+            .inner
+            .store
+            .read()
+            .expect("resource store lock poisoned");
         // Instance records of all scenes, and per scene the draws referring to them.
         let mut records: Vec<[u32; 32]> = Vec::new();
         let mut draws: Vec<Vec<Draw>> = Vec::with_capacity(views.len());
@@ -261,26 +293,39 @@ impl Renderer {
             draws.push(scene_draws);
         }
         let sizes: Vec<(u32, u32)> = cameras.iter().map(|c| (c.width, c.height)).collect();
-        let taken = self.inner.pool.lock().expect("frame pool lock poisoned").take(&sizes);
+        let taken = self
+            .inner
+            .pool
+            .lock()
+            .expect("frame pool lock poisoned")
+            .take(&sizes);
         let mut resources = taken.unwrap_or_else(|| FrameResources::new(self, &sizes));
         let gpu = &self.inner.gpu;
         resources.ensure_instance_capacity(&gpu.device, records.len() as u64);
-        let instances = resources.instances.as_ref().expect("instance buffer allocated above");
+        let instances = resources
+            .instances
+            .as_ref()
+            .expect("instance buffer allocated above");
         if !records.is_empty() {
-            gpu.queue.write_buffer(instances, 0, bytemuck::cast_slice(&records));
+            gpu.queue
+                .write_buffer(instances, 0, bytemuck::cast_slice(&records));
         }
         let mut uniform_bytes = vec![0u8; (gpu.uniform_stride as usize) * cameras.len()];
         for (c, camera) in cameras.iter().enumerate() {
             let block = camera_block(camera, views[camera_scene[c]].0);
             let at = c * gpu.uniform_stride as usize;
-            uniform_bytes[at..at + CAMERA_BLOCK_BYTES as usize].copy_from_slice(bytemuck::cast_slice(&block));
+            uniform_bytes[at..at + CAMERA_BLOCK_BYTES as usize]
+                .copy_from_slice(bytemuck::cast_slice(&block));
         }
-        gpu.queue.write_buffer(&resources.uniforms, 0, &uniform_bytes);
+        gpu.queue
+            .write_buffer(&resources.uniforms, 0, &uniform_bytes);
 
         let error_scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("ms2-render batch"),
-        });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("ms2-render batch"),
+            });
         for (c, target) in resources.targets.iter().enumerate() {
             let scene = views[camera_scene[c]].0;
             let bg = scene.lighting.background;
@@ -328,7 +373,9 @@ impl Renderer {
             pass.set_bind_group(0, &resources.camera_bind_group, &[offset]);
             for draw in &draws[camera_scene[c]] {
                 let mesh = &store.meshes[draw.mesh];
-                let texture = draw.texture.map_or(&gpu.white_texture, |t| &store.textures[t]);
+                let texture = draw
+                    .texture
+                    .map_or(&gpu.white_texture, |t| &store.textures[t]);
                 pass.set_bind_group(1, texture, &[]);
                 pass.set_vertex_buffer(0, mesh.vertices.slice(..));
                 let start = draw.record * INSTANCE_BYTES;
@@ -344,7 +391,11 @@ impl Renderer {
             };
             for (texture, offset, row_bytes) in [
                 (&target.color, target.color_offset, target.color_row_bytes),
-                (&target.gbuffer, target.gbuffer_offset, target.gbuffer_row_bytes),
+                (
+                    &target.gbuffer,
+                    target.gbuffer_offset,
+                    target.gbuffer_row_bytes,
+                ),
             ] {
                 encoder.copy_texture_to_buffer(
                     texture.as_image_copy(),
@@ -367,18 +418,32 @@ impl Renderer {
         }
         let map_state: MapState = Arc::new(Mutex::new(None));
         let callback_state = Arc::clone(&map_state);
-        resources.readback.slice(..).map_async(wgpu::MapMode::Read, move |result| {
-            *callback_state.lock().expect("map state lock poisoned") = Some(result);
-        });
-        Ok(PendingFrame { renderer: self.clone(), work: Some((resources, submission, map_state)), cameras })
+        resources
+            .readback
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |result| {
+                *callback_state.lock().expect("map state lock poisoned") = Some(result);
+            });
+        Ok(PendingFrame {
+            renderer: self.clone(),
+            work: Some((resources, submission, map_state)),
+            cameras,
+        })
     }
 }
 
 /// Resolves an instance's mesh and texture handles against the store.
-fn check_draw(store: &ResourceStore, instance: &crate::Instance, record: u64) -> Result<Draw, RenderError> {
+fn check_draw(
+    store: &ResourceStore,
+    instance: &crate::Instance,
+    record: u64,
+) -> Result<Draw, RenderError> {
     let mesh = instance.mesh.0 as usize;
     if mesh >= store.meshes.len() {
-        return Err(RenderError::UnknownMesh(instance.mesh.0, store.meshes.len()));
+        return Err(RenderError::UnknownMesh(
+            instance.mesh.0,
+            store.meshes.len(),
+        ));
     }
     let texture = match instance.material.texture {
         Some(t) if t.0 as usize >= store.textures.len() => {
@@ -387,7 +452,11 @@ fn check_draw(store: &ResourceStore, instance: &crate::Instance, record: u64) ->
         Some(t) => Some(t.0 as usize),
         None => None,
     };
-    Ok(Draw { mesh, texture, record })
+    Ok(Draw {
+        mesh,
+        texture,
+        record,
+    })
 }
 
 impl PendingFrame {
@@ -414,7 +483,10 @@ impl PendingFrame {
                 break result;
             }
             device
-                .poll(wgpu::PollType::Wait { submission_index: Some(submission.clone()), timeout: None })
+                .poll(wgpu::PollType::Wait {
+                    submission_index: Some(submission.clone()),
+                    timeout: None,
+                })
                 .map_err(|e| RenderError::Gpu(e.to_string()))?;
         };
         mapped.map_err(|e| RenderError::Gpu(format!("reading images back failed: {e}")))?;
@@ -433,7 +505,12 @@ impl PendingFrame {
                 .collect()
         };
         resources.readback.unmap();
-        self.renderer.inner.pool.lock().expect("frame pool lock poisoned").give(resources);
+        self.renderer
+            .inner
+            .pool
+            .lock()
+            .expect("frame pool lock poisoned")
+            .give(resources);
         Ok(outputs)
     }
 }
@@ -452,12 +529,24 @@ fn decode(bytes: &[u8], target: &Target, camera: Camera) -> CameraOutput {
         }
         let row = target.gbuffer_offset as usize + y * target.gbuffer_row_bytes as usize;
         for px in bytes[row..row + 16 * w].chunks_exact(16) {
-            let word = |k: usize| u32::from_le_bytes([px[4 * k], px[4 * k + 1], px[4 * k + 2], px[4 * k + 3]]);
+            let word = |k: usize| {
+                u32::from_le_bytes([px[4 * k], px[4 * k + 1], px[4 * k + 2], px[4 * k + 3]])
+            };
             let covered = word(3) != 0;
-            depth_m.push(if covered { f32::from_bits(word(0)) } else { 0.0 });
+            depth_m.push(if covered {
+                f32::from_bits(word(0))
+            } else {
+                0.0
+            });
             segmentation_actor.push(word(1));
             segmentation_link.push(word(2));
         }
     }
-    CameraOutput { camera, rgb, depth_m, segmentation_actor, segmentation_link }
+    CameraOutput {
+        camera,
+        rgb,
+        depth_m,
+        segmentation_actor,
+        segmentation_link,
+    }
 }

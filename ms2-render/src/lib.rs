@@ -55,10 +55,12 @@ pub use frame::PendingFrame;
 pub use mesh::MeshData;
 pub use output::CameraOutput;
 pub use renderer::{
-    AdapterSummary, BackendChoice, MeshHandle, Renderer, RendererConfig, TextureData, TextureHandle,
-    BACKEND_ENV_VAR,
+    AdapterSummary, BackendChoice, MeshHandle, Renderer, RendererConfig, TextureData,
+    TextureHandle, BACKEND_ENV_VAR,
 };
-pub use scene::{DirectionalLight, Instance, InstanceId, Lighting, Material, Scene, SegmentationIds};
+pub use scene::{
+    DirectionalLight, Instance, InstanceId, Lighting, Material, Scene, SegmentationIds,
+};
 
 #[cfg(test)]
 mod send_sync {

@@ -85,7 +85,8 @@ impl MeshData {
             (None, Some(b)) if base == 0 => self.uvs = Some(b),
             _ => self.uvs = None,
         }
-        self.indices.extend(other.indices.into_iter().map(|i| i + base));
+        self.indices
+            .extend(other.indices.into_iter().map(|i| i + base));
     }
 
     /// An axis-aligned box centred on the origin with the given half extents (metres), flat
@@ -143,6 +144,7 @@ impl MeshData {
             // t in [0, 1] from the south pole (z = -r) to the north pole (z = +r).
             let polar = PI * (1.0 - t);
             let (s, c) = polar.sin_cos();
+            let s = s.max(0.0); // sin(π) rounds to a tiny negative radius
             ([radius * s, radius * c], [s, c])
         })
     }
@@ -267,7 +269,7 @@ mod tests {
             let centroid = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
             let dot: f32 = (0..3).map(|k| n[k] * centroid[k]).sum();
             let area2: f32 = n.iter().map(|x| x * x).sum::<f32>().sqrt();
-            if area2 > 1e-9 {
+            if area2 > 1e-7 {
                 assert!(dot > 0.0, "triangle {tri:?} winds inward");
             }
         }
@@ -295,7 +297,11 @@ mod tests {
             assert!((r - 0.5).abs() < 1e-5);
         }
         let capsule = MeshData::capsule(0.1, 0.3, 12, 4);
-        let top = capsule.positions.iter().map(|p| p[2]).fold(f32::MIN, f32::max);
+        let top = capsule
+            .positions
+            .iter()
+            .map(|p| p[2])
+            .fold(f32::MIN, f32::max);
         assert!((top - 0.4).abs() < 1e-5, "capsule top at {top}");
     }
 

@@ -90,7 +90,13 @@ impl CameraOutput {
 
     /// Writes the colour image as a PNG (through a temporary file renamed into place).
     pub fn save_rgb_png(&self, path: &Path) -> Result<(), RenderError> {
-        save_png(path, self.width(), self.height(), image::ColorType::Rgb8, &self.rgb)
+        save_png(
+            path,
+            self.width(),
+            self.height(),
+            image::ColorType::Rgb8,
+            &self.rgb,
+        )
     }
 
     /// Writes the depth image as an 8-bit grey PNG, near = white, `max_depth_m` and background
@@ -99,16 +105,38 @@ impl CameraOutput {
         let grey: Vec<u8> = self
             .depth_m
             .iter()
-            .map(|&d| if d > 0.0 { (255.0 * (1.0 - (d / max_depth_m).clamp(0.0, 1.0))) as u8 } else { 0 })
+            .map(|&d| {
+                if d > 0.0 {
+                    (255.0 * (1.0 - (d / max_depth_m).clamp(0.0, 1.0))) as u8
+                } else {
+                    0
+                }
+            })
             .collect();
-        save_png(path, self.width(), self.height(), image::ColorType::L8, &grey)
+        save_png(
+            path,
+            self.width(),
+            self.height(),
+            image::ColorType::L8,
+            &grey,
+        )
     }
 
     /// Writes the link segmentation as a PNG with one arbitrary bright colour per id
     /// (background black).
     pub fn save_segmentation_png(&self, path: &Path) -> Result<(), RenderError> {
-        let rgb: Vec<u8> = self.segmentation_link.iter().flat_map(|&id| id_color(id)).collect();
-        save_png(path, self.width(), self.height(), image::ColorType::Rgb8, &rgb)
+        let rgb: Vec<u8> = self
+            .segmentation_link
+            .iter()
+            .flat_map(|&id| id_color(id))
+            .collect();
+        save_png(
+            path,
+            self.width(),
+            self.height(),
+            image::ColorType::Rgb8,
+            &rgb,
+        )
     }
 }
 
@@ -118,7 +146,11 @@ fn id_color(id: u32) -> [u8; 3] {
         return [0, 0, 0];
     }
     let h = id.wrapping_mul(2_654_435_761);
-    [(h >> 24) as u8 | 0x40, (h >> 16) as u8 | 0x40, (h >> 8) as u8 | 0x40]
+    [
+        (h >> 24) as u8 | 0x40,
+        (h >> 16) as u8 | 0x40,
+        (h >> 8) as u8 | 0x40,
+    ]
 }
 
 /// Encodes `data` as PNG into `path` via a temporary sibling file and a rename.
@@ -129,7 +161,10 @@ pub(crate) fn save_png(
     color: image::ColorType,
     data: &[u8],
 ) -> Result<(), RenderError> {
-    let err = |reason: String| RenderError::ImageWrite { path: path.to_path_buf(), reason };
+    let err = |reason: String| RenderError::ImageWrite {
+        path: path.to_path_buf(),
+        reason,
+    };
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");
     let tmp = std::path::PathBuf::from(tmp);

@@ -29,7 +29,9 @@ impl BackendChoice {
             "auto" | "" => Ok(BackendChoice::Auto),
             "vulkan" | "vk" => Ok(BackendChoice::Vulkan),
             "gl" | "gles" | "opengl" | "egl" => Ok(BackendChoice::Gl),
-            _ => Err(RenderError::UnknownBackend { value: value.to_string() }),
+            _ => Err(RenderError::UnknownBackend {
+                value: value.to_string(),
+            }),
         }
     }
 }
@@ -44,6 +46,14 @@ pub struct RendererConfig {
 /// Handle to a mesh in a renderer's shared store.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct MeshHandle(pub(crate) u32);
+
+impl MeshHandle {
+    /// A handle from its raw index (for tests and serialisation; using an index the renderer
+    /// never returned gives [`RenderError::UnknownMesh`] at render time).
+    pub fn from_raw(index: u32) -> MeshHandle {
+        MeshHandle(index)
+    }
+}
 
 /// Handle to a texture in a renderer's shared store.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -157,7 +167,10 @@ fn pick_adapter(choice: BackendChoice) -> Result<wgpu::Adapter, RenderError> {
         }
     }
     let names: Vec<String> = order.iter().map(|b| format!("{b:?}")).collect();
-    Err(RenderError::NoAdapter { backends: names.join(" then "), advice: INSTALL_ADVICE })
+    Err(RenderError::NoAdapter {
+        backends: names.join(" then "),
+        advice: INSTALL_ADVICE,
+    })
 }
 
 impl Renderer {
@@ -178,7 +191,10 @@ impl Renderer {
             required_limits: adapter.limits(),
             ..Default::default()
         }))
-        .map_err(|e| RenderError::DeviceCreation { adapter: info.name.clone(), reason: e.to_string() })?;
+        .map_err(|e| RenderError::DeviceCreation {
+            adapter: info.name.clone(),
+            reason: e.to_string(),
+        })?;
         let gpu = Gpu::new(device, queue);
         Ok(Renderer {
             inner: Arc::new(RendererInner {
@@ -220,7 +236,11 @@ impl Renderer {
             }),
             index_count: mesh.indices.len() as u32,
         };
-        let mut store = self.inner.store.write().expect("resource store lock poisoned");
+        let mut store = self
+            .inner
+            .store
+            .write()
+            .expect("resource store lock poisoned");
         store.meshes.push(gpu_mesh);
         self.inner
             .triangle_counts
@@ -247,15 +267,26 @@ impl Renderer {
             )));
         }
         let bind_group = self.inner.gpu.upload_texture(w, h, &texture.rgba8_srgb);
-        let mut store = self.inner.store.write().expect("resource store lock poisoned");
+        let mut store = self
+            .inner
+            .store
+            .write()
+            .expect("resource store lock poisoned");
         store.textures.push(bind_group);
         Ok(TextureHandle(store.textures.len() as u32 - 1))
     }
 
     /// Number of triangles of a stored mesh.
     pub fn mesh_triangle_count(&self, mesh: MeshHandle) -> Result<usize, RenderError> {
-        let counts = self.inner.triangle_counts.read().expect("triangle count lock poisoned");
-        counts.get(mesh.0 as usize).copied().ok_or(RenderError::UnknownMesh(mesh.0, counts.len()))
+        let counts = self
+            .inner
+            .triangle_counts
+            .read()
+            .expect("triangle count lock poisoned");
+        counts
+            .get(mesh.0 as usize)
+            .copied()
+            .ok_or(RenderError::UnknownMesh(mesh.0, counts.len()))
     }
 }
 
@@ -413,27 +444,37 @@ fn texture_bind_group(
 ) -> wgpu::BindGroup {
     use wgpu::util::TextureDataOrder;
     let texture = device.create_texture_with_data(
-            queue,
-            &wgpu::TextureDescriptor {
-                label: Some("ms2-render texture"),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba8UnormSrgb,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some("ms2-render texture"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
             },
-            TextureDataOrder::LayerMajor,
-            rgba8_srgb,
-        );
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        TextureDataOrder::LayerMajor,
+        rgba8_srgb,
+    );
     let view = texture.create_view(&Default::default());
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("ms2-render texture"),
         layout,
         entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(sampler) },
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Sampler(sampler),
+            },
         ],
     })
 }

@@ -19,7 +19,10 @@ pub struct Material {
 impl Material {
     /// An untextured material of the given linear RGB colour.
     pub fn color(r: f32, g: f32, b: f32) -> Material {
-        Material { base_color: [r, g, b, 1.0], texture: None }
+        Material {
+            base_color: [r, g, b, 1.0],
+            texture: None,
+        }
     }
 }
 
@@ -201,7 +204,9 @@ impl Scene {
         }
         for (k, inst) in self.instances.iter().enumerate() {
             let m = inst.pose_world_from_mesh.to_homogeneous();
-            if !(m.iter().all(|v| v.is_finite()) && inst.scale.iter().all(|v| v.is_finite() && *v != 0.0)) {
+            if !(m.iter().all(|v| v.is_finite())
+                && inst.scale.iter().all(|v| v.is_finite() && *v != 0.0))
+            {
                 return Err(RenderError::InvalidScene(format!(
                     "instance {k}: pose and scale must be finite and scale non-zero (scale {:?})",
                     inst.scale
