@@ -41,6 +41,7 @@
 //! # Ok::<(), RenderError>(())
 //! ```
 
+mod atlas;
 pub mod camera;
 mod error;
 mod frame;

