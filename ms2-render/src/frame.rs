@@ -3,11 +3,13 @@
 //! [`Renderer::submit`] encodes and submits one batch and returns at once with a
 //! [`PendingFrame`]; the GPU (or lavapipe's worker threads) renders while the caller steps
 //! physics, and [`PendingFrame::wait`] collects the images. Per-batch GPU objects (targets,
-//! uniform, instance and readback buffers) are pooled by batch shape and reused.
+//! uniform, instance and readback buffers) are pooled by batch shape and reused. Each camera
+//! has its own small targets and render pass: on lavapipe that beat one shared atlas texture
+//! (llvmpipe bins per-draw state into every tile of a render pass's framebuffer).
 
-use crate::atlas::{linear_to_srgb8, FrameResources};
 use crate::renderer::{Renderer, ResourceStore, CAMERA_BLOCK_BYTES, INSTANCE_BYTES};
 use crate::scene::MAX_DIRECTIONAL_LIGHTS;
+use crate::targets::{linear_to_srgb8, CameraTargets, FrameResources};
 use crate::{Camera, CameraOutput, RenderError, Scene};
 use std::sync::{Arc, Mutex};
 
@@ -173,15 +175,9 @@ impl Renderer {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("ms2-render batch"),
             });
-        // One render pass per camera (the first clears the whole atlas): on lavapipe this is
-        // 1.4-2.5x faster than one pass for all cameras, whose per-draw state llvmpipe bins into
-        // every tile of the atlas.
-        for (c, slot) in resources.slots.iter().enumerate() {
-            let mut pass = begin_pass(&mut encoder, &resources, c == 0);
+        for (c, targets) in resources.targets.iter().enumerate() {
+            let mut pass = begin_pass(&mut encoder, targets);
             pass.set_pipeline(&gpu.pipeline);
-            let (x, y, w, h) = (slot.x, slot.y, slot.width, slot.height);
-            pass.set_viewport(x as f32, y as f32, w as f32, h as f32, 0.0, 1.0);
-            pass.set_scissor_rect(x, y, w, h);
             let offset = (c as u64 * gpu.uniform_stride) as u32;
             pass.set_bind_group(0, &resources.camera_bind_group, &[offset]);
             for draw in &draws[camera_scene[c]] {
@@ -224,50 +220,33 @@ impl Renderer {
     }
 }
 
-/// Begins a render pass over the whole atlas, clearing it (`clear`) or keeping its contents.
+/// Begins a camera's render pass, clearing its targets.
 fn begin_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
-    resources: &FrameResources,
-    clear: bool,
+    targets: &CameraTargets,
 ) -> wgpu::RenderPass<'e> {
-    let load = |value| {
-        if clear {
-            wgpu::LoadOp::Clear(value)
-        } else {
-            wgpu::LoadOp::Load
-        }
+    let clear = |view, value| {
+        Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(value),
+                store: wgpu::StoreOp::Store,
+            },
+        })
     };
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("ms2-render batch"),
+        label: Some("ms2-render camera"),
         color_attachments: &[
-            Some(wgpu::RenderPassColorAttachment {
-                view: &resources.color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: load(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            }),
-            Some(wgpu::RenderPassColorAttachment {
-                view: &resources.gbuffer_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: load(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            }),
+            clear(&targets.color_view, wgpu::Color::BLACK),
+            clear(&targets.gbuffer_view, wgpu::Color::TRANSPARENT),
         ],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &resources.depth_view,
+            view: &targets.depth_view,
             depth_ops: Some(wgpu::Operations {
-                load: if clear {
-                    wgpu::LoadOp::Clear(1.0)
-                } else {
-                    wgpu::LoadOp::Load
-                },
-                store: wgpu::StoreOp::Store,
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
             }),
             stencil_ops: None,
         }),
@@ -343,14 +322,7 @@ impl PendingFrame {
                 .map_err(|e| RenderError::Gpu(format!("reading images back failed: {e}")))?;
             let bytes: &[u8] = &view;
             (0..self.cameras.len())
-                .map(|c| {
-                    resources.decode(
-                        bytes,
-                        resources.slots[c],
-                        self.cameras[c],
-                        self.backgrounds[c],
-                    )
-                })
+                .map(|c| resources.targets[c].decode(bytes, self.cameras[c], self.backgrounds[c]))
                 .collect()
         };
         resources.readback.unmap();

@@ -41,7 +41,6 @@
 //! # Ok::<(), RenderError>(())
 //! ```
 
-mod atlas;
 pub mod camera;
 mod error;
 mod frame;
@@ -49,6 +48,7 @@ pub mod mesh;
 mod output;
 mod renderer;
 pub mod scene;
+mod targets;
 
 pub use camera::Camera;
 pub use error::{RenderError, INSTALL_ADVICE};

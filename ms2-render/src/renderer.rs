@@ -1,7 +1,7 @@
 //! The renderer: adapter selection, the shared mesh/texture store and the render pipeline.
 
-use crate::atlas::FramePool;
 use crate::error::INSTALL_ADVICE;
+use crate::targets::FramePool;
 use crate::{MeshData, RenderError};
 use std::sync::{Arc, Mutex, RwLock};
 use wgpu::util::DeviceExt;
