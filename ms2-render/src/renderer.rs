@@ -166,7 +166,16 @@ fn pick_adapter(choice: BackendChoice) -> Result<wgpu::Adapter, RenderError> {
             return Ok(adapter);
         }
     }
-    let names: Vec<String> = order.iter().map(|b| format!("{b:?}")).collect();
+    let names: Vec<&str> = order
+        .iter()
+        .map(|&b| {
+            if b == wgpu::Backends::VULKAN {
+                "Vulkan"
+            } else {
+                "GL (EGL)"
+            }
+        })
+        .collect();
     Err(RenderError::NoAdapter {
         backends: names.join(" then "),
         advice: INSTALL_ADVICE,

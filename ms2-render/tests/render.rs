@@ -140,6 +140,13 @@ fn box_point_cloud_lies_on_its_surface() {
         }
         assert!(hits > 100, "the box covers only {hits} pixels");
     }
+    // Fused over both cameras: every point keeps its pixel's colour and ids.
+    let fused = FusedPointCloud::from_cameras(&outputs);
+    assert_eq!(fused.len(), 2 * 128 * 128);
+    let i = 128 * 128 + 77;
+    assert_eq!(fused.xyzw[i], outputs[1].point_cloud_world()[77]);
+    assert_eq!(fused.rgb[i][..], outputs[1].rgb[3 * 77..3 * 77 + 3]);
+    assert_eq!(fused.segmentation_link[i], outputs[1].segmentation_link[77]);
 }
 
 #[test]
@@ -379,4 +386,28 @@ fn golden_image_matches_within_rasterizer_tolerance() {
         mean < 2.0 && large < 0.02,
         "mean channel difference {mean}, {large} of channels differ by more than 24"
     );
+}
+
+#[test]
+fn environments_in_threads_share_one_renderer() {
+    let BoxScene { scene, .. } = box_scene();
+    let camera = base_camera(32);
+    let alone = renderer().render(&[(&scene, &[camera][..])]).unwrap();
+    let results: Vec<Vec<CameraOutput>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..3)
+            .map(|_| {
+                let (shared, scene) = (renderer().clone(), scene.clone());
+                s.spawn(move || {
+                    (0..3)
+                        .map(|_| shared.render(&[(&scene, &[camera][..])]).unwrap())
+                        .last()
+                        .unwrap()
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for r in &results {
+        assert!(r == &alone, "a render from another thread differs");
+    }
 }
