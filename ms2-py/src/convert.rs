@@ -30,7 +30,9 @@ fn owned_array<'py, T: numpy::Element>(
     data: Vec<T>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let array = ArrayD::from_shape_vec(IxDyn(shape), data).map_err(|e| {
-        NativeError::Input(format!("array data does not match its shape {shape:?}: {e}"))
+        NativeError::Input(format!(
+            "array data does not match its shape {shape:?}: {e}"
+        ))
     })?;
     Ok(PyArray::from_owned_array(py, array).into_any())
 }
@@ -65,11 +67,16 @@ fn concat_data<T: Clone>(
     parts: &[&Array],
     pick: impl Fn(&ArrayData) -> Option<&Vec<T>>,
 ) -> Result<Vec<T>, NativeError> {
-    let total: usize = parts.iter().map(|a| a.shape.iter().product::<usize>()).sum();
+    let total: usize = parts
+        .iter()
+        .map(|a| a.shape.iter().product::<usize>())
+        .sum();
     let mut out = Vec::with_capacity(total);
     for (i, part) in parts.iter().enumerate() {
         let data = pick(&part.data).ok_or_else(|| {
-            NativeError::Input(format!("observation of env {i} has a different dtype than env 0"))
+            NativeError::Input(format!(
+                "observation of env {i} has a different dtype than env 0"
+            ))
         })?;
         out.extend_from_slice(data);
     }
@@ -93,22 +100,46 @@ fn stack_arrays<'py>(py: Python<'py>, parts: &[&Array]) -> PyResult<Bound<'py, P
         ArrayData::F32(_) => owned_array(
             py,
             &shape,
-            concat_data(parts, |d| if let ArrayData::F32(v) = d { Some(v) } else { None })?,
+            concat_data(parts, |d| {
+                if let ArrayData::F32(v) = d {
+                    Some(v)
+                } else {
+                    None
+                }
+            })?,
         ),
         ArrayData::U8(_) => owned_array(
             py,
             &shape,
-            concat_data(parts, |d| if let ArrayData::U8(v) = d { Some(v) } else { None })?,
+            concat_data(parts, |d| {
+                if let ArrayData::U8(v) = d {
+                    Some(v)
+                } else {
+                    None
+                }
+            })?,
         ),
         ArrayData::U32(_) => owned_array(
             py,
             &shape,
-            concat_data(parts, |d| if let ArrayData::U32(v) = d { Some(v) } else { None })?,
+            concat_data(parts, |d| {
+                if let ArrayData::U32(v) = d {
+                    Some(v)
+                } else {
+                    None
+                }
+            })?,
         ),
         ArrayData::Bool(_) => owned_array(
             py,
             &shape,
-            concat_data(parts, |d| if let ArrayData::Bool(v) = d { Some(v) } else { None })?,
+            concat_data(parts, |d| {
+                if let ArrayData::Bool(v) = d {
+                    Some(v)
+                } else {
+                    None
+                }
+            })?,
         ),
     }
 }
@@ -209,7 +240,10 @@ pub fn info_to_py<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDi
 /// The infos of `num_envs` envs as gymnasium's vector info: for each key, a numpy array with one
 /// entry per env (bool, float64 or int64, after the key's first value) and a boolean mask
 /// `"_<key>"` of the envs that reported it. `None` entries (envs not stepped) report nothing.
-pub fn vec_info_to_py<'py>(py: Python<'py>, infos: &[Option<&Info>]) -> PyResult<Bound<'py, PyDict>> {
+pub fn vec_info_to_py<'py>(
+    py: Python<'py>,
+    infos: &[Option<&Info>],
+) -> PyResult<Bound<'py, PyDict>> {
     let num_envs = infos.len();
     let mut keys: Vec<(&str, &InfoValue)> = Vec::new();
     for info in infos.iter().flatten() {

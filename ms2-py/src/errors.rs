@@ -104,7 +104,10 @@ pub fn catch_panics<T>(f: impl FnOnce() -> Result<T, NativeError>) -> Result<T, 
 
 /// Locks `mutex`, or reports that a panic while it was held poisoned it (`what` names the object
 /// for the message).
-pub fn lock<'a, T>(mutex: &'a Mutex<T>, what: &'static str) -> Result<MutexGuard<'a, T>, NativeError> {
+pub fn lock<'a, T>(
+    mutex: &'a Mutex<T>,
+    what: &'static str,
+) -> Result<MutexGuard<'a, T>, NativeError> {
     mutex.lock().map_err(|_| NativeError::Poisoned(what))
 }
 

@@ -27,11 +27,22 @@ fn env_ids() -> PyResult<Vec<String>> {
     Ok(ids.into_iter().map(str::to_owned).collect())
 }
 
+/// The default episode limit (env steps) of task `env_id` (`ValueError` for an unknown id).
+#[pyfunction]
+fn default_max_episode_steps(py: Python<'_>, env_id: String) -> PyResult<u32> {
+    let cfg = ms2_tasks::EnvConfig::new(&env_id);
+    let steps =
+        py.detach(|| errors::catch_panics(|| Ok(ms2_tasks::make_env(&cfg)?.max_episode_steps())))?;
+    Ok(steps)
+}
+
 /// Panics inside a guarded native call with `message`: a test hook showing that a Rust panic
 /// reaches Python as `RuntimeError` (see `errors`).
 #[pyfunction]
 fn _panic_for_tests(py: Python<'_>, message: String) -> PyResult<()> {
-    py.detach(|| errors::catch_panics(|| -> Result<(), errors::NativeError> { panic!("{message}") }))?;
+    py.detach(|| {
+        errors::catch_panics(|| -> Result<(), errors::NativeError> { panic!("{message}") })
+    })?;
     Ok(())
 }
 
@@ -50,5 +61,7 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<policy::NativeScriptedPolicy>()?;
     m.add_function(wrap_pyfunction!(env_ids, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(default_max_episode_steps, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     Ok(())
 }

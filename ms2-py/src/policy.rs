@@ -22,9 +22,7 @@ impl NativeScriptedPolicy {
     /// The scripted policy for `env`'s task and control mode (`ValueError` if there is none).
     #[new]
     fn new(py: Python<'_>, env: Py<NativeEnv>) -> PyResult<Self> {
-        let policy = env
-            .get()
-            .with_env(py, |e| Ok(make_scripted_policy(e)?))?;
+        let policy = env.get().with_env(py, |e| Ok(make_scripted_policy(e)?))?;
         Ok(NativeScriptedPolicy {
             policy: Mutex::new(policy),
             env,
@@ -44,10 +42,9 @@ impl NativeScriptedPolicy {
     /// The next action (float32, the env's action shape) for the env's current state.
     fn act<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f32>>> {
         let policy = &self.policy;
-        let action = self
-            .env
-            .get()
-            .with_env(py, |env| Ok::<_, NativeError>(lock(policy, "scripted policy")?.act(env)))?;
+        let action = self.env.get().with_env(py, |env| {
+            Ok::<_, NativeError>(lock(policy, "scripted policy")?.act(env))
+        })?;
         Ok(PyArray1::from_vec(py, action))
     }
 }

@@ -4,7 +4,7 @@
 use std::sync::Mutex;
 
 use ms2_tasks::{Env, EnvError, Info, ObsValue, VecEnv};
-use numpy::{PyArray1, PyReadonlyArray2};
+use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
@@ -55,14 +55,21 @@ impl NativeVecEnv {
         let trees: Vec<&ObsValue> = state
             .last_obs
             .iter()
-            .map(|o| o.as_ref().ok_or(NativeError::Input("an env was never reset".to_owned())))
+            .map(|o| {
+                o.as_ref()
+                    .ok_or(NativeError::Input("an env was never reset".to_owned()))
+            })
             .collect::<Result<_, _>>()?;
         stack_obs(py, &trees)
     }
 }
 
 /// Resets `env`, storing its observation.
-fn reset_one(env: &mut Env, seed: Option<u64>, obs: &mut Option<ObsValue>) -> Result<Info, EnvError> {
+fn reset_one(
+    env: &mut Env,
+    seed: Option<u64>,
+    obs: &mut Option<ObsValue>,
+) -> Result<Info, EnvError> {
     let (o, info) = env.reset(seed, false)?;
     *obs = Some(o);
     Ok(info)
@@ -201,7 +208,9 @@ impl NativeVecEnv {
         }
         let actions: Vec<f32> = actions
             .as_slice()
-            .map_err(|_| NativeError::Input("actions must be a contiguous float32 array".to_owned()))?
+            .map_err(|_| {
+                NativeError::Input("actions must be a contiguous float32 array".to_owned())
+            })?
             .to_vec();
         // Refuse the whole batch before any env steps, so a bad row leaves every env untouched.
         if let Some(k) = actions.iter().position(|a| !a.is_finite()) {
@@ -290,7 +299,10 @@ impl NativeVecEnv {
     fn get_state<'py>(&self, py: Python<'py>, index: usize) -> PyResult<Bound<'py, PyArray1<f32>>> {
         let state = lock(&self.inner, "vector env")?;
         let env = state.envs.envs().get(index).ok_or_else(|| {
-            NativeError::Input(format!("env index {index} out of range for {} envs", self.num_envs))
+            NativeError::Input(format!(
+                "env index {index} out of range for {} envs",
+                self.num_envs
+            ))
         })?;
         Ok(PyArray1::from_vec(py, env.get_state()))
     }

@@ -15,7 +15,8 @@ from gymnasium import spaces
 def to_gym_space(description: Any) -> spaces.Space:
     """The gymnasium space (``Box`` or nested ``Dict`` of ``Box``) for a native description."""
     if isinstance(description, dict):
-        return spaces.Dict({key: to_gym_space(value) for key, value in description.items()})
+        # A sequence of pairs keeps the layout order (a plain dict would be sorted by key).
+        return spaces.Dict([(key, to_gym_space(value)) for key, value in description.items()])
     kind, shape, low, high, dtype = description
     if kind != "box":
         raise ValueError(f"unknown native space kind {kind!r}; expected 'box'")
