@@ -6,16 +6,17 @@ import re
 import subprocess
 import sys
 
+from conftest import ENV_IDS, MAIN_ID
 from ms2.cli import main
 
 
 def test_envs_lists_tasks(capsys):
     assert main(["envs"]) == 0
-    assert "PickCube-v0" in capsys.readouterr().out.split()
+    assert capsys.readouterr().out.split() == ENV_IDS
 
 
 def test_run_scripted_prints_success_rate_and_speed(capsys):
-    assert main(["run", "PickCube-v0", "--policy", "scripted", "--episodes", "2"]) == 0
+    assert main(["run", MAIN_ID, "--policy", "scripted", "--episodes", "2"]) == 0
     out = capsys.readouterr().out
     m = re.search(
         r"success rate (\d+)/2 = ([\d.]+) %, (\d+) env steps in [\d.]+ s = (\d+) steps/s", out
@@ -26,10 +27,10 @@ def test_run_scripted_prints_success_rate_and_speed(capsys):
 
 
 def test_run_random_and_bad_env(capsys):
-    assert main(["run", "LiftCube-v0", "--policy", "random", "--episodes", "1"]) == 0
+    assert main(["run", ENV_IDS[-1], "--policy", "random", "--episodes", "1"]) == 0
     assert "success rate 0/1" in capsys.readouterr().out
     assert main(["run", "NoSuchEnv-v0", "--episodes", "1"]) == 2
-    assert "PickCube-v0" in capsys.readouterr().err
+    assert MAIN_ID in capsys.readouterr().err
 
 
 def test_python_dash_m_and_bench_smoke():
@@ -43,6 +44,8 @@ def test_python_dash_m_and_bench_smoke():
             "40",
             "--num-envs",
             "2",
+            "--env-id",
+            MAIN_ID,
             "--control-modes",
             "pd_joint_delta_pos",
         ],

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import ms2
 import pytest
-from conftest import make
+from conftest import MAIN_ID, make, preferred_control_mode
 
 #: Episodes per task; the success-rate floor leaves room for the odd hard initial state.
 EPISODES = 10
@@ -12,7 +12,7 @@ MIN_SUCCESS_RATE = 0.8
 
 
 def test_scripted_policy_success_rate(env_id):
-    env = make(env_id, obs_mode="state", control_mode="pd_ee_delta_pose")
+    env = make(env_id, obs_mode="state", control_mode=preferred_control_mode(env_id))
     policy = ms2.ScriptedPolicy(env)
     successes = 0
     for seed in range(EPISODES):
@@ -27,7 +27,7 @@ def test_scripted_policy_success_rate(env_id):
 
 
 def test_random_policy_rarely_succeeds():
-    env = make("PickCube-v0", obs_mode="state", control_mode="pd_ee_delta_pose")
+    env = make(MAIN_ID, obs_mode="state", control_mode=preferred_control_mode(MAIN_ID))
     successes = 0
     for seed in range(3):
         env.reset(seed=seed)

@@ -6,18 +6,20 @@ import gymnasium as gym
 import ms2
 import numpy as np
 import pytest
-from conftest import assert_obs_equal
+from conftest import MAIN_ID, assert_obs_equal, preferred_control_mode, random_actions
 
 
 def _single_envs(n, **kwargs):
-    return [ms2.Ms2Env("PickCube-v0", **kwargs) for _ in range(n)]
+    return [ms2.Ms2Env(MAIN_ID, **kwargs) for _ in range(n)]
 
 
 @pytest.mark.parametrize("obs_mode", ["state", "state_dict"])
 def test_vector_matches_single_envs_with_autoreset(obs_mode):
     n, limit = 3, 6
-    kwargs = dict(obs_mode=obs_mode, control_mode="pd_ee_delta_pose", max_episode_steps=limit)
-    envs = ms2.make_vec("PickCube-v0", num_envs=n, **kwargs)
+    kwargs = dict(
+        obs_mode=obs_mode, control_mode=preferred_control_mode(MAIN_ID), max_episode_steps=limit
+    )
+    envs = ms2.make_vec(MAIN_ID, num_envs=n, **kwargs)
     singles = _single_envs(n, **kwargs)
     assert envs.single_observation_space == singles[0].observation_space
     assert envs.single_action_space == singles[0].action_space
@@ -29,11 +31,10 @@ def test_vector_matches_single_envs_with_autoreset(obs_mode):
         assert_obs_equal(_row(batch, i), expected[i])
 
     rng = np.random.default_rng(5)
-    space = envs.single_action_space
     pending = [False] * n
     saw_autoreset = False
     for step in range(2 * limit + 2):
-        actions = rng.uniform(space.low, space.high, size=(n, *space.shape)).astype(np.float32)
+        actions = random_actions(envs.single_action_space, rng, n)
         batch, rewards, terminated, truncated, infos = envs.step(actions)
         assert rewards.dtype == np.float64 and rewards.shape == (n,)
         assert terminated.dtype == np.bool_ and truncated.dtype == np.bool_
@@ -60,11 +61,12 @@ def _row(batch, i):
 
 
 def test_vector_info_and_spaces():
-    envs = ms2.make_vec("PickCube-v0", num_envs=4, obs_mode="state")
+    envs = ms2.make_vec(MAIN_ID, num_envs=4, obs_mode="state")
+    single = ms2.Ms2Env(MAIN_ID, obs_mode="state").observation_space
     assert envs.metadata["autoreset_mode"] == gym.vector.AutoresetMode.NEXT_STEP
-    assert envs.observation_space.shape == (4, 51)
+    assert envs.observation_space.shape == (4, *single.shape)
     obs, info = envs.reset(seed=0)
-    assert obs.shape == (4, 51) and obs.dtype == np.float32
+    assert obs.shape == (4, *single.shape) and obs.dtype == np.float32
     obs, rewards, term, trunc, info = envs.step(envs.action_space.sample())
     assert info["success"].dtype == np.bool_ and info["success"].shape == (4,)
     assert info["_success"].all()
@@ -74,7 +76,7 @@ def test_vector_info_and_spaces():
 
 
 def test_vector_seed_list_and_reset_mask():
-    envs = ms2.make_vec("PickCube-v0", num_envs=3, obs_mode="state")
+    envs = ms2.make_vec(MAIN_ID, num_envs=3, obs_mode="state")
     a, _ = envs.reset(seed=[5, 6, 7])
     b, _ = envs.reset(seed=5)
     np.testing.assert_array_equal(a, b)
@@ -90,23 +92,26 @@ def test_vector_seed_list_and_reset_mask():
 
 
 def test_vector_bad_actions():
-    envs = ms2.make_vec("PickCube-v0", num_envs=2, obs_mode="state")
+    envs = ms2.make_vec(MAIN_ID, num_envs=2, obs_mode="state")
     envs.reset(seed=0)
+    d = envs.single_action_space.shape[0]
     with pytest.raises(ValueError, match="shape"):
-        envs.step(np.zeros((3, 8), np.float32))
-    bad = np.zeros((2, 8), np.float32)
+        envs.step(np.zeros((3, d), np.float32))
+    with pytest.raises(ValueError, match="shape"):
+        envs.step(np.zeros((2, d + 1), np.float32))
+    bad = np.zeros((2, d), np.float32)
     bad[1, 2] = np.nan
     with pytest.raises(ValueError, match="env 1"):
         envs.step(bad)
     # Nothing was stepped by the refused call: both envs are still at step 0.
-    _, _, _, _, info = envs.step(np.zeros((2, 8), np.float32))
+    _, _, _, _, info = envs.step(np.zeros((2, d), np.float32))
     assert info["elapsed_steps"].tolist() == [1, 1]
 
 
 def test_gymnasium_make_vec_uses_native_vector_env():
     envs = gym.make_vec(
-        "PickCube-v0", num_envs=2, vectorization_mode="vector_entry_point", obs_mode="state"
+        MAIN_ID, num_envs=2, vectorization_mode="vector_entry_point", obs_mode="state"
     )
     assert isinstance(envs.unwrapped, ms2.Ms2VectorEnv)
     obs, _ = envs.reset(seed=1)
-    assert obs.shape == (2, 51)
+    assert obs.shape == (2, *envs.single_observation_space.shape)

@@ -29,10 +29,14 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     import ms2
 
+    control_mode = args.control_mode
+    if control_mode is None:
+        supported = ms2.Ms2Env(args.env_id).supported_control_modes
+        control_mode = "pd_ee_delta_pose" if "pd_ee_delta_pose" in supported else None
     env = gym.make(
         args.env_id,
         obs_mode=args.obs_mode,
-        control_mode=args.control_mode,
+        control_mode=control_mode,
         reward_mode=args.reward_mode,
     )
     policy = ms2.ScriptedPolicy(env) if args.policy == "scripted" else None
@@ -79,7 +83,11 @@ def _add_run_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--episodes", type=int, default=20)
     p.add_argument("--seed", type=int, default=0, help="seed of the first episode (then +1 each)")
     p.add_argument("--obs-mode", default="state")
-    p.add_argument("--control-mode", default="pd_ee_delta_pose")
+    p.add_argument(
+        "--control-mode",
+        default=None,
+        help="default: pd_ee_delta_pose where the robot has it, else the task's default",
+    )
     p.add_argument("--reward-mode", default=None)
     p.add_argument("-v", "--verbose", action="store_true", help="print one line per episode")
     p.set_defaults(func=_cmd_run)

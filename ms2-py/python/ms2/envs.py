@@ -87,13 +87,14 @@ class Ms2Env(gym.Env):
         """Starts an episode. ``seed`` makes it reproducible; ``seed=None`` continues the env's
         random sequence (seeded from OS entropy on the first reset). ``options={"reconfigure":
         True}`` rebuilds the scene (ManiSkill2's option)."""
+        if seed is not None:
+            if not isinstance(seed, (int, np.integer)) or seed < 0:
+                raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+            seed = int(seed)
         super().reset(seed=seed)
         if seed is None and not self._seeded:
             seed = _seed_from(self.np_random)
         if seed is not None:
-            seed = int(seed)
-            if seed < 0:
-                raise ValueError(f"seed must be a non-negative integer, got {seed}")
             self._seeded = True
         reconfigure = bool((options or {}).get("reconfigure", False))
         return self._native.reset(seed=seed, reconfigure=reconfigure)
