@@ -58,9 +58,12 @@ fi
 # when nothing changed) and installs the package in editable mode: the Python sources in
 # ms2-py/python are used in place.
 echo "[setup] building the ms2 Python package (maturin develop --release)"
-(cd ms2-py && maturin develop --release --quiet 2>&1 | grep -vE '^(📦|✏️|🛠|🍹|🐍|🔗|Looking in links)' || true)
-python -c 'import ms2' || {
-  echo "[setup] error: the ms2 package failed to build or import" >&2
-  exit 1
-}
+if [ "$(cat .venv/.ms2-installed 2>/dev/null)" = "$REQ_HASH" ]; then
+  # Already installed in editable mode: rebuilding the extension in place is enough.
+  (cd ms2-py && maturin develop --release --quiet --skip-install)
+else
+  (cd ms2-py && maturin develop --release --quiet)
+  echo "$REQ_HASH" >.venv/.ms2-installed
+fi
+python -c 'import ms2'
 echo "[setup] done: activate the venv with '. $ROOT/.venv/bin/activate'"
