@@ -398,10 +398,11 @@ fn environments_in_threads_share_one_renderer() {
             .map(|_| {
                 let (shared, scene) = (renderer().clone(), scene.clone());
                 s.spawn(move || {
-                    (0..3)
-                        .map(|_| shared.render(&[(&scene, &[camera][..])]).unwrap())
-                        .last()
-                        .unwrap()
+                    let mut last = Vec::new();
+                    for _ in 0..3 {
+                        last = shared.render(&[(&scene, &[camera][..])]).unwrap();
+                    }
+                    last
                 })
             })
             .collect();
