@@ -20,7 +20,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   echo "[bench] creating $VENV" >&2
   "$PY" -m venv "$VENV"
 fi
-if ! "$VENV/bin/python" -c "import taichi" 2>/dev/null; then
+if ! "$VENV/bin/python" -c "import taichi" >/dev/null 2>&1; then
   echo "[bench] installing taichi 1.7.4 into $VENV" >&2
   "$VENV/bin/python" -m pip install -q "taichi==1.7.4"
 fi
@@ -33,7 +33,9 @@ field() { # field NAME LINE
   tr ' ' '\n' <<<"$2" | sed -n "s/^$1=//p"
 }
 
-printf '%-10s %-8s %-22s %-22s %s\n' particles threads "ms2-mpm (p·substep/s)" "taichi (p·substep/s)" ratio
+# top_z: height (m) of the block's top after the run, from each engine: the same physics.
+printf '%-10s %-8s %-22s %-22s %-7s %s\n' particles threads "ms2-mpm (p·substep/s)" \
+  "taichi (p·substep/s)" ratio "top_z ms2 / taichi (m)"
 for n in $PARTICLES; do
   for t in 1 "$ALL"; do
     ours=$("$MS2" "$n" "$t" "$SUBSTEPS")
@@ -41,7 +43,8 @@ for n in $PARTICLES; do
     a=$(field particle_substeps_per_s "$ours")
     b=$(field particle_substeps_per_s "$theirs")
     ratio=$(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.2f", a / b }')
-    printf '%-10s %-8s %-22s %-22s %sx\n' "$n" "$t" "$a" "$b" "$ratio"
+    printf '%-10s %-8s %-22s %-22s %-7s %s / %s\n' "$n" "$t" "$a" "$b" "${ratio}x" \
+      "$(field top_z "$ours")" "$(field top_z "$theirs")"
     if [ "$t" = "$ALL" ] && [ "$ALL" = 1 ]; then break; fi
   done
 done

@@ -7,9 +7,9 @@
 use glam::{Mat3, Vec3};
 
 use crate::error::MpmError;
-use crate::math::Svd3;
 #[cfg(test)]
 use crate::math::svd3;
+use crate::math::Svd3;
 
 /// Constitutive behaviour of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
