@@ -40,8 +40,10 @@ pub struct TcpKinematics {
 
 impl TcpKinematics {
     pub fn new() -> Self {
-        let mut config = WorldConfig::default();
-        config.ground = None;
+        let config = WorldConfig {
+            ground: None,
+            ..WorldConfig::default()
+        };
         let mut world = World::new(config).unwrap();
         let panda = add_panda(&mut world, &PandaOptions::default()).unwrap();
         let tcp = world.link_index(panda, ms2_assets::PANDA_TCP_LINK).unwrap();
