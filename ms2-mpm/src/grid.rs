@@ -176,6 +176,18 @@ impl GridStorage {
             .collect();
     }
 
+    /// Total mass (kg) on the active blocks (the only ones the last transfer wrote).
+    pub fn active_mass(&self) -> f64 {
+        self.active
+            .iter()
+            .flat_map(|&b| {
+                let start = b as usize * BLOCK_NODES;
+                &self.nodes[start..start + BLOCK_NODES]
+            })
+            .map(|n| n[3] as f64)
+            .sum()
+    }
+
     /// Zeroes every active block.
     pub fn clear_active(&mut self) {
         let nodes = crate::parallel::SyncPtr::new(self.nodes.as_mut_ptr());

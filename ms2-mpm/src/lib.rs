@@ -28,6 +28,7 @@ pub mod error;
 pub mod grid;
 pub mod material;
 pub mod math;
+mod math_x4;
 pub mod mesh;
 mod parallel;
 mod particles;

@@ -7,7 +7,9 @@
 use glam::{Mat3, Vec3};
 
 use crate::error::MpmError;
+#[cfg(test)]
 use crate::math::svd3;
+use crate::math::Svd3;
 
 /// Constitutive behaviour of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -154,10 +156,31 @@ pub(crate) struct CompiledMaterial {
 const CLAY_MIN_STRETCH: f32 = 0.05;
 
 impl CompiledMaterial {
+    /// Whether [`Self::project_and_stress_svd`] uses the SVD of the trial gradient.
+    #[inline(always)]
+    pub fn needs_svd(&self) -> bool {
+        self.kind != CompiledKind::Water
+    }
+
     /// Projects the trial deformation gradient `f` onto the material's admissible set and
     /// returns `(projected F, Kirchhoff stress τ)`.
-    #[inline(always)]
+    #[cfg(test)]
     pub fn project_and_stress(&self, f: Mat3) -> (Mat3, Mat3) {
+        let d = if self.needs_svd() {
+            svd3(f)
+        } else {
+            Svd3 {
+                u: Mat3::IDENTITY,
+                sigma: Vec3::ONE,
+                v: Mat3::IDENTITY,
+            }
+        };
+        self.project_and_stress_svd(f, &d)
+    }
+
+    /// As [`Self::project_and_stress`], given the SVD `d` of `f` (ignored by water).
+    #[inline(always)]
+    pub fn project_and_stress_svd(&self, f: Mat3, d: &Svd3) -> (Mat3, Mat3) {
         match self.kind {
             CompiledKind::Water => {
                 let j = f.determinant();
@@ -166,12 +189,8 @@ impl CompiledMaterial {
                 let p = self.lambda * (j - 1.0) * j;
                 (f_new, Mat3::from_diagonal(Vec3::splat(p)))
             }
-            CompiledKind::Elastic => {
-                let d = svd3(f);
-                (f, self.corotated_stress(d.u, d.sigma))
-            }
+            CompiledKind::Elastic => (f, self.corotated_stress(d.u, d.sigma)),
             CompiledKind::Clay => {
-                let d = svd3(f);
                 let sig = d.sigma.max(Vec3::splat(CLAY_MIN_STRETCH));
                 let eps = Vec3::new(sig.x.ln(), sig.y.ln(), sig.z.ln());
                 let dev = eps - Vec3::splat((eps.x + eps.y + eps.z) / 3.0);

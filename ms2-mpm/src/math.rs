@@ -3,6 +3,8 @@
 
 use glam::{Mat3, Vec3};
 
+pub use crate::math_x4::svd3_x4;
+
 /// Singular value decomposition `A = U · diag(sigma) · Vᵀ` of a 3×3 matrix.
 ///
 /// `u` and `v` are proper rotations (determinant +1); `sigma` is sorted by decreasing magnitude
@@ -21,7 +23,7 @@ pub struct Svd3 {
 /// Number of cyclic Jacobi sweeps on `AᵀA`. Convergence is quadratic; four sweeps reach
 /// f32 round-off (relative reconstruction error ~2e-6 on random matrices) and keep the cost
 /// fixed (no data-dependent loop count).
-const JACOBI_SWEEPS: usize = 4;
+pub(crate) const JACOBI_SWEEPS: usize = 4;
 
 /// One Jacobi rotation in the `(p, q)` plane (`r` the third axis) of the symmetric matrix
 /// with entries `app, aqq, apq, apr, aqr`, zeroing `apq`, accumulated into the columns `vp`,

@@ -316,7 +316,7 @@ impl MpmSolver {
 
     /// Total mass (kg) on the grid after the last particle-to-grid transfer.
     pub fn grid_mass(&self) -> f64 {
-        self.grid.nodes.iter().map(|n| n[3] as f64).sum()
+        self.grid.active_mass()
     }
 
     /// Advances by one substep without external forces.

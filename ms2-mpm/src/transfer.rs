@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use crate::grid::{GridSpec, GridStorage, BLOCK};
 use crate::material::CompiledMaterial;
-use crate::math::quadratic_weights;
+use crate::math::{quadratic_weights, svd3_x4, Svd3};
 use crate::parallel::SyncPtr;
 use crate::particles::{Binning, Particles};
 
@@ -19,6 +19,12 @@ use crate::particles::{Binning, Particles};
 /// below, one above, and the two extra B-spline nodes.
 const LOCAL: usize = BLOCK + 4;
 const LOCAL_NODES: usize = LOCAL * LOCAL * LOCAL;
+
+const IDENTITY_SVD: Svd3 = Svd3 {
+    u: Mat3::IDENTITY,
+    sigma: Vec3::ONE,
+    v: Mat3::IDENTITY,
+};
 
 type LocalGrid = [[f32; 4]; LOCAL_NODES];
 
@@ -68,6 +74,8 @@ pub(crate) fn particle_to_grid(
     let stress_scale = -dt * 4.0 * inv_dx * inv_dx;
     let bins = grid.bins;
     let f_ptr = SyncPtr::new(p.f.as_mut_ptr());
+    // Read-only view of F for the trial update; each F is overwritten only after its read.
+    let p_f: &[Mat3] = unsafe { std::slice::from_raw_parts(p.f.as_ptr(), p.f.len()) };
     let (x, v, c, mass, volume, material) = (&p.x, &p.v, &p.c, &p.mass, &p.volume, &p.material);
     let grid_ptr = SyncPtr::new(grid.nodes.as_mut_ptr());
     let grid_ref = &*grid;
@@ -76,41 +84,58 @@ pub(crate) fn particle_to_grid(
             let (bin, start, end) = binning.bins[bi as usize];
             let corner = bin_corner(bin, bins);
             let mut local: LocalGrid = [[0.0; 4]; LOCAL_NODES];
-            for pi in start as usize..end as usize {
-                let (base, fx, w) = quadratic_weights((x[pi] - origin) * inv_dx);
-                // SAFETY: bins own disjoint particle ranges and each F is touched once.
-                let f = unsafe { f_ptr.get_mut(pi) };
-                let mat = &prm.materials[material[pi] as usize];
-                let (f_new, tau) = mat.project_and_stress((Mat3::IDENTITY + dt * c[pi]) * *f);
-                *f = f_new;
-                let m = mass[pi];
-                let affine = (stress_scale * volume[pi]) * tau + m * c[pi];
-                let mut mv = m * v[pi];
-                if let Some(forces) = prm.forces {
-                    mv += dt * forces[pi];
+            // Particles go in groups of four so that their SVDs run in the SIMD lanes.
+            for group in (start as usize..end as usize).step_by(4) {
+                let n = (end as usize - group).min(4);
+                let mut trial = [Mat3::IDENTITY; 4];
+                let mut any_svd = false;
+                for (l, t) in trial.iter_mut().enumerate().take(n) {
+                    let pi = group + l;
+                    *t = (Mat3::IDENTITY + dt * c[pi]) * p_f[pi];
+                    any_svd |= prm.materials[material[pi] as usize].needs_svd();
                 }
-                // Momentum at node offset (i, j, k): mv + affine·((i, j, k) − fx)·dx.
-                let a = affine * dx;
-                let m0 = mv - a * fx;
-                let o = [
-                    (base[0] - corner[0]) as usize,
-                    (base[1] - corner[1]) as usize,
-                    (base[2] - corner[2]) as usize,
-                ];
-                for i in 0..3 {
-                    let mi = m0 + a.x_axis * i as f32;
-                    for j in 0..3 {
-                        let mij = mi + a.y_axis * j as f32;
-                        let wij = w[0][i] * w[1][j];
-                        let row = local_index(o[0] + i, o[1] + j, o[2]);
-                        for k in 0..3 {
-                            let wt = wij * w[2][k];
-                            let mom = (mij + a.z_axis * k as f32) * wt;
-                            let node = &mut local[row + k];
-                            node[0] += mom.x;
-                            node[1] += mom.y;
-                            node[2] += mom.z;
-                            node[3] += wt * m;
+                let svds = if any_svd {
+                    svd3_x4(&trial)
+                } else {
+                    [IDENTITY_SVD; 4]
+                };
+                for l in 0..n {
+                    let pi = group + l;
+                    let mat = &prm.materials[material[pi] as usize];
+                    let (f_new, tau) = mat.project_and_stress_svd(trial[l], &svds[l]);
+                    // SAFETY: bins own disjoint particle ranges and each F is written once,
+                    // after its last read above.
+                    unsafe { *f_ptr.get_mut(pi) = f_new };
+                    let (base, fx, w) = quadratic_weights((x[pi] - origin) * inv_dx);
+                    let m = mass[pi];
+                    let affine = (stress_scale * volume[pi]) * tau + m * c[pi];
+                    let mut mv = m * v[pi];
+                    if let Some(forces) = prm.forces {
+                        mv += dt * forces[pi];
+                    }
+                    // Momentum at node offset (i, j, k): mv + affine·((i, j, k) − fx)·dx.
+                    let a = affine * dx;
+                    let m0 = mv - a * fx;
+                    let o = [
+                        (base[0] - corner[0]) as usize,
+                        (base[1] - corner[1]) as usize,
+                        (base[2] - corner[2]) as usize,
+                    ];
+                    for i in 0..3 {
+                        let mi = m0 + a.x_axis * i as f32;
+                        for j in 0..3 {
+                            let mij = mi + a.y_axis * j as f32;
+                            let wij = w[0][i] * w[1][j];
+                            let row = local_index(o[0] + i, o[1] + j, o[2]);
+                            for k in 0..3 {
+                                let wt = wij * w[2][k];
+                                let mom = (mij + a.z_axis * k as f32) * wt;
+                                let node = &mut local[row + k];
+                                node[0] += mom.x;
+                                node[1] += mom.y;
+                                node[2] += mom.z;
+                                node[3] += wt * m;
+                            }
                         }
                     }
                 }
