@@ -9,9 +9,10 @@ use ms2_physics::{
     World, WorldConfig,
 };
 
-fn pick_cube_scene(solver_iterations: usize) -> (World, BodyId) {
+fn pick_cube_scene(substeps: usize, pgs_iterations: usize) -> (World, BodyId) {
     let mut config = WorldConfig::default();
-    config.solver.solver_iterations = solver_iterations;
+    config.solver.solver_iterations = substeps;
+    config.solver.pgs_iterations = pgs_iterations;
     let mut world = World::new(config).expect("valid config");
     add_panda(&mut world, &PandaOptions::default()).expect("panda loads");
     let cube = world
@@ -30,19 +31,41 @@ fn pick_cube_scene(solver_iterations: usize) -> (World, BodyId) {
 }
 
 fn bench(c: &mut Criterion) {
-    let iterations = ms2_physics::SolverConfig::default().solver_iterations;
+    let defaults = ms2_physics::SolverConfig::default();
     let mut group = c.benchmark_group("pick_cube");
-    let (mut world, _cube) = pick_cube_scene(iterations);
     group.throughput(Throughput::Elements(1));
-    group.bench_function(format!("physics_step_iters{iterations}"), |b| {
-        b.iter(|| world.step())
-    });
-    let (mut world, _cube) = pick_cube_scene(iterations);
-    group.bench_function(format!("env_step_25_substeps_iters{iterations}"), |b| {
+    // The default settings (the grasp test's), then the other settings side by side.
+    for (substeps, pgs) in [
+        (defaults.solver_iterations, defaults.pgs_iterations),
+        (1, 1),
+        (2, 2),
+        (4, 1),
+    ] {
+        let (mut world, _cube) = pick_cube_scene(substeps, pgs);
+        group.bench_function(format!("physics_step/substeps{substeps}_pgs{pgs}"), |b| {
+            b.iter(|| world.step())
+        });
+    }
+    let (mut world, _cube) = pick_cube_scene(defaults.solver_iterations, defaults.pgs_iterations);
+    group.bench_function("env_step_25_substeps/default", |b| {
         b.iter(|| world.step_n(25))
+    });
+    let (mut world, _cube) = pick_cube_scene(defaults.solver_iterations, defaults.pgs_iterations);
+    group.bench_function("get_state_then_set_state/default", |b| {
+        b.iter(|| {
+            let s = world.get_state();
+            world.set_state(&s).expect("own state")
+        })
     });
     group.finish();
 }
 
-criterion_group!(benches, bench);
+criterion_group! {
+    name = benches;
+    config = Criterion::default()
+        .sample_size(20)
+        .warm_up_time(std::time::Duration::from_secs(1))
+        .measurement_time(std::time::Duration::from_secs(3));
+    targets = bench
+}
 criterion_main!(benches);

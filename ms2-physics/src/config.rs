@@ -29,8 +29,12 @@ impl Default for GroundConfig {
 /// between solver iterations and speed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverConfig {
-    /// Velocity-solver iterations per step (rapier's `num_solver_iterations`).
+    /// Solver substeps per step (rapier's `num_solver_iterations`): each one re-runs the
+    /// multibody dynamics (mass matrices), so the cost is about linear in this number.
     pub solver_iterations: usize,
+    /// Projected-Gauss-Seidel iterations inside each substep (rapier's
+    /// `num_internal_pgs_iterations`): cheap, they reuse the substep's mass matrices.
+    pub pgs_iterations: usize,
     /// Natural frequency (Hz) of the contact constraints' softness. Stiffer than rapier's default
     /// (30 Hz) so squeezing fingers do not sink into objects.
     pub contact_frequency_hz: f32,
@@ -47,7 +51,8 @@ pub struct SolverConfig {
 impl Default for SolverConfig {
     fn default() -> Self {
         SolverConfig {
-            solver_iterations: 4,
+            solver_iterations: 1,
+            pgs_iterations: 8,
             contact_frequency_hz: 300.0,
             contact_damping_ratio: 5.0,
             friction_in_bias_pass: true,
@@ -113,6 +118,13 @@ impl WorldConfig {
             return Err(PhysicsError::InvalidParameter {
                 name: "solver_iterations",
                 value: s.solver_iterations.to_string(),
+                expected: "an integer in [1, 1000]",
+            });
+        }
+        if s.pgs_iterations == 0 || s.pgs_iterations > 1000 {
+            return Err(PhysicsError::InvalidParameter {
+                name: "pgs_iterations",
+                value: s.pgs_iterations.to_string(),
                 expected: "an integer in [1, 1000]",
             });
         }

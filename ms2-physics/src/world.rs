@@ -190,6 +190,7 @@ impl World {
         };
         let s = &config.solver;
         params.num_solver_iterations = s.solver_iterations;
+        params.num_internal_pgs_iterations = s.pgs_iterations;
         params.contact_softness =
             SpringCoefficients::new(s.contact_frequency_hz, s.contact_damping_ratio);
         params.static_contact_softness =
