@@ -377,6 +377,7 @@ impl World {
     /// Forces and torques applied with [`apply_force`](World::apply_force) and
     /// [`apply_torque`](World::apply_torque) act during this step only.
     pub fn step(&mut self) {
+        self.wake_bodies_touching_moving_kinematics();
         let gravity = vec_from_na(&self.config.gravity);
         let sim = &mut self.sim;
         self.pipeline.step(
@@ -401,6 +402,35 @@ impl World {
             }
         }
         self.steps += 1;
+    }
+
+    /// rapier 0.36 does not wake a sleeping body that a moving kinematic body touches (the
+    /// kinematic body then passes through it): wake those bodies before the step.
+    fn wake_bodies_touching_moving_kinematics(&mut self) {
+        let mut to_wake = Vec::new();
+        for e in self.table.iter().filter(|e| e.kind == BodyKind::Kinematic) {
+            let rb = &self.sim.bodies[e.handle];
+            if rb.next_position() == rb.position() && rb.linvel() == rapier3d::math::Vector::ZERO {
+                continue;
+            }
+            for &c in &e.colliders {
+                for pair in self.sim.narrow_phase.contact_pairs_with(c) {
+                    let other = if pair.collider1 == c {
+                        pair.collider2
+                    } else {
+                        pair.collider1
+                    };
+                    if let Some(parent) = self.sim.colliders.get(other).and_then(|co| co.parent()) {
+                        if self.sim.bodies[parent].is_sleeping() {
+                            to_wake.push(parent);
+                        }
+                    }
+                }
+            }
+        }
+        for h in to_wake {
+            self.sim.bodies[h].wake_up(true);
+        }
     }
 
     /// Advances the simulation by `n` time steps.
