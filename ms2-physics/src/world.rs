@@ -177,6 +177,9 @@ pub struct World {
     /// materials, ...): snapshots of an older generation are never restored.
     pub(crate) generation: u64,
     pub(crate) snapshots: Mutex<SnapshotCache>,
+    /// The simulation as it was when the configuration last changed (taken lazily): the base on
+    /// which [`World::set_state`] writes vectors it has no snapshot of.
+    pub(crate) cold_template: Option<(u64, Box<Sim>)>,
     pub(crate) steps: u64,
 }
 
@@ -219,6 +222,7 @@ impl World {
             forced: Vec::new(),
             generation: 0,
             snapshots: Mutex::new(SnapshotCache::default()),
+            cold_template: None,
             steps: 0,
             config,
         };
@@ -377,6 +381,7 @@ impl World {
     /// Forces and torques applied with [`apply_force`](World::apply_force) and
     /// [`apply_torque`](World::apply_torque) act during this step only.
     pub fn step(&mut self) {
+        self.ensure_cold_template();
         self.wake_bodies_touching_moving_kinematics();
         let gravity = vec_from_na(&self.config.gravity);
         let sim = &mut self.sim;
@@ -402,6 +407,13 @@ impl World {
             }
         }
         self.steps += 1;
+    }
+
+    /// Takes the cold template if the configuration changed since the last one.
+    pub(crate) fn ensure_cold_template(&mut self) {
+        if self.cold_template.as_ref().map(|(g, _)| *g) != Some(self.generation) {
+            self.cold_template = Some((self.generation, Box::new(self.sim.clone())));
+        }
     }
 
     /// rapier 0.36 does not wake a sleeping body that a moving kinematic body touches (the
@@ -560,7 +572,8 @@ impl World {
         Ok(e.handle)
     }
 
-    /// Teleports an actor (static, dynamic or kinematic) to a pose; wakes it.
+    /// Teleports an actor (static, dynamic or kinematic) to a pose; wakes it. Moving a static
+    /// actor counts as a configuration change (see [`World::set_state`]).
     pub fn set_body_pose(&mut self, body: BodyId, pose: &Pose3) -> Result<()> {
         let h = self.actor_handle(body, "pose")?;
         check_finite(
@@ -579,6 +592,10 @@ impl World {
         rb.set_position(pose_from_na(pose), true);
         if rb.is_kinematic() {
             rb.set_next_kinematic_position(pose_from_na(pose));
+        }
+        if rb.is_fixed() {
+            // Static poses are not part of the state vector: moving one is a configuration change.
+            self.generation += 1;
         }
         Ok(())
     }
