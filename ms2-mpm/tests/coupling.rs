@@ -219,3 +219,40 @@ fn coupled_runs_are_deterministic_for_any_thread_count() {
         "the box never touched the clay"
     );
 }
+
+#[test]
+fn bad_coupling_input_is_refused() {
+    let mut world = SimpleRigidWorld::new(Vec3::new(0.0, 0.0, -9.81));
+    world.add_box(
+        Vec3::splat(0.02),
+        500.0,
+        Vec3::new(0.1, 0.1, 0.1),
+        Motion::Dynamic,
+    );
+    let mut params = CouplingParams::for_substep(5e-4);
+    params.friction = f32::NAN;
+    let err = Coupling::new(&world, params)
+        .err()
+        .expect("NaN friction must be refused");
+    assert!(err.to_string().contains("friction"), "{err}");
+    let mut coupling = Coupling::new(&world, CouplingParams::for_substep(5e-4)).unwrap();
+    world.add_box(
+        Vec3::splat(0.02),
+        500.0,
+        Vec3::new(0.2, 0.1, 0.1),
+        Motion::Dynamic,
+    );
+    assert!(matches!(
+        coupling.sync_bodies(&world),
+        Err(ms2_mpm::MpmError::BodyCountChanged {
+            expected: 1,
+            got: 2
+        })
+    ));
+    world.bodies[0].position.x = f32::INFINITY;
+    world.bodies.pop();
+    assert!(matches!(
+        coupling.sync_bodies(&world),
+        Err(ms2_mpm::MpmError::NonFiniteInput { .. })
+    ));
+}
