@@ -3,172 +3,15 @@
 //! [`Renderer::submit`] encodes and submits one batch and returns at once with a
 //! [`PendingFrame`]; the GPU (or lavapipe's worker threads) renders while the caller steps
 //! physics, and [`PendingFrame::wait`] collects the images. Per-batch GPU objects (targets,
-//! uniform, instance and readback buffers) are pooled by batch shape and reused.
+//! uniform, instance and readback buffers) are pooled by batch shape and reused. Each camera
+//! has its own small targets and render pass: on lavapipe that beat one shared atlas texture
+//! (llvmpipe bins per-draw state into every tile of a render pass's framebuffer).
 
-use crate::renderer::{
-    Renderer, ResourceStore, CAMERA_BLOCK_BYTES, COLOR_FORMAT, DEPTH_FORMAT, GBUFFER_FORMAT,
-    INSTANCE_BYTES,
-};
+use crate::renderer::{Renderer, ResourceStore, CAMERA_BLOCK_BYTES, INSTANCE_BYTES};
 use crate::scene::MAX_DIRECTIONAL_LIGHTS;
+use crate::targets::{linear_to_srgb8, CameraTargets, FrameResources};
 use crate::{Camera, CameraOutput, RenderError, Scene};
 use std::sync::{Arc, Mutex};
-
-/// Render targets and readback layout of one camera slot.
-struct Target {
-    color: wgpu::Texture,
-    color_view: wgpu::TextureView,
-    gbuffer: wgpu::Texture,
-    gbuffer_view: wgpu::TextureView,
-    depth_view: wgpu::TextureView,
-    width: u32,
-    height: u32,
-    color_offset: u64,
-    color_row_bytes: u32,
-    gbuffer_offset: u64,
-    gbuffer_row_bytes: u32,
-}
-
-/// GPU objects for one batch shape (the list of camera image sizes).
-pub(crate) struct FrameResources {
-    sizes: Vec<(u32, u32)>,
-    targets: Vec<Target>,
-    readback: wgpu::Buffer,
-    uniforms: wgpu::Buffer,
-    camera_bind_group: wgpu::BindGroup,
-    instances: Option<wgpu::Buffer>,
-    instance_capacity: u64,
-}
-
-/// Idle [`FrameResources`], reused by batches of the same shape.
-#[derive(Default)]
-pub(crate) struct FramePool {
-    free: Vec<FrameResources>,
-}
-
-/// How many idle batches the pool keeps.
-const POOL_CAPACITY: usize = 8;
-
-impl FramePool {
-    fn take(&mut self, sizes: &[(u32, u32)]) -> Option<FrameResources> {
-        let pos = self.free.iter().position(|r| r.sizes == sizes)?;
-        Some(self.free.swap_remove(pos))
-    }
-
-    fn give(&mut self, resources: FrameResources) {
-        if self.free.len() >= POOL_CAPACITY {
-            self.free.remove(0);
-        }
-        self.free.push(resources);
-    }
-}
-
-fn align_up(value: u64, alignment: u64) -> u64 {
-    value.div_ceil(alignment) * alignment
-}
-
-impl FrameResources {
-    fn new(renderer: &Renderer, sizes: &[(u32, u32)]) -> FrameResources {
-        let gpu = &renderer.inner.gpu;
-        let device = &gpu.device;
-        let row_align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
-        let mut offset = 0u64;
-        let mut targets = Vec::with_capacity(sizes.len());
-        for &(width, height) in sizes {
-            let extent = wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            };
-            let make = |format, usage, label| {
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: extent,
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-            };
-            let copyable = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-            let color = make(COLOR_FORMAT, copyable, "ms2-render colour");
-            let gbuffer = make(GBUFFER_FORMAT, copyable, "ms2-render gbuffer");
-            let depth = make(
-                DEPTH_FORMAT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-                "ms2-render depth",
-            );
-            let color_row_bytes = align_up(width as u64 * 4, row_align);
-            let gbuffer_row_bytes = align_up(width as u64 * 16, row_align);
-            let color_offset = offset;
-            let gbuffer_offset = color_offset + color_row_bytes * height as u64;
-            offset = align_up(
-                gbuffer_offset + gbuffer_row_bytes * height as u64,
-                row_align,
-            );
-            targets.push(Target {
-                color_view: color.create_view(&Default::default()),
-                gbuffer_view: gbuffer.create_view(&Default::default()),
-                depth_view: depth.create_view(&Default::default()),
-                color,
-                gbuffer,
-                width,
-                height,
-                color_offset,
-                color_row_bytes: color_row_bytes as u32,
-                gbuffer_offset,
-                gbuffer_row_bytes: gbuffer_row_bytes as u32,
-            });
-        }
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ms2-render readback"),
-            size: offset,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ms2-render camera uniforms"),
-            size: gpu.uniform_stride * sizes.len() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let camera_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ms2-render camera"),
-            layout: &gpu.camera_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &uniforms,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(CAMERA_BLOCK_BYTES),
-                }),
-            }],
-        });
-        FrameResources {
-            sizes: sizes.to_vec(),
-            targets,
-            readback,
-            uniforms,
-            camera_bind_group,
-            instances: None,
-            instance_capacity: 0,
-        }
-    }
-
-    fn ensure_instance_capacity(&mut self, device: &wgpu::Device, records: u64) {
-        if self.instances.is_none() || self.instance_capacity < records {
-            let capacity = records.max(64).next_power_of_two();
-            self.instances = Some(device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("ms2-render instances"),
-                size: capacity * INSTANCE_BYTES,
-                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
-            self.instance_capacity = capacity;
-        }
-    }
-}
 
 /// One instance to draw: which mesh, which texture (if any), which instance record.
 struct Draw {
@@ -247,6 +90,8 @@ pub struct PendingFrame {
     /// `None` for an empty batch.
     work: Option<(FrameResources, wgpu::SubmissionIndex, MapState)>,
     cameras: Vec<Camera>,
+    /// Background colour of each camera's scene, sRGB.
+    backgrounds: Vec<[u8; 3]>,
 }
 
 impl Renderer {
@@ -274,6 +119,7 @@ impl Renderer {
                 renderer: self.clone(),
                 work: None,
                 cameras,
+                backgrounds: Vec::new(),
             });
         }
         let store = self
@@ -299,7 +145,10 @@ impl Renderer {
             .lock()
             .expect("frame pool lock poisoned")
             .take(&sizes);
-        let mut resources = taken.unwrap_or_else(|| FrameResources::new(self, &sizes));
+        let mut resources = match taken {
+            Some(resources) => resources,
+            None => FrameResources::new(self, &sizes)?,
+        };
         let gpu = &self.inner.gpu;
         resources.ensure_instance_capacity(&gpu.device, records.len() as u64);
         let instances = resources
@@ -326,48 +175,8 @@ impl Renderer {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("ms2-render batch"),
             });
-        for (c, target) in resources.targets.iter().enumerate() {
-            let scene = views[camera_scene[c]].0;
-            let bg = scene.lighting.background;
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("ms2-render camera"),
-                color_attachments: &[
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &target.color_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color {
-                                r: bg[0] as f64,
-                                g: bg[1] as f64,
-                                b: bg[2] as f64,
-                                a: 1.0,
-                            }),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &target.gbuffer_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
-                ],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &target.depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+        for (c, targets) in resources.targets.iter().enumerate() {
+            let mut pass = begin_pass(&mut encoder, targets);
             pass.set_pipeline(&gpu.pipeline);
             let offset = (c as u64 * gpu.uniform_stride) as u32;
             pass.set_bind_group(0, &resources.camera_bind_group, &[offset]);
@@ -383,34 +192,8 @@ impl Renderer {
                 pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..mesh.index_count, 0, 0..1);
             }
-            drop(pass);
-            let extent = wgpu::Extent3d {
-                width: target.width,
-                height: target.height,
-                depth_or_array_layers: 1,
-            };
-            for (texture, offset, row_bytes) in [
-                (&target.color, target.color_offset, target.color_row_bytes),
-                (
-                    &target.gbuffer,
-                    target.gbuffer_offset,
-                    target.gbuffer_row_bytes,
-                ),
-            ] {
-                encoder.copy_texture_to_buffer(
-                    texture.as_image_copy(),
-                    wgpu::TexelCopyBufferInfo {
-                        buffer: &resources.readback,
-                        layout: wgpu::TexelCopyBufferLayout {
-                            offset,
-                            bytes_per_row: Some(row_bytes),
-                            rows_per_image: Some(target.height),
-                        },
-                    },
-                    extent,
-                );
-            }
         }
+        resources.encode_copies(&mut encoder);
         drop(store);
         let submission = gpu.queue.submit([encoder.finish()]);
         if let Some(error) = pollster::block_on(error_scope.pop()) {
@@ -424,12 +207,53 @@ impl Renderer {
             .map_async(wgpu::MapMode::Read, move |result| {
                 *callback_state.lock().expect("map state lock poisoned") = Some(result);
             });
+        let backgrounds = camera_scene
+            .iter()
+            .map(|&k| views[k].0.lighting.background.map(linear_to_srgb8))
+            .collect();
         Ok(PendingFrame {
             renderer: self.clone(),
             work: Some((resources, submission, map_state)),
             cameras,
+            backgrounds,
         })
     }
+}
+
+/// Begins a camera's render pass, clearing its targets.
+fn begin_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    targets: &CameraTargets,
+) -> wgpu::RenderPass<'e> {
+    let clear = |view, value| {
+        Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(value),
+                store: wgpu::StoreOp::Store,
+            },
+        })
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("ms2-render camera"),
+        color_attachments: &[
+            clear(&targets.color_view, wgpu::Color::BLACK),
+            clear(&targets.gbuffer_view, wgpu::Color::TRANSPARENT),
+        ],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &targets.depth_view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
 }
 
 /// Resolves an instance's mesh and texture handles against the store.
@@ -497,11 +321,8 @@ impl PendingFrame {
                 .get_mapped_range()
                 .map_err(|e| RenderError::Gpu(format!("reading images back failed: {e}")))?;
             let bytes: &[u8] = &view;
-            resources
-                .targets
-                .iter()
-                .zip(&self.cameras)
-                .map(|(target, camera)| decode(bytes, target, *camera))
+            (0..self.cameras.len())
+                .map(|c| resources.targets[c].decode(bytes, self.cameras[c], self.backgrounds[c]))
                 .collect()
         };
         resources.readback.unmap();
@@ -512,41 +333,5 @@ impl PendingFrame {
             .expect("frame pool lock poisoned")
             .give(resources);
         Ok(outputs)
-    }
-}
-
-/// Unpacks one camera's colour and G-buffer rows from the readback bytes.
-fn decode(bytes: &[u8], target: &Target, camera: Camera) -> CameraOutput {
-    let (w, h) = (target.width as usize, target.height as usize);
-    let mut rgb = Vec::with_capacity(w * h * 3);
-    let mut depth_m = Vec::with_capacity(w * h);
-    let mut segmentation_actor = Vec::with_capacity(w * h);
-    let mut segmentation_link = Vec::with_capacity(w * h);
-    for y in 0..h {
-        let row = target.color_offset as usize + y * target.color_row_bytes as usize;
-        for px in bytes[row..row + 4 * w].chunks_exact(4) {
-            rgb.extend_from_slice(&px[..3]);
-        }
-        let row = target.gbuffer_offset as usize + y * target.gbuffer_row_bytes as usize;
-        for px in bytes[row..row + 16 * w].chunks_exact(16) {
-            let word = |k: usize| {
-                u32::from_le_bytes([px[4 * k], px[4 * k + 1], px[4 * k + 2], px[4 * k + 3]])
-            };
-            let covered = word(3) != 0;
-            depth_m.push(if covered {
-                f32::from_bits(word(0))
-            } else {
-                0.0
-            });
-            segmentation_actor.push(word(1));
-            segmentation_link.push(word(2));
-        }
-    }
-    CameraOutput {
-        camera,
-        rgb,
-        depth_m,
-        segmentation_actor,
-        segmentation_link,
     }
 }

@@ -48,12 +48,13 @@ pub mod mesh;
 mod output;
 mod renderer;
 pub mod scene;
+mod targets;
 
 pub use camera::Camera;
 pub use error::{RenderError, INSTALL_ADVICE};
 pub use frame::PendingFrame;
 pub use mesh::MeshData;
-pub use output::CameraOutput;
+pub use output::{CameraOutput, FusedPointCloud};
 pub use renderer::{
     AdapterSummary, BackendChoice, MeshHandle, Renderer, RendererConfig, TextureData,
     TextureHandle, BACKEND_ENV_VAR,

@@ -172,3 +172,48 @@ pub(crate) fn save_png(
         .map_err(|e| err(e.to_string()))?;
     std::fs::rename(&tmp, path).map_err(|e| err(e.to_string()))
 }
+
+/// Point clouds of several cameras fused in the world frame (ManiSkill2's `pointcloud`
+/// observation): all pixels of all cameras, in camera order then row-major.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FusedPointCloud {
+    /// World-frame points, metres, `[x, y, z, w]` with w = 1 for valid points and all zeros
+    /// for background pixels.
+    pub xyzw: Vec<[f32; 4]>,
+    /// Colour of each point, sRGB.
+    pub rgb: Vec<[u8; 3]>,
+    /// Actor id of each point (0 = background).
+    pub segmentation_actor: Vec<u32>,
+    /// Link id of each point (0 = background).
+    pub segmentation_link: Vec<u32>,
+}
+
+impl FusedPointCloud {
+    /// Concatenates the world-frame point clouds of `outputs`.
+    pub fn from_cameras(outputs: &[CameraOutput]) -> FusedPointCloud {
+        let mut fused = FusedPointCloud::default();
+        for out in outputs {
+            fused.xyzw.extend(out.point_cloud_world());
+            fused
+                .rgb
+                .extend(out.rgb.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+            fused
+                .segmentation_actor
+                .extend_from_slice(&out.segmentation_actor);
+            fused
+                .segmentation_link
+                .extend_from_slice(&out.segmentation_link);
+        }
+        fused
+    }
+
+    /// Number of points (valid or not).
+    pub fn len(&self) -> usize {
+        self.xyzw.len()
+    }
+
+    /// Whether there are no points at all.
+    pub fn is_empty(&self) -> bool {
+        self.xyzw.is_empty()
+    }
+}

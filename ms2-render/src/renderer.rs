@@ -1,7 +1,7 @@
 //! The renderer: adapter selection, the shared mesh/texture store and the render pipeline.
 
 use crate::error::INSTALL_ADVICE;
-use crate::frame::FramePool;
+use crate::targets::FramePool;
 use crate::{MeshData, RenderError};
 use std::sync::{Arc, Mutex, RwLock};
 use wgpu::util::DeviceExt;
@@ -166,7 +166,16 @@ fn pick_adapter(choice: BackendChoice) -> Result<wgpu::Adapter, RenderError> {
             return Ok(adapter);
         }
     }
-    let names: Vec<String> = order.iter().map(|b| format!("{b:?}")).collect();
+    let names: Vec<&str> = order
+        .iter()
+        .map(|&b| {
+            if b == wgpu::Backends::VULKAN {
+                "Vulkan"
+            } else {
+                "GL (EGL)"
+            }
+        })
+        .collect();
     Err(RenderError::NoAdapter {
         backends: names.join(" then "),
         advice: INSTALL_ADVICE,
