@@ -297,9 +297,9 @@ impl Coupling {
     pub fn sync_bodies(&mut self, backend: &dyn RigidBackend) -> Result<(), MpmError> {
         let n = backend.body_count();
         if n != self.impulses.len() {
-            return Err(MpmError::UnknownBody {
-                body: n,
-                count: self.impulses.len(),
+            return Err(MpmError::BodyCountChanged {
+                expected: self.impulses.len(),
+                got: n,
             });
         }
         self.bodies.clear();
