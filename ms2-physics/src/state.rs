@@ -13,8 +13,11 @@
 //! also remembers a full snapshot of the simulation, keyed by the exact bits of the returned
 //! vector, for the last [`SNAPSHOT_CACHE_LEN`] calls. [`World::set_state`] with such a vector
 //! (and no configuration change in between) restores that snapshot, so stepping afterwards
-//! reproduces the original run bit for bit. Any other vector is written body by body; the run
-//! from it is deterministic but starts with cold solver caches.
+//! reproduces the original run bit for bit. Any other vector is written body by body onto the
+//! simulation as it was when the world's configuration last changed (bodies added, drive gains,
+//! gravity, static poses, ...): the run from it depends only on the vector and that
+//! configuration, never on what was simulated since, so resetting to a saved vector always
+//! replays the same episode.
 
 use std::collections::VecDeque;
 
@@ -133,7 +136,7 @@ impl World {
                 return Ok(());
             }
         }
-        // Validate quaternions before writing anything.
+        // Validate quaternions before writing anything (below).
         let mut offset = 0;
         let mut poses = Vec::new();
         for e in &self.table {
@@ -159,6 +162,11 @@ impl World {
                 });
             }
         }
+        // Write onto the configuration's cold template, not onto the current run's caches.
+        self.ensure_cold_template();
+        let template = self.cold_template.as_ref().expect("just ensured");
+        self.sim = (*template.1).clone();
+        self.pipeline = rapier3d::prelude::PhysicsPipeline::new();
         let mut o = 0;
         let handles: Vec<_> = self
             .table

@@ -177,6 +177,9 @@ pub struct World {
     /// materials, ...): snapshots of an older generation are never restored.
     pub(crate) generation: u64,
     pub(crate) snapshots: Mutex<SnapshotCache>,
+    /// The simulation as it was when the configuration last changed (taken lazily): the base on
+    /// which [`World::set_state`] writes vectors it has no snapshot of.
+    pub(crate) cold_template: Option<(u64, Box<Sim>)>,
     pub(crate) steps: u64,
 }
 
@@ -219,6 +222,7 @@ impl World {
             forced: Vec::new(),
             generation: 0,
             snapshots: Mutex::new(SnapshotCache::default()),
+            cold_template: None,
             steps: 0,
             config,
         };
@@ -377,6 +381,8 @@ impl World {
     /// Forces and torques applied with [`apply_force`](World::apply_force) and
     /// [`apply_torque`](World::apply_torque) act during this step only.
     pub fn step(&mut self) {
+        self.ensure_cold_template();
+        self.wake_bodies_touching_moving_kinematics();
         let gravity = vec_from_na(&self.config.gravity);
         let sim = &mut self.sim;
         self.pipeline.step(
@@ -401,6 +407,42 @@ impl World {
             }
         }
         self.steps += 1;
+    }
+
+    /// Takes the cold template if the configuration changed since the last one.
+    pub(crate) fn ensure_cold_template(&mut self) {
+        if self.cold_template.as_ref().map(|(g, _)| *g) != Some(self.generation) {
+            self.cold_template = Some((self.generation, Box::new(self.sim.clone())));
+        }
+    }
+
+    /// rapier 0.36 does not wake a sleeping body that a moving kinematic body touches (the
+    /// kinematic body then passes through it): wake those bodies before the step.
+    fn wake_bodies_touching_moving_kinematics(&mut self) {
+        let mut to_wake = Vec::new();
+        for e in self.table.iter().filter(|e| e.kind == BodyKind::Kinematic) {
+            let rb = &self.sim.bodies[e.handle];
+            if rb.next_position() == rb.position() && rb.linvel() == rapier3d::math::Vector::ZERO {
+                continue;
+            }
+            for &c in &e.colliders {
+                for pair in self.sim.narrow_phase.contact_pairs_with(c) {
+                    let other = if pair.collider1 == c {
+                        pair.collider2
+                    } else {
+                        pair.collider1
+                    };
+                    if let Some(parent) = self.sim.colliders.get(other).and_then(|co| co.parent()) {
+                        if self.sim.bodies[parent].is_sleeping() {
+                            to_wake.push(parent);
+                        }
+                    }
+                }
+            }
+        }
+        for h in to_wake {
+            self.sim.bodies[h].wake_up(true);
+        }
     }
 
     /// Advances the simulation by `n` time steps.
@@ -530,7 +572,8 @@ impl World {
         Ok(e.handle)
     }
 
-    /// Teleports an actor (static, dynamic or kinematic) to a pose; wakes it.
+    /// Teleports an actor (static, dynamic or kinematic) to a pose; wakes it. Moving a static
+    /// actor counts as a configuration change (see [`World::set_state`]).
     pub fn set_body_pose(&mut self, body: BodyId, pose: &Pose3) -> Result<()> {
         let h = self.actor_handle(body, "pose")?;
         check_finite(
@@ -549,6 +592,10 @@ impl World {
         rb.set_position(pose_from_na(pose), true);
         if rb.is_kinematic() {
             rb.set_next_kinematic_position(pose_from_na(pose));
+        }
+        if rb.is_fixed() {
+            // Static poses are not part of the state vector: moving one is a configuration change.
+            self.generation += 1;
         }
         Ok(())
     }

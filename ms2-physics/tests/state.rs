@@ -90,3 +90,25 @@ fn bad_state_vectors_are_rejected() {
     state[0] = f32::NAN;
     assert!(world.set_state(&state).is_err());
 }
+
+#[test]
+fn resetting_to_a_foreign_vector_replays_the_same_run_whatever_came_before() {
+    let (mut source, source_panda, _) = scene();
+    run(&mut source, source_panda, 120);
+    let saved = source.get_state();
+
+    let (mut world, panda, _) = scene();
+    run(&mut world, panda, 300);
+    world.set_state(&saved).unwrap();
+    let first = run(&mut world, panda, 150);
+    // A different history in between: other targets, a pushed cube.
+    for _ in 0..200 {
+        let mut t = world.drive_targets(panda).unwrap();
+        t[1] -= 0.001;
+        world.set_drive_targets(panda, &t).unwrap();
+        world.step();
+    }
+    world.set_state(&saved).unwrap();
+    let second = run(&mut world, panda, 150);
+    assert_bitwise_equal(&first, &second);
+}
