@@ -369,6 +369,27 @@ impl Coupling {
         }
     }
 
+    /// Signed distance (m; negative inside) from world point `p` to the closest shape of
+    /// `body`, at the pose of the last sync; `f32::INFINITY` if the body has no shapes. For
+    /// task checks such as "how much clay is inside the beaker".
+    pub fn distance_to_body(&self, body: usize, p: Vec3) -> Result<f32, MpmError> {
+        if body >= self.bodies.len() {
+            return Err(MpmError::UnknownBody {
+                body,
+                count: self.bodies.len(),
+            });
+        }
+        Ok(self
+            .shapes
+            .iter()
+            .filter(|sh| sh.body == body)
+            .map(|sh| {
+                let local = sh.inverse_rotation * (p - sh.world_position);
+                sh.sdf.distance_and_normal(local).0
+            })
+            .fold(f32::INFINITY, f32::min))
+    }
+
     /// The wrench each body received at the last [`Self::apply_wrenches`].
     pub fn last_wrenches(&self) -> &[Wrench] {
         &self.last_wrenches

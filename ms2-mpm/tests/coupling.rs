@@ -256,3 +256,33 @@ fn bad_coupling_input_is_refused() {
         Err(ms2_mpm::MpmError::NonFiniteInput { .. })
     ));
 }
+
+#[test]
+fn distance_to_body_follows_the_synced_pose() {
+    let mut world = SimpleRigidWorld::new(Vec3::ZERO);
+    let b = world.add_box(
+        Vec3::new(0.02, 0.03, 0.04),
+        500.0,
+        Vec3::new(0.1, 0.1, 0.1),
+        Motion::Kinematic,
+    );
+    let mut coupling = Coupling::new(&world, CouplingParams::for_substep(5e-4)).unwrap();
+    let d = coupling
+        .distance_to_body(b, Vec3::new(0.1, 0.1, 0.2))
+        .unwrap();
+    assert!((d - 0.06).abs() < 1e-6, "{d}");
+    // Turn the box 90° about x: its z half extent becomes 3 cm.
+    world.bodies[b].rotation = glam::Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    coupling.sync_bodies(&world).unwrap();
+    let d = coupling
+        .distance_to_body(b, Vec3::new(0.1, 0.1, 0.2))
+        .unwrap();
+    assert!((d - 0.07).abs() < 1e-5, "{d}");
+    assert!(
+        coupling
+            .distance_to_body(b, Vec3::new(0.1, 0.1, 0.1))
+            .unwrap()
+            < 0.0
+    );
+    assert!(coupling.distance_to_body(7, Vec3::ZERO).is_err());
+}

@@ -299,7 +299,8 @@ impl World {
         Ok(())
     }
 
-    /// Sets the PD drive of one degree of freedom (keeps its targets).
+    /// Sets the PD drive of one degree of freedom (keeps its targets). Changing gains is a
+    /// configuration change for [`World::set_state`]; writing the same gains is a no-op.
     pub fn set_drive(&mut self, art: ArticulationId, dof: usize, drive: DriveParams) -> Result<()> {
         drive.validate()?;
         let a = self.articulation_ref(art)?;
@@ -315,6 +316,16 @@ impl World {
             .get_multibody_mut(mbi)
             .expect("multibody");
         let data = &mut mb.link_mut(d.mb_link).expect("link").joint.data;
+        if let Some(m) = data.motor(d.axis) {
+            if m.stiffness == drive.stiffness
+                && m.damping == drive.damping
+                && m.max_force == drive.force_limit
+                && m.model == MotorModel::ForceBased
+            {
+                // Unchanged: not a configuration change, exact snapshots stay valid.
+                return Ok(());
+            }
+        }
         let (pos, vel) = data
             .motor(d.axis)
             .map(|m| (m.target_pos, m.target_vel))

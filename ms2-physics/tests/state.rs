@@ -112,3 +112,25 @@ fn resetting_to_a_foreign_vector_replays_the_same_run_whatever_came_before() {
     let second = run(&mut world, panda, 150);
     assert_bitwise_equal(&first, &second);
 }
+
+#[test]
+fn set_state_keeps_drive_gains_and_same_gain_writes_keep_snapshots_exact() {
+    let (mut world, panda, _) = scene();
+    run(&mut world, panda, 100);
+    let state = world.get_state();
+    let first = run(&mut world, panda, 100);
+    // Writing the gains it already has is not a configuration change.
+    let gains = world.drive(panda, 0).unwrap();
+    world.set_drive(panda, 0, gains).unwrap();
+    world.set_state(&state).unwrap();
+    assert_bitwise_equal(&first, &run(&mut world, panda, 100));
+    // New gains survive a state restore (gains are configuration, not state).
+    let softer = ms2_physics::DriveParams {
+        stiffness: 10.0,
+        ..gains
+    };
+    world.set_drive(panda, 0, softer).unwrap();
+    world.set_state(&state).unwrap();
+    assert_eq!(world.drive(panda, 0).unwrap(), softer);
+    assert_eq!(world.get_state(), state);
+}
