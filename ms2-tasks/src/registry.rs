@@ -5,10 +5,13 @@ use crate::config::EnvConfig;
 use crate::error::EnvError;
 use crate::tasks::dummy::DummyEnv;
 
+/// Builds a backend from a config and the number of physics substeps per env step.
+type MakeBackend = fn(&EnvConfig, u32) -> Result<Box<dyn EnvBackend>, EnvError>;
+
 /// A registered environment id and how to build its backend.
 struct Registration {
     id: &'static str,
-    make: fn(&EnvConfig, u32) -> Result<Box<dyn EnvBackend>, EnvError>,
+    make: MakeBackend,
 }
 
 const REGISTRY: &[Registration] = &[Registration {
