@@ -22,8 +22,10 @@ fn ee_delta_pos_reaches_5cm_steps_without_turning() {
             rig.command(&action);
             rig.run(ONE_SECOND);
             let end = rig.tcp();
-            let mut expected = start.translation.vector;
-            expected[axis] += 0.05 * sign;
+            // ManiSkill2's default frame for the Panda's ee controllers is the TCP frame.
+            let mut delta = Vector3::zeros();
+            delta[axis] = 0.05 * sign;
+            let expected = start.translation.vector + start.rotation * delta;
             let err = (end.translation.vector - expected).norm();
             let turn = end.rotation.angle_to(&start.rotation);
             assert!(err < 0.003, "axis {axis} sign {sign}: position error {err} m");
@@ -91,17 +93,19 @@ fn target_variants_accumulate_targets_when_tracking_lags() {
     assert!(t_target - t_plain > 1e-3);
 
     // End-effector variants likewise.
-    let action = [1.0f32, 0.0, 0.0, 1.0];
+    let action = [0.0f32, 1.0, 0.0, 1.0]; // 0.1 m along the TCP's y axis (sideways)
     let mut plain = Rig::new(ControlMode::PdEeDeltaPos, 3);
     let mut target = Rig::new(ControlMode::PdEeTargetDeltaPos, 3);
-    let x0 = plain.tcp().translation.x;
+    let start = plain.tcp();
     for rig in [&mut plain, &mut target] {
         rig.step(&action);
         rig.step(&action);
         rig.run(ONE_SECOND);
     }
-    let (xp, xt) = (plain.tcp().translation.x, target.tcp().translation.x);
-    assert!((xt - (x0 + 0.2)).abs() < 0.005, "target variant reaches x0 + 0.2: {xt} vs {x0}");
+    // Displacement along the TCP's y axis (the controllers' frame).
+    let along_y = |rig: &Rig| (start.inverse() * rig.tcp()).translation.y;
+    let (xp, xt) = (along_y(&plain), along_y(&target));
+    assert!((xt - 0.2).abs() < 0.005, "target variant moves 0.2 m: {xt}");
     assert!(xt - xp > 0.01, "plain variant falls short: {xp} vs target {xt}");
 }
 

@@ -92,6 +92,11 @@ impl Articulation for PhysicsArticulation<'_> {
                 damping: g.damping as f32,
                 force_limit: g.force_limit as f32,
             };
+            // Unchanged gains are not rewritten: a gain write is a configuration change for the
+            // physics world, which would invalidate its exact state snapshots.
+            if self.world.drive(self.id, i).ok() == Some(params) {
+                continue;
+            }
             let result = self.world.set_drive(self.id, i, params);
             debug_assert!(result.is_ok(), "drive gain write failed: {result:?}");
         }
