@@ -108,7 +108,9 @@ impl PandaAgent {
     pub fn set_joint_state(&mut self, world: &mut World, qpos: &[f32]) -> Result<(), EnvError> {
         let art = self.articulation;
         let zeros = vec![0.0; qpos.len()];
-        world.set_root_pose(art, &self.base_pose).map_err(physics_err)?;
+        world
+            .set_root_pose(art, &self.base_pose)
+            .map_err(physics_err)?;
         world.set_qpos(art, qpos).map_err(physics_err)?;
         world.set_qvel(art, &zeros).map_err(physics_err)?;
         world.set_drive_targets(art, qpos).map_err(physics_err)?;

@@ -106,7 +106,8 @@ mod tests {
         // TCP z pointing down, x along the cube's x: rotation of pi about x.
         let down = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f32::consts::PI);
         assert!(top_down_grasp_rotation_loss(down.to_rotation_matrix().matrix()) < 1e-6);
-        let down_yawed = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f32::consts::FRAC_PI_4) * down;
+        let down_yawed =
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f32::consts::FRAC_PI_4) * down;
         let loss = top_down_grasp_rotation_loss(down_yawed.to_rotation_matrix().matrix());
         assert!(loss > 0.1, "{loss}");
         assert!(top_down_grasp_rotation_loss(&Matrix3::identity()) > 0.5);
@@ -116,7 +117,14 @@ mod tests {
     fn quarter_turn_yaw_is_nearest() {
         let y = nearest_quarter_turn_yaw(0.1, 1.5);
         assert_relative_eq!(y, 0.1 + std::f32::consts::FRAC_PI_2, epsilon = 1e-6);
-        assert_relative_eq!(wrap_angle(3.0 * std::f32::consts::PI), std::f32::consts::PI, epsilon = 1e-5);
-        assert_relative_eq!(angle_between(&Vector3::x(), &Vector3::y()), std::f32::consts::FRAC_PI_2);
+        assert_relative_eq!(
+            wrap_angle(3.0 * std::f32::consts::PI),
+            std::f32::consts::PI,
+            epsilon = 1e-5
+        );
+        assert_relative_eq!(
+            angle_between(&Vector3::x(), &Vector3::y()),
+            std::f32::consts::FRAC_PI_2
+        );
     }
 }

@@ -49,6 +49,6 @@ pub use obs::{Array, ArrayData, DType, DictBuilder, ObsValue};
 pub use registry::env_ids;
 pub use scripted::{make_scripted_policy, ScriptedPolicy};
 pub use seeding::EpisodeRng;
-pub use task::{Task, TaskScene};
 pub use spaces::{BoxSpace, Space};
+pub use task::{Task, TaskScene};
 pub use vec_env::VecEnv;

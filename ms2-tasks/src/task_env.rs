@@ -199,7 +199,10 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
         let ctrl_len: usize = parts.iter().map(|(_, v)| v.len()).sum();
         let (world_state, rest) = state.split_at(world_len);
         let (ctrl_state, task_state) = rest.split_at(ctrl_len);
-        self.scene.world.set_state(world_state).map_err(physics_err)?;
+        self.scene
+            .world
+            .set_state(world_state)
+            .map_err(physics_err)?;
         let mut offset = 0;
         let restored: Vec<(String, Vec<f64>)> = parts
             .into_iter()

@@ -28,8 +28,14 @@ fn ee_delta_pos_reaches_5cm_steps_without_turning() {
             let expected = start.translation.vector + start.rotation * delta;
             let err = (end.translation.vector - expected).norm();
             let turn = end.rotation.angle_to(&start.rotation);
-            assert!(err < 0.003, "axis {axis} sign {sign}: position error {err} m");
-            assert!(turn < 0.02, "axis {axis} sign {sign}: orientation moved {turn} rad");
+            assert!(
+                err < 0.003,
+                "axis {axis} sign {sign}: position error {err} m"
+            );
+            assert!(
+                turn < 0.02,
+                "axis {axis} sign {sign}: orientation moved {turn} rad"
+            );
         }
     }
 }
@@ -48,7 +54,10 @@ fn ee_delta_pose_rotations_reach_without_translating() {
         let end = rig.tcp();
         let turned = end.rotation.angle_to(&start.rotation);
         let moved = (end.translation.vector - start.translation.vector).norm();
-        assert!((turned - 0.1).abs() < 0.02, "axis {axis}: turned {turned} rad, expected 0.1");
+        assert!(
+            (turned - 0.1).abs() < 0.02,
+            "axis {axis}: turned {turned} rad, expected 0.1"
+        );
         assert!(moved < 0.003, "axis {axis}: TCP moved {moved} m");
     }
 }
@@ -85,11 +94,21 @@ fn target_variants_accumulate_targets_when_tracking_lags() {
         rig.command(&action);
     }
     let lagging_q = plain.qpos()[0];
-    assert!(lagging_q < q0 + 0.1 - 1e-3, "the arm should lag its first target");
+    assert!(
+        lagging_q < q0 + 0.1 - 1e-3,
+        "the arm should lag its first target"
+    );
     let t_plain = plain.drive_targets()[0];
     let t_target = target.drive_targets()[0];
-    assert!((t_target - (q0 + 0.2)).abs() < 1e-5, "target variant: {t_target} vs {}", q0 + 0.2);
-    assert!((t_plain - (lagging_q + 0.1)).abs() < 1e-5, "plain variant: {t_plain}");
+    assert!(
+        (t_target - (q0 + 0.2)).abs() < 1e-5,
+        "target variant: {t_target} vs {}",
+        q0 + 0.2
+    );
+    assert!(
+        (t_plain - (lagging_q + 0.1)).abs() < 1e-5,
+        "plain variant: {t_plain}"
+    );
     assert!(t_target - t_plain > 1e-3);
 
     // End-effector variants likewise.
@@ -106,7 +125,10 @@ fn target_variants_accumulate_targets_when_tracking_lags() {
     let along_y = |rig: &Rig| (start.inverse() * rig.tcp()).translation.y;
     let (xp, xt) = (along_y(&plain), along_y(&target));
     assert!((xt - 0.2).abs() < 0.005, "target variant moves 0.2 m: {xt}");
-    assert!(xt - xp > 0.01, "plain variant falls short: {xp} vs target {xt}");
+    assert!(
+        xt - xp > 0.01,
+        "plain variant falls short: {xp} vs target {xt}"
+    );
 }
 
 #[test]
@@ -122,7 +144,11 @@ fn joint_pos_trajectory_converted_to_ee_delta_pose_ends_within_5mm() {
     };
     let mut src = make("pd_joint_pos");
     let mut dst = make("pd_ee_delta_pose");
-    let q0: Vec<f32> = src.task_scene().unwrap().agent.qpos(&src.task_scene().unwrap().world);
+    let q0: Vec<f32> = src
+        .task_scene()
+        .unwrap()
+        .agent
+        .qpos(&src.task_scene().unwrap().world);
     let goal_offsets = [0.3f32, 0.2, -0.2, 0.3, 0.2, -0.3, 0.4];
     let steps = 40;
     for k in 1..=steps {
@@ -150,7 +176,11 @@ fn joint_pos_trajectory_converted_to_ee_delta_pose_ends_within_5mm() {
             let mut desired: Vec<f64> =
                 (0..7).map(|i| f64::from(q0[i] + goal_offsets[i])).collect();
             desired.extend([0.04, 0.04]);
-            let c = scene.agent.controller.action_for_joint_targets(&snap, &desired).unwrap();
+            let c = scene
+                .agent
+                .controller
+                .action_for_joint_targets(&snap, &desired)
+                .unwrap();
             c.action.iter().map(|&v| v as f32).collect()
         };
         dst.step(&hold).unwrap();
@@ -163,5 +193,9 @@ fn joint_pos_trajectory_converted_to_ee_delta_pose_ends_within_5mm() {
         s.agent.tcp_pose(&s.world).translation.vector
     };
     let gap: Vector3<f32> = tcp(&src) - tcp(&dst);
-    assert!(gap.norm() < 0.005, "converted trajectory ends {} m from the source", gap.norm());
+    assert!(
+        gap.norm() < 0.005,
+        "converted trajectory ends {} m from the source",
+        gap.norm()
+    );
 }

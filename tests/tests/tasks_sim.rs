@@ -21,7 +21,9 @@ fn actions(dim: usize, steps: usize, salt: u32) -> Vec<Vec<f32>> {
         .map(|t| {
             (0..dim)
                 .map(|i| {
-                    let x = ((t * 31 + i * 17) as u32).wrapping_mul(2654435761).wrapping_add(salt);
+                    let x = ((t * 31 + i * 17) as u32)
+                        .wrapping_mul(2654435761)
+                        .wrapping_add(salt);
                     (x % 2001) as f32 / 1000.0 - 1.0
                 })
                 .collect()
@@ -44,7 +46,11 @@ fn state_layouts_match_maniskill2() {
                 "obj_to_goal_pos",
             ],
         ),
-        ("LiftCube-v0", 42, vec!["tcp_pose", "obj_pose", "tcp_to_obj_pos"]),
+        (
+            "LiftCube-v0",
+            42,
+            vec!["tcp_pose", "obj_pose", "tcp_to_obj_pos"],
+        ),
         (
             "StackCube-v0",
             55,
@@ -68,8 +74,15 @@ fn state_layouts_match_maniskill2() {
         let extra: Vec<String> = extra_keys.iter().map(|k| format!("extra/{k}")).collect();
         want.extend(extra.iter().map(String::as_str));
         assert_eq!(keys, want, "{id}");
-        assert_eq!(e.action_space().size(), 8, "{id}: default pd_joint_delta_pos");
-        assert_eq!(e.config().control_mode.as_deref(), Some("pd_joint_delta_pos"));
+        assert_eq!(
+            e.action_space().size(),
+            8,
+            "{id}: default pd_joint_delta_pos"
+        );
+        assert_eq!(
+            e.config().control_mode.as_deref(),
+            Some("pd_joint_delta_pos")
+        );
         assert_eq!(e.max_episode_steps(), 200);
     }
 }
@@ -87,17 +100,32 @@ fn reset_distribution_follows_maniskill2() {
         let qpos = get("agent/qpos");
         for i in 0..7 {
             let d = (qpos[i] - rest[i] as f32).abs();
-            assert!(d < 0.1, "seed {seed} joint {i}: noise {d} rad is not N(0, 0.02)");
+            assert!(
+                d < 0.1,
+                "seed {seed} joint {i}: noise {d} rad is not N(0, 0.02)"
+            );
             max_noise = max_noise.max(d);
         }
         assert_eq!(&qpos[7..], &[0.04, 0.04]);
         assert!(get("agent/qvel").iter().all(|v| *v == 0.0));
         let obj = get("extra/obj_pose");
-        assert!(obj[0].abs() <= 0.1 && obj[1].abs() <= 0.1, "cube xy {obj:?}");
-        assert!((obj[2] - 0.02).abs() < 1e-6, "cube rests on the ground: {obj:?}");
+        assert!(
+            obj[0].abs() <= 0.1 && obj[1].abs() <= 0.1,
+            "cube xy {obj:?}"
+        );
+        assert!(
+            (obj[2] - 0.02).abs() < 1e-6,
+            "cube rests on the ground: {obj:?}"
+        );
         let goal = get("extra/goal_pos");
-        let d: f32 = (0..3).map(|i| (goal[i] - obj[i]).powi(2)).sum::<f32>().sqrt();
-        assert!(d > 0.05 && goal[2] >= 0.02 && goal[2] <= 0.52, "goal {goal:?}");
+        let d: f32 = (0..3)
+            .map(|i| (goal[i] - obj[i]).powi(2))
+            .sum::<f32>()
+            .sqrt();
+        assert!(
+            d > 0.05 && goal[2] >= 0.02 && goal[2] <= 0.52,
+            "goal {goal:?}"
+        );
     }
     assert!(max_noise > 1e-3, "the arm joints get noise");
 }
@@ -140,13 +168,19 @@ fn get_set_state_round_trip_is_exact_and_replays() {
         assert_eq!(e.get_state(), state, "{id}: round trip");
         assert_eq!(e.observe(), obs, "{id}: observation restored");
         let replay: Vec<_> = acts[4..].iter().map(|a| e.step(a).unwrap().obs).collect();
-        assert_eq!(replay, tail, "{id}: stepping from a restored state replays the run");
+        assert_eq!(
+            replay, tail,
+            "{id}: stepping from a restored state replays the run"
+        );
     }
     // PickCube's state ends with the goal.
     let mut e = env("PickCube-v0", "state_dict");
     let (obs, _) = e.reset(Some(5), false).unwrap();
     let state = e.get_state();
-    let goal = obs.get("extra/goal_pos").and_then(ObsValue::as_f32).unwrap();
+    let goal = obs
+        .get("extra/goal_pos")
+        .and_then(ObsValue::as_f32)
+        .unwrap();
     assert_eq!(&state[state.len() - 3..], goal);
 }
 
@@ -170,7 +204,10 @@ fn rewards_and_info_are_consistent() {
         let n = norm.step(&a).unwrap();
         assert!((n.reward - d.reward / 5.0).abs() < 1e-9);
         assert!((0.0..=5.0).contains(&d.reward));
-        assert_eq!(d.terminated, info_get(&d.info, "success") == Some(InfoValue::Bool(true)));
+        assert_eq!(
+            d.terminated,
+            info_get(&d.info, "success") == Some(InfoValue::Bool(true))
+        );
         assert!(info_get(&d.info, "is_obj_placed").is_some());
         assert!(info_get(&d.info, "is_robot_static").is_some());
         grasp_bonus_seen |= d.reward > 2.0;
@@ -180,7 +217,10 @@ fn rewards_and_info_are_consistent() {
             break;
         }
     }
-    assert!(grasp_bonus_seen, "the grasp term fires while carrying: {rewards:?}");
+    assert!(
+        grasp_bonus_seen,
+        "the grasp term fires while carrying: {rewards:?}"
+    );
     assert_eq!(*rewards.last().unwrap(), 5.0, "the oracle solves seed 0");
 }
 

@@ -4,7 +4,7 @@
 
 use nalgebra::Vector3;
 
-use super::oracle::{top_down_tcp_pose, tcp_yaw, TcpOracle, GRIPPER_CLOSED, GRIPPER_OPEN};
+use super::oracle::{tcp_yaw, top_down_tcp_pose, TcpOracle, GRIPPER_CLOSED, GRIPPER_OPEN};
 use super::ScriptedPolicy;
 use crate::env::Env;
 use crate::geometry::{nearest_quarter_turn_yaw, pose_from_vec7, Pose3};

@@ -48,7 +48,12 @@ pub struct CubeOnGround {
 impl CubeOnGround {
     /// Adds the cube.
     pub fn build(&mut self, world: &mut World) -> Result<(), EnvError> {
-        self.cube = Some(add_cube(world, "cube", CUBE_HALF_SIZE, [1.0, 0.0, 0.0, 1.0])?);
+        self.cube = Some(add_cube(
+            world,
+            "cube",
+            CUBE_HALF_SIZE,
+            [1.0, 0.0, 0.0, 1.0],
+        )?);
         Ok(())
     }
 
@@ -87,7 +92,10 @@ pub(crate) fn placed_and_static(scene: &TaskScene, is_obj_placed: bool) -> Evalu
         success: is_obj_placed && is_robot_static,
         terms: vec![
             ("is_obj_placed".to_owned(), InfoValue::Bool(is_obj_placed)),
-            ("is_robot_static".to_owned(), InfoValue::Bool(is_robot_static)),
+            (
+                "is_robot_static".to_owned(),
+                InfoValue::Bool(is_robot_static),
+            ),
         ],
     }
 }
@@ -124,7 +132,11 @@ impl Task for PickCube {
     fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
         let tcp = scene.agent.tcp_pose(&scene.world);
         let obj = body_pose(&scene.world, self.scene.body());
-        let (tcp_p, obj_p, goal) = (tcp.translation.vector, obj.translation.vector, self.goal_pos);
+        let (tcp_p, obj_p, goal) = (
+            tcp.translation.vector,
+            obj.translation.vector,
+            self.goal_pos,
+        );
         extra.push_vector("tcp_pose", &vectorize_pose(&tcp));
         extra.push_vector("goal_pos", goal.as_slice());
         extra.push_vector("tcp_to_goal_pos", (goal - tcp_p).as_slice());

@@ -88,8 +88,18 @@ impl Task for StackCube {
     }
 
     fn build_scene(&mut self, world: &mut World, _rng: &mut EpisodeRng) -> Result<(), EnvError> {
-        self.cube_a = Some(add_cube(world, "cubeA", CUBE_HALF_SIZE, [1.0, 0.0, 0.0, 1.0])?);
-        self.cube_b = Some(add_cube(world, "cubeB", CUBE_HALF_SIZE, [0.0, 1.0, 0.0, 1.0])?);
+        self.cube_a = Some(add_cube(
+            world,
+            "cubeA",
+            CUBE_HALF_SIZE,
+            [1.0, 0.0, 0.0, 1.0],
+        )?);
+        self.cube_b = Some(add_cube(
+            world,
+            "cubeB",
+            CUBE_HALF_SIZE,
+            [0.0, 1.0, 0.0, 1.0],
+        )?);
         Ok(())
     }
 
@@ -153,8 +163,14 @@ impl Task for StackCube {
         let rot_a_from_tcp = (a.rotation.inverse() * tcp.rotation).to_rotation_matrix();
         let mut reward = 1.0 - f64::from(top_down_grasp_rotation_loss(rot_a_from_tcp.matrix()));
         // Cube B should stay still.
-        let lin_b = world.body_linear_velocity(self.b()).map(|v| v.norm()).unwrap_or(0.0);
-        let ang_b = world.body_angular_velocity(self.b()).map(|v| v.norm()).unwrap_or(0.0);
+        let lin_b = world
+            .body_linear_velocity(self.b())
+            .map(|v| v.norm())
+            .unwrap_or(0.0);
+        let ang_b = world
+            .body_angular_velocity(self.b())
+            .map(|v| v.norm())
+            .unwrap_or(0.0);
         reward -= f64::from(lin_b + ang_b);
         // Reach cube A.
         reward += closeness((tcp.translation.vector - ap).norm(), 3.0);
