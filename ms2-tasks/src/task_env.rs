@@ -165,6 +165,21 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
         let mut agent_obs = DictBuilder::new();
         agent_obs.push_vector("qpos", &agent.qpos(world));
         agent_obs.push_vector("qvel", &agent.qvel(world));
+        // Target-accumulating modes also report their targets, as ManiSkill2 does.
+        let ctrl_state = agent.controller.state();
+        if !ctrl_state.is_empty() {
+            let mut ctrl = DictBuilder::new();
+            for (part, values) in ctrl_state {
+                let key = if agent.control_mode.name().starts_with("pd_ee") && part == "arm" {
+                    "target_pose"
+                } else {
+                    "target_qpos"
+                };
+                let values: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+                ctrl.push(&part, DictBuilder::new().vector(key, &values).build());
+            }
+            agent_obs.push("controller", ctrl.build());
+        }
         agent_obs.push_vector("base_pose", &vectorize_pose(&agent.base_pose()));
         let mut extra = DictBuilder::new();
         self.task.extra_obs(&self.scene, &mut extra);

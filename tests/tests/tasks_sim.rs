@@ -284,3 +284,28 @@ fn vec_env_steps_pick_cube_like_single_envs() {
         }
     }
 }
+
+#[test]
+fn target_modes_report_their_targets_in_the_agent_obs() {
+    for (mode, key) in [
+        ("pd_joint_target_delta_pos", "agent/controller/arm/target_qpos"),
+        ("pd_ee_target_delta_pose", "agent/controller/arm/target_pose"),
+    ] {
+        let mut e = make_env(&EnvConfig {
+            control_mode: Some(mode.into()),
+            ..EnvConfig::new("PickCube-v0")
+        })
+        .unwrap();
+        let (obs, _) = e.reset(Some(0), false).unwrap();
+        let keys: Vec<String> = obs.leaf_layout().into_iter().map(|(k, _)| k).collect();
+        assert_eq!(&keys[..4], ["agent/qpos", "agent/qvel", key, "agent/base_pose"], "{mode}");
+        assert_eq!(obs.get(key).and_then(ObsValue::as_f32).unwrap().len(), 7);
+        // The targets are part of the state too, and restored by set_state.
+        let state = e.get_state();
+        e.step(&vec![0.5; e.action_space().size()]).unwrap();
+        let moved = e.observe();
+        e.set_state(&state).unwrap();
+        assert_eq!(e.observe(), obs, "{mode}");
+        assert_ne!(moved, obs);
+    }
+}
