@@ -288,8 +288,14 @@ fn vec_env_steps_pick_cube_like_single_envs() {
 #[test]
 fn target_modes_report_their_targets_in_the_agent_obs() {
     for (mode, key) in [
-        ("pd_joint_target_delta_pos", "agent/controller/arm/target_qpos"),
-        ("pd_ee_target_delta_pose", "agent/controller/arm/target_pose"),
+        (
+            "pd_joint_target_delta_pos",
+            "agent/controller/arm/target_qpos",
+        ),
+        (
+            "pd_ee_target_delta_pose",
+            "agent/controller/arm/target_pose",
+        ),
     ] {
         let mut e = make_env(&EnvConfig {
             control_mode: Some(mode.into()),
@@ -298,7 +304,11 @@ fn target_modes_report_their_targets_in_the_agent_obs() {
         .unwrap();
         let (obs, _) = e.reset(Some(0), false).unwrap();
         let keys: Vec<String> = obs.leaf_layout().into_iter().map(|(k, _)| k).collect();
-        assert_eq!(&keys[..4], ["agent/qpos", "agent/qvel", key, "agent/base_pose"], "{mode}");
+        assert_eq!(
+            &keys[..4],
+            ["agent/qpos", "agent/qvel", key, "agent/base_pose"],
+            "{mode}"
+        );
         assert_eq!(obs.get(key).and_then(ObsValue::as_f32).unwrap().len(), 7);
         // The targets are part of the state too, and restored by set_state.
         let state = e.get_state();
