@@ -1,0 +1,44 @@
+//! The interface between the generic [`crate::Env`] runtime and a concrete simulation.
+//!
+//! [`crate::Env`] owns what every environment shares (config resolution, seeding, step counting,
+//! truncation, reward modes, observation modes, spaces). A backend owns the simulation: the robot
+//! task runtime ([`crate::task_env::TaskEnv`] over a [`crate::Task`]) or the physics-free test
+//! env `Dummy-v0`.
+
+use crate::error::EnvError;
+use crate::info::Evaluation;
+use crate::obs::ObsValue;
+use crate::seeding::EpisodeRng;
+use crate::spaces::BoxSpace;
+
+/// A simulation the [`crate::Env`] runtime drives.
+pub(crate) trait EnvBackend: Send {
+    /// The task's default episode length in env steps.
+    fn default_max_episode_steps(&self) -> u32;
+    /// Control modes supported by the robot.
+    fn control_modes(&self) -> Vec<String>;
+    /// The active control mode.
+    fn control_mode(&self) -> &str;
+    /// Action space of the active control mode.
+    fn action_space(&self) -> &BoxSpace;
+    /// Largest dense reward (for `normalized_dense`).
+    fn max_dense_reward(&self) -> f64;
+    /// (Re)builds the scene.
+    fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError>;
+    /// Samples a new episode (robot and objects) from `rng`.
+    fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError>;
+    /// Applies one (validated, finite, right-length) action and advances one control period.
+    fn apply_action(&mut self, action: &[f32]) -> Result<(), EnvError>;
+    /// The full privileged `state_dict` observation.
+    fn observe_state_dict(&self) -> ObsValue;
+    /// Success and evaluation terms of the current state.
+    fn evaluate(&self) -> Evaluation;
+    /// Dense reward of the current state after `action`.
+    fn dense_reward(&self, eval: &Evaluation, action: &[f32]) -> f64;
+    /// Length of the flat state vector.
+    fn state_len(&self) -> usize;
+    /// Flat float32 simulation + task state.
+    fn get_state(&self) -> Vec<f32>;
+    /// Restores a state (length and finiteness already checked).
+    fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError>;
+}

@@ -1,0 +1,305 @@
+//! [`Env`]: the gymnasium-style environment runtime shared by every task.
+
+use crate::backend::EnvBackend;
+use crate::config::{EnvConfig, ObsMode, RewardMode, RENDER_MODES};
+use crate::error::EnvError;
+use crate::info::{Evaluation, Info, InfoValue};
+use crate::obs::{Array, ArrayData, ObsValue};
+use crate::registry;
+use crate::seeding::{episode_rng, Seeding};
+use crate::spaces::{BoxSpace, Space};
+
+/// Episode seed used to build the scene and sample a first episode when an env is made (as
+/// ManiSkill2 does to derive its observation space). The env is usable (steppable) right away.
+const CONSTRUCTION_SEED: u64 = 2022;
+
+/// The result of one [`Env::step`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepOutput {
+    /// Observation after the step, in the env's obs mode.
+    pub obs: ObsValue,
+    /// Reward in the env's reward mode.
+    pub reward: f64,
+    /// True when the task is solved (`terminated` = `success`, as in ManiSkill2).
+    pub terminated: bool,
+    /// True when `elapsed_steps >= max_episode_steps`.
+    pub truncated: bool,
+    /// `elapsed_steps`, `success`, then the task's evaluation terms.
+    pub info: Info,
+}
+
+/// One environment: a task's simulation plus seeding, rewards, observations and episode limits.
+///
+/// ```
+/// use ms2_tasks::{make_env, EnvConfig};
+/// let mut env = make_env(&EnvConfig::new("Dummy-v0")).unwrap();
+/// let (obs, _info) = env.reset(Some(0), false).unwrap();
+/// let action = vec![0.0; env.action_space().size()];
+/// let out = env.step(&action).unwrap();
+/// assert_eq!(env.elapsed_steps(), 1);
+/// assert!(obs.get("agent/qpos").is_some() && !out.truncated);
+/// ```
+pub struct Env {
+    cfg: EnvConfig,
+    obs_mode: ObsMode,
+    reward_mode: RewardMode,
+    backend: Box<dyn EnvBackend>,
+    seeding: Seeding,
+    elapsed_steps: u32,
+    max_episode_steps: u32,
+    observation_space: Space,
+}
+
+impl std::fmt::Debug for Env {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Env")
+            .field("cfg", &self.cfg)
+            .field("elapsed_steps", &self.elapsed_steps)
+            .field("episode_seed", &self.seeding.episode_seed())
+            .finish_non_exhaustive()
+    }
+}
+
+/// Makes the environment `cfg.env_id` (see [`env_ids`](crate::env_ids)).
+pub fn make_env(cfg: &EnvConfig) -> Result<Env, EnvError> {
+    Env::new(cfg)
+}
+
+impl Env {
+    /// Makes the environment `cfg.env_id`, builds its scene and samples a first episode.
+    pub fn new(cfg: &EnvConfig) -> Result<Env, EnvError> {
+        let obs_mode = ObsMode::parse(&cfg.obs_mode)?;
+        let reward_mode =
+            RewardMode::parse(cfg.reward_mode.as_deref().unwrap_or("normalized_dense"))?;
+        if let Some(rm) = &cfg.render_mode {
+            if !RENDER_MODES.contains(&rm.as_str()) {
+                return Err(EnvError::UnknownRenderMode {
+                    got: rm.clone(),
+                    valid: RENDER_MODES.iter().map(|s| s.to_string()).collect(),
+                });
+            }
+        }
+        if cfg.max_episode_steps == Some(0) {
+            return Err(EnvError::InvalidConfig(
+                "max_episode_steps must be at least 1, got 0".to_owned(),
+            ));
+        }
+        let substeps = cfg.substeps()?;
+        let backend = registry::make_backend(cfg, substeps)?;
+        let resolved = EnvConfig {
+            control_mode: Some(backend.control_mode().to_owned()),
+            reward_mode: Some(reward_mode.as_str().to_owned()),
+            max_episode_steps: Some(
+                cfg.max_episode_steps
+                    .unwrap_or_else(|| backend.default_max_episode_steps()),
+            ),
+            ..cfg.clone()
+        };
+        let mut env = Env {
+            max_episode_steps: resolved.max_episode_steps.unwrap_or(1),
+            cfg: resolved,
+            obs_mode,
+            reward_mode,
+            backend,
+            seeding: Seeding::from_entropy(),
+            elapsed_steps: 0,
+            observation_space: Space::Dict(Vec::new()),
+        };
+        let mut rng = episode_rng(CONSTRUCTION_SEED);
+        env.backend.reconfigure(&mut rng)?;
+        env.backend.initialize_episode(&mut rng)?;
+        env.observation_space = Space::unbounded_like(&env.observe());
+        Ok(env)
+    }
+
+    /// Starts a new episode. `seed = Some(s)` determines the episode fully by `s`; `None` draws
+    /// the next episode seed from the env's main RNG. `reconfigure` rebuilds the scene first.
+    /// Returns the first observation and an info with `elapsed_steps = 0`, `success` and the
+    /// task's evaluation terms.
+    pub fn reset(
+        &mut self,
+        seed: Option<u64>,
+        reconfigure: bool,
+    ) -> Result<(ObsValue, Info), EnvError> {
+        let mut rng = self.seeding.start_episode(seed);
+        if reconfigure {
+            self.backend.reconfigure(&mut rng)?;
+        }
+        self.backend.initialize_episode(&mut rng)?;
+        self.elapsed_steps = 0;
+        let eval = self.backend.evaluate();
+        Ok((self.observe(), self.make_info(eval)))
+    }
+
+    /// Applies `action` (length = `action_space().size()`, finite) for one control period of
+    /// `sim_freq / control_freq` physics substeps, then observes, evaluates and rewards.
+    pub fn step(&mut self, action: &[f32]) -> Result<StepOutput, EnvError> {
+        self.check_action(action)?;
+        self.backend.apply_action(action)?;
+        self.elapsed_steps = self.elapsed_steps.saturating_add(1);
+        let eval = self.backend.evaluate();
+        let reward = match self.reward_mode {
+            RewardMode::Sparse => f64::from(u8::from(eval.success)),
+            RewardMode::Dense => self.backend.dense_reward(&eval, action),
+            RewardMode::NormalizedDense => {
+                self.backend.dense_reward(&eval, action) / self.backend.max_dense_reward()
+            }
+        };
+        let terminated = eval.success;
+        Ok(StepOutput {
+            obs: self.observe(),
+            reward,
+            terminated,
+            truncated: self.elapsed_steps >= self.max_episode_steps,
+            info: self.make_info(eval),
+        })
+    }
+
+    fn check_action(&self, action: &[f32]) -> Result<(), EnvError> {
+        let expected = self.backend.action_space().size();
+        if action.len() != expected {
+            return Err(EnvError::ActionShape {
+                control_mode: self.backend.control_mode().to_owned(),
+                expected,
+                got: action.len(),
+            });
+        }
+        if let Some((index, &value)) = action.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(EnvError::NonFiniteAction {
+                control_mode: self.backend.control_mode().to_owned(),
+                index,
+                value,
+            });
+        }
+        Ok(())
+    }
+
+    fn make_info(&self, eval: Evaluation) -> Info {
+        let mut info = Vec::with_capacity(eval.terms.len() + 2);
+        info.push((
+            "elapsed_steps".to_owned(),
+            InfoValue::I64(i64::from(self.elapsed_steps)),
+        ));
+        info.push(("success".to_owned(), InfoValue::Bool(eval.success)));
+        info.extend(eval.terms);
+        info
+    }
+
+    /// The current observation in the env's obs mode.
+    pub fn observe(&self) -> ObsValue {
+        let dict = self.backend.observe_state_dict();
+        match self.obs_mode {
+            ObsMode::StateDict => dict,
+            ObsMode::State => {
+                let mut flat = Vec::with_capacity(64);
+                dict.flatten_f32_into(&mut flat);
+                ObsValue::Array(Array {
+                    shape: vec![flat.len()],
+                    data: ArrayData::F32(flat),
+                })
+            }
+        }
+    }
+
+    /// The full `state_dict` observation (privileged: object poses, goals), whatever the obs mode.
+    /// Scripted policies and tests read this.
+    pub fn privileged_obs(&self) -> ObsValue {
+        self.backend.observe_state_dict()
+    }
+
+    /// Success and evaluation terms of the current state (without stepping).
+    pub fn evaluate(&self) -> Evaluation {
+        self.backend.evaluate()
+    }
+
+    /// Observation space of the env's obs mode (float bounds unbounded, as in ManiSkill2).
+    pub fn observation_space(&self) -> &Space {
+        &self.observation_space
+    }
+
+    /// Action space of the env's control mode.
+    pub fn action_space(&self) -> &BoxSpace {
+        self.backend.action_space()
+    }
+
+    /// Flat float32 state: simulation state (objects, robot) then task state (e.g. the goal).
+    /// See `docs/tasks.md` for each task's layout.
+    pub fn get_state(&self) -> Vec<f32> {
+        self.backend.get_state()
+    }
+
+    /// Restores a state from [`Env::get_state`]; the episode step counter is kept.
+    pub fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError> {
+        let expected = self.backend.state_len();
+        if state.len() != expected {
+            return Err(EnvError::StateShape {
+                expected,
+                got: state.len(),
+            });
+        }
+        if let Some((index, &value)) = state.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(EnvError::NonFiniteState { index, value });
+        }
+        self.backend.set_state(state)
+    }
+
+    /// Env steps since the last reset.
+    pub fn elapsed_steps(&self) -> u32 {
+        self.elapsed_steps
+    }
+
+    /// Episode limit (steps after which `truncated` is true).
+    pub fn max_episode_steps(&self) -> u32 {
+        self.max_episode_steps
+    }
+
+    /// Seed of the current episode.
+    pub fn episode_seed(&self) -> u64 {
+        self.seeding.episode_seed()
+    }
+
+    /// The resolved config (defaults filled in).
+    pub fn config(&self) -> &EnvConfig {
+        &self.cfg
+    }
+
+    /// The active control mode.
+    pub fn control_mode(&self) -> &str {
+        self.backend.control_mode()
+    }
+
+    /// Control modes supported by this env's robot.
+    pub fn control_modes(&self) -> Vec<String> {
+        self.backend.control_modes()
+    }
+
+    /// Supported observation modes.
+    pub fn obs_modes(&self) -> Vec<String> {
+        ObsMode::ALL.iter().map(|m| m.as_str().to_owned()).collect()
+    }
+
+    /// Supported reward modes.
+    pub fn reward_modes(&self) -> Vec<String> {
+        RewardMode::ALL
+            .iter()
+            .map(|m| m.as_str().to_owned())
+            .collect()
+    }
+
+    /// Largest dense reward of the task.
+    pub fn max_dense_reward(&self) -> f64 {
+        self.backend.max_dense_reward()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn assert_send<T: Send>() {}
+
+    #[test]
+    fn env_is_send() {
+        assert_send::<Env>();
+    }
+}

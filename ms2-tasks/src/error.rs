@@ -1,0 +1,116 @@
+//! Typed errors of the environment runtime.
+
+/// Everything that can go wrong when making, resetting or stepping an environment.
+///
+/// Messages name the bad value and list what was expected.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EnvError {
+    /// `env_id` is not registered.
+    #[error("unknown env id {got:?}; registered ids: {valid:?}")]
+    UnknownEnvId {
+        /// The id that was asked for.
+        got: String,
+        /// The registered ids.
+        valid: Vec<String>,
+    },
+    /// `obs_mode` is not supported by this environment.
+    #[error("unknown obs_mode {got:?}; valid obs modes: {valid:?}")]
+    UnknownObsMode {
+        /// The mode that was asked for.
+        got: String,
+        /// The supported modes.
+        valid: Vec<String>,
+    },
+    /// `control_mode` is not supported by this environment's robot.
+    #[error("unknown control_mode {got:?}; valid control modes: {valid:?}")]
+    UnknownControlMode {
+        /// The mode that was asked for.
+        got: String,
+        /// The supported modes.
+        valid: Vec<String>,
+    },
+    /// `reward_mode` is not supported.
+    #[error("unknown reward_mode {got:?}; valid reward modes: {valid:?}")]
+    UnknownRewardMode {
+        /// The mode that was asked for.
+        got: String,
+        /// The supported modes.
+        valid: Vec<String>,
+    },
+    /// `render_mode` is not supported.
+    #[error("unknown render_mode {got:?}; valid render modes: {valid:?}")]
+    UnknownRenderMode {
+        /// The mode that was asked for.
+        got: String,
+        /// The supported modes.
+        valid: Vec<String>,
+    },
+    /// The action has the wrong number of elements for the control mode.
+    #[error("action for control_mode {control_mode:?} must have {expected} elements, got {got}")]
+    ActionShape {
+        /// The env's control mode.
+        control_mode: String,
+        /// Expected number of elements.
+        expected: usize,
+        /// Number of elements given.
+        got: usize,
+    },
+    /// The action contains NaN or an infinity.
+    #[error(
+        "action for control_mode {control_mode:?} has non-finite element {value} at index {index}"
+    )]
+    NonFiniteAction {
+        /// The env's control mode.
+        control_mode: String,
+        /// Index of the first non-finite element.
+        index: usize,
+        /// Its value.
+        value: f32,
+    },
+    /// A state vector given to `set_state` has the wrong length.
+    #[error("state vector must have {expected} elements, got {got}")]
+    StateShape {
+        /// Expected number of elements.
+        expected: usize,
+        /// Number of elements given.
+        got: usize,
+    },
+    /// A state vector given to `set_state` contains NaN or an infinity.
+    #[error("state vector has non-finite element {value} at index {index}")]
+    NonFiniteState {
+        /// Index of the first non-finite element.
+        index: usize,
+        /// Its value.
+        value: f32,
+    },
+    /// `step` was called before the first `reset`.
+    #[error("step() called before reset(): reset the environment first")]
+    NotReset,
+    /// `VecEnv::reset` got a seed list of the wrong length.
+    #[error("expected one seed entry per env ({expected}), got {got}")]
+    SeedCount {
+        /// Number of envs.
+        expected: usize,
+        /// Number of seeds given.
+        got: usize,
+    },
+    /// The configuration is inconsistent (message says what and why).
+    #[error("invalid env config: {0}")]
+    InvalidConfig(String),
+    /// The physics backend failed (message from the physics crate).
+    #[error("physics error: {0}")]
+    Physics(String),
+    /// The controller failed (message from the control crate).
+    #[error("controller error: {0}")]
+    Controller(String),
+    /// No scripted policy exists for this env / control mode.
+    #[error("no scripted policy for env {env_id:?} with control_mode {control_mode:?}: {reason}")]
+    NoScriptedPolicy {
+        /// The env id.
+        env_id: String,
+        /// The env's control mode.
+        control_mode: String,
+        /// Why not.
+        reason: String,
+    },
+}

@@ -1,0 +1,41 @@
+//! The registry of environment ids.
+
+use crate::backend::EnvBackend;
+use crate::config::EnvConfig;
+use crate::error::EnvError;
+use crate::tasks::dummy::DummyEnv;
+
+/// A registered environment id and how to build its backend.
+struct Registration {
+    id: &'static str,
+    make: fn(&EnvConfig, u32) -> Result<Box<dyn EnvBackend>, EnvError>,
+}
+
+const REGISTRY: &[Registration] = &[Registration {
+    id: "Dummy-v0",
+    make: |cfg, substeps| Ok(Box::new(DummyEnv::new(cfg, substeps)?)),
+}];
+
+/// Registered environment ids.
+///
+/// ```
+/// assert!(ms2_tasks::env_ids().contains(&"Dummy-v0"));
+/// ```
+pub fn env_ids() -> Vec<&'static str> {
+    REGISTRY.iter().map(|r| r.id).collect()
+}
+
+/// Builds the backend of `cfg.env_id` with `substeps` physics steps per env step.
+pub(crate) fn make_backend(
+    cfg: &EnvConfig,
+    substeps: u32,
+) -> Result<Box<dyn EnvBackend>, EnvError> {
+    let reg = REGISTRY
+        .iter()
+        .find(|r| r.id == cfg.env_id)
+        .ok_or_else(|| EnvError::UnknownEnvId {
+            got: cfg.env_id.clone(),
+            valid: env_ids().into_iter().map(str::to_owned).collect(),
+        })?;
+    (reg.make)(cfg, substeps)
+}

@@ -1,0 +1,3 @@
+//! The registered tasks.
+
+pub mod dummy;
