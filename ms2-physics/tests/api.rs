@@ -325,3 +325,21 @@ fn stl_mesh_and_convex_decomposition_load() {
     ));
     assert!(Path::new(&dir.path().join("l.stl")).exists());
 }
+
+#[test]
+fn targets_of_a_subset_of_dofs_leave_the_others_alone() {
+    let (mut world, panda, _) = panda_scene(WorldConfig::default(), None);
+    let before = world.drive_targets(panda).unwrap();
+    world
+        .set_drive_targets_of(panda, &[7, 8], &[0.01, 0.02])
+        .unwrap();
+    world
+        .set_drive_velocity_targets_of(panda, &[2], &[0.3])
+        .unwrap();
+    let after = world.drive_targets(panda).unwrap();
+    assert_eq!(&after[..7], &before[..7]);
+    assert_eq!(&after[7..], &[0.01, 0.02]);
+    assert_eq!(world.drive_velocity_targets(panda).unwrap()[2], 0.3);
+    assert!(world.set_drive_targets_of(panda, &[9], &[0.0]).is_err());
+    assert!(world.set_drive_targets_of(panda, &[0, 1], &[0.0]).is_err());
+}
