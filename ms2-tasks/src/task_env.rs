@@ -7,6 +7,7 @@ use std::sync::Mutex;
 use ms2_control::{ControlMode, ControlTiming, RobotConfig};
 use ms2_physics::{World, WorldConfig};
 
+use crate::adapters::RenderContext;
 use crate::agent::{physics_err, PandaAgent};
 use crate::backend::EnvBackend;
 use crate::config::EnvConfig;
@@ -15,10 +16,9 @@ use crate::geometry::vectorize_pose;
 use crate::info::Evaluation;
 use crate::obs::{DictBuilder, ObsValue};
 use crate::seeding::{episode_rng, EpisodeRng};
-use crate::spaces::BoxSpace;
 use crate::sensors::{CameraConfig, CameraFrame, Sensors};
+use crate::spaces::BoxSpace;
 use crate::task::{Task, TaskScene};
-use crate::adapters::RenderContext;
 
 /// Seed of the scene built when an env is made.
 const BUILD_SEED: u64 = 2022;

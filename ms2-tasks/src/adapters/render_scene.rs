@@ -131,8 +131,13 @@ impl RenderContext {
 
     /// Meshes drawing `shape`: `(mesh, scale, pose_shape_from_mesh)` per part. Triangle meshes
     /// and convex hulls are uploaded per call (they are not shared); primitives are cached.
-    fn meshes_for(&self, shape: &ShapeDesc) -> Result<Vec<(MeshHandle, Vector3<f32>, Pose3)>, EnvError> {
-        let one = |key, scale| -> Result<_, EnvError> { Ok(vec![(self.mesh(key)?, scale, Pose3::identity())]) };
+    fn meshes_for(
+        &self,
+        shape: &ShapeDesc,
+    ) -> Result<Vec<(MeshHandle, Vector3<f32>, Pose3)>, EnvError> {
+        let one = |key, scale| -> Result<_, EnvError> {
+            Ok(vec![(self.mesh(key)?, scale, Pose3::identity())])
+        };
         match shape {
             ShapeDesc::Box { half_extents } => one(MeshKey::UnitBox, *half_extents),
             ShapeDesc::Sphere { radius } => one(MeshKey::UnitSphere, Vector3::repeat(*radius)),
@@ -180,9 +185,18 @@ impl RenderContext {
 fn flat_shaded_mesh(vertices: &[nalgebra::Point3<f32>], indices: &[[u32; 3]]) -> MeshData {
     let mut mesh = MeshData::default();
     for tri in indices {
-        let [a, b, c] = tri.map(|i| vertices.get(i as usize).copied().unwrap_or_else(nalgebra::Point3::origin));
+        let [a, b, c] = tri.map(|i| {
+            vertices
+                .get(i as usize)
+                .copied()
+                .unwrap_or_else(nalgebra::Point3::origin)
+        });
         let n = (b - a).cross(&(c - a));
-        let n = if n.norm() > 0.0 { n.normalize() } else { Vector3::z() };
+        let n = if n.norm() > 0.0 {
+            n.normalize()
+        } else {
+            Vector3::z()
+        };
         for p in [a, b, c] {
             mesh.indices.push(mesh.positions.len() as u32);
             mesh.positions.push([p.x, p.y, p.z]);
@@ -373,7 +387,9 @@ impl WorldRenderScene {
     ) -> Result<(), EnvError> {
         for b in &self.bindings {
             if matches!(b.source, PoseSource::Link(a, _) if a == art) {
-                self.scene.set_visible(b.instance, visible).map_err(render_err)?;
+                self.scene
+                    .set_visible(b.instance, visible)
+                    .map_err(render_err)?;
             }
         }
         Ok(())

@@ -149,7 +149,10 @@ impl CameraConfig {
         if !(self.fov_y.is_finite() && self.fov_y > 0.0 && self.fov_y < std::f32::consts::PI) {
             return bad(format!("fov_y must be in (0, π) rad, got {}", self.fov_y));
         }
-        if !(self.near.is_finite() && self.far.is_finite() && self.near > 0.0 && self.far > self.near)
+        if !(self.near.is_finite()
+            && self.far.is_finite()
+            && self.near > 0.0
+            && self.far > self.near)
         {
             return bad(format!(
                 "need 0 < near < far (m), got near {} and far {}",
@@ -209,7 +212,10 @@ mod tests {
         let forward = pose.rotation * Vector3::x();
         let expected = Vector3::new(-0.4, 0.0, -0.5).normalize();
         assert!((forward - expected).norm() < 1e-5, "{forward:?}");
-        assert!((pose.rotation * Vector3::z()).z > 0.0, "camera up points up");
+        assert!(
+            (pose.rotation * Vector3::z()).z > 0.0,
+            "camera up points up"
+        );
     }
 
     #[test]
@@ -218,7 +224,10 @@ mod tests {
         assert!(cam.validate().is_ok());
         cam.fov_y = f32::NAN;
         let err = cam.validate().unwrap_err().to_string();
-        assert!(err.contains("base_camera") && err.contains("fov_y"), "{err}");
+        assert!(
+            err.contains("base_camera") && err.contains("fov_y"),
+            "{err}"
+        );
         let mut cam = CameraConfig::hand_camera();
         cam.far = 0.001;
         assert!(cam.validate().is_err());

@@ -130,9 +130,14 @@ impl Sensors {
         if let Some(goal) = goal_world {
             let scene = self.scene.scene_mut();
             scene
-                .set_pose(self.goal_marker, Isometry3::translation(goal.x, goal.y, goal.z))
+                .set_pose(
+                    self.goal_marker,
+                    Isometry3::translation(goal.x, goal.y, goal.z),
+                )
                 .map_err(render_err)?;
-            scene.set_visible(self.goal_marker, true).map_err(render_err)?;
+            scene
+                .set_visible(self.goal_marker, true)
+                .map_err(render_err)?;
         }
         let result = self
             .ctx

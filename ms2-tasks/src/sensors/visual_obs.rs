@@ -44,10 +44,10 @@ fn array(shape: Vec<usize>, data: ArrayData) -> ObsValue {
     ObsValue::Array(Array { shape, data })
 }
 
-fn matrix_rows<const R: usize, const C: usize>(
-    m: &nalgebra::SMatrix<f32, R, C>,
-) -> ObsValue {
-    let data = (0..R).flat_map(|r| (0..C).map(move |c| m[(r, c)])).collect();
+fn matrix_rows<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f32, R, C>) -> ObsValue {
+    let data = (0..R)
+        .flat_map(|r| (0..C).map(move |c| m[(r, c)]))
+        .collect();
     array(vec![R, C], ArrayData::F32(data))
 }
 
@@ -110,7 +110,10 @@ pub fn assemble(
                 ];
                 if robot_seg {
                     let mask = out.segmentation_link.iter().map(is_robot).collect();
-                    image.push(("robot_seg".to_owned(), array(vec![h, w, 1], ArrayData::Bool(mask))));
+                    image.push((
+                        "robot_seg".to_owned(),
+                        array(vec![h, w, 1], ArrayData::Bool(mask)),
+                    ));
                 }
                 images.push((uid.clone(), ObsValue::Dict(image)));
             }
@@ -131,11 +134,17 @@ pub fn assemble(
             let mut cloud = vec![
                 ("xyzw".to_owned(), array(vec![n, 4], ArrayData::F32(xyzw))),
                 ("rgb".to_owned(), array(vec![n, 3], ArrayData::U8(rgb))),
-                ("Segmentation".to_owned(), array(vec![n, 4], ArrayData::U32(seg))),
+                (
+                    "Segmentation".to_owned(),
+                    array(vec![n, 4], ArrayData::U32(seg)),
+                ),
             ];
             if robot_seg {
                 let mask = fused.segmentation_link.iter().map(is_robot).collect();
-                cloud.push(("robot_seg".to_owned(), array(vec![n, 1], ArrayData::Bool(mask))));
+                cloud.push((
+                    "robot_seg".to_owned(),
+                    array(vec![n, 1], ArrayData::Bool(mask)),
+                ));
             }
             root.push(("pointcloud".to_owned(), ObsValue::Dict(cloud)));
         }
@@ -151,7 +160,10 @@ mod tests {
     #[test]
     fn extra_keeps_only_non_privileged_keys() {
         let state = ObsValue::Dict(vec![
-            ("agent".into(), DictBuilder::new().vector("qpos", &[0.0]).build()),
+            (
+                "agent".into(),
+                DictBuilder::new().vector("qpos", &[0.0]).build(),
+            ),
             (
                 "extra".into(),
                 DictBuilder::new()
