@@ -1,0 +1,110 @@
+//! Soft-body tasks: the ms2-physics ↔ ms2-mpm adapter, checked by simulating it.
+
+use glam::Vec3;
+use ms2_mpm::{sampling, Coupling, CouplingParams, GridSpec, Material, MpmSolver, SolverConfig};
+use ms2_physics::{ActorDesc, ActorKind, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig};
+use ms2_tasks::adapters::mpm_rigid::{CoupledBodies, MpmAdapterError, MpmRigidWorld};
+use nalgebra::Vector3;
+
+/// Particle spacing (m): two per 1 cm cell and axis.
+const SPACING: f32 = 0.005;
+/// Soft substeps per 500 Hz rigid step (MPM at 2000 Hz, as ManiSkill2).
+const SUBSTEPS: usize = 4;
+
+fn clay_bed(top: f32) -> MpmSolver {
+    let grid = GridSpec::new(Vec3::ZERO, 0.01, [32; 3]);
+    let mut s = MpmSolver::new(SolverConfig::new(grid)).unwrap();
+    let clay = s
+        .add_material(Material::clay(1000.0, 1e4, 0.3, 2e3))
+        .unwrap();
+    let (lo, _) = s.usable_domain();
+    let pts = sampling::sample_box(
+        Vec3::new(0.08, 0.08, lo.z),
+        Vec3::new(0.24, 0.24, top),
+        SPACING,
+    );
+    s.add_particles(&pts, clay, SPACING.powi(3), Vec3::ZERO)
+        .unwrap();
+    s
+}
+
+#[test]
+fn rigid_box_resting_on_clay_is_held_up_by_it() {
+    let bed_top = 0.06;
+    let mut solver = clay_bed(bed_top);
+    for _ in 0..200 {
+        solver.substep().unwrap();
+    }
+    let mut world = World::new(WorldConfig::default()).unwrap();
+    let half = Vector3::new(0.025, 0.025, 0.015);
+    let start_z = bed_top + half.z + 0.004;
+    let block = world
+        .add_actor(
+            ActorDesc::new("block", ActorKind::Dynamic)
+                .with_pose(Pose3::translation(0.16, 0.16, start_z))
+                .with_shape(ShapeSpec::new(ShapeDesc::Box { half_extents: half })),
+        )
+        .unwrap();
+    let bodies = CoupledBodies::new(&world, vec![block]).unwrap();
+    let weight = world.body_mass(block).unwrap() * 9.81;
+    let mut coupling = Coupling::new(
+        &MpmRigidWorld::new(&mut world, &bodies),
+        CouplingParams::for_substep(solver.config().substep_dt),
+    )
+    .unwrap();
+    let mut support = Vec::new();
+    for step in 0..300 {
+        world.step();
+        coupling
+            .advance(
+                &mut solver,
+                &mut MpmRigidWorld::new(&mut world, &bodies),
+                SUBSTEPS,
+            )
+            .unwrap();
+        if step >= 200 {
+            support.push(coupling.last_wrenches()[0].force.z);
+        }
+    }
+    // Without the clay the block would fall to the ground (z = half.z); it rests on the bed.
+    let z = world.body_pose(block).unwrap().translation.vector.z;
+    let bottom = z - half.z;
+    assert!(
+        (0.045..0.07).contains(&bottom),
+        "block bottom at {bottom} m (bed top {bed_top} m)"
+    );
+    let v = world.body_linear_velocity(block).unwrap().norm();
+    assert!(v < 0.02, "block still moving at {v} m/s");
+    let mean = support.iter().sum::<f32>() / support.len() as f32;
+    assert!(
+        (mean - weight).abs() < 0.1 * weight,
+        "clay pushes with {mean} N, block weighs {weight} N"
+    );
+}
+
+#[test]
+fn unsupported_shapes_are_refused_by_name() {
+    let mut world = World::new(WorldConfig::default()).unwrap();
+    let hull = world
+        .add_actor(
+            ActorDesc::new("hull", ActorKind::Dynamic).with_shape(ShapeSpec::new(
+                ShapeDesc::ConvexHull {
+                    points: vec![
+                        [0.0, 0.0, 0.0].into(),
+                        [0.1, 0.0, 0.0].into(),
+                        [0.0, 0.1, 0.0].into(),
+                        [0.0, 0.0, 0.1].into(),
+                    ],
+                },
+            )),
+        )
+        .unwrap();
+    let err = CoupledBodies::new(&world, vec![hull]).unwrap_err();
+    assert!(matches!(
+        err,
+        MpmAdapterError::UnsupportedShape {
+            kind: "convex hull",
+            ..
+        }
+    ));
+}
