@@ -192,6 +192,13 @@ impl World {
         file: &str,
     ) -> Result<ArticulationId> {
         let tree = validate_tree(desc, file)?;
+        if !crate::math::pose_is_finite(&options.root_pose) {
+            return Err(PhysicsError::InvalidParameter {
+                name: "root_pose",
+                value: format!("{:?}", options.root_pose),
+                expected: "a finite pose",
+            });
+        }
         options.default_material.validate()?;
         for (name, m) in &options.link_materials {
             m.validate()?;

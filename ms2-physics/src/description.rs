@@ -215,6 +215,29 @@ pub(crate) fn validate_tree(desc: &ArticulationDesc, file: &str) -> Result<Tree>
                     format!("mass {}: expected a finite mass >= 0 kg", i.mass),
                 ));
             }
+            let eigen = i.inertia.cast::<f64>().symmetric_eigen().eigenvalues;
+            let scale = i.inertia.abs().max() as f64;
+            if !i.inertia.iter().all(|v| v.is_finite())
+                || (i.inertia - i.inertia.transpose()).abs().max()
+                    > 1e-6 * (scale as f32).max(1e-12)
+                || eigen.iter().any(|&e| e < -1e-9 * scale.max(1e-12))
+            {
+                return Err(invalid(
+                    file,
+                    format!("<link name=\"{}\"> <inertia>", l.name),
+                    format!(
+                        "inertia {:?}: expected a finite, symmetric, positive semi-definite tensor in kg m^2",
+                        i.inertia.as_slice()
+                    ),
+                ));
+            }
+            if !crate::math::pose_is_finite(&i.pose_link_from_inertial) {
+                return Err(invalid(
+                    file,
+                    format!("<link name=\"{}\"> <inertial> <origin>", l.name),
+                    "expected a finite pose".into(),
+                ));
+            }
         }
     }
     let roots: Vec<usize> = (0..desc.links.len())
