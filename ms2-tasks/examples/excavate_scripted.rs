@@ -22,26 +22,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for step in 0..steps {
             scene.step(plan.command(step))?;
             env_steps += 1;
-            if std::env::var("EXCAVATE_DEBUG").is_ok() {
-                let e = scene.evaluate();
-                let c = scene.bucket_command();
-                let near = scene
-                    .particle_positions()
-                    .iter()
-                    .filter(|p| {
-                        (p.x - c.position.x).abs() < 0.05
-                            && (p.y - c.position.y).abs() < 0.035
-                            && p.z > c.position.z
-                    })
-                    .count();
-                println!(
-                    "step {step} in {} near {near} spilled {} cmd {:?} floor {}",
-                    e.particles_in_bucket,
-                    e.spilled,
-                    c,
-                    scene.floor_z()
-                );
-            }
             if scene.evaluate().success {
                 success = true;
                 break;
@@ -56,23 +36,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             b,
             scene.particle_positions().len()
         );
-        if std::env::var("EXCAVATE_DEBUG").is_ok() {
-            let high: Vec<_> = scene
-                .particle_positions()
-                .iter()
-                .filter(|p| p.z > 0.1)
-                .take(5)
-                .collect();
-            println!(
-                "pose {:?} high {:?}",
-                scene
-                    .world()
-                    .bodies()
-                    .map(|b| scene.world().body_pose(b).unwrap())
-                    .collect::<Vec<_>>(),
-                high
-            );
-        }
         successes += u32::from(success);
     }
     println!(
