@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# Sets up a fresh machine (scripts/setup.sh) and runs every test: Rust (workspace) and Python.
+# Sets up a fresh machine (scripts/setup.sh) and runs every test: Rust (the workspace, release
+# profile, sharing target/ with the maturin build setup.sh made) and Python (ruff + pytest).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+started=$(date +%s)
 bash scripts/setup.sh
 # shellcheck disable=SC1091
 . .venv/bin/activate
 echo "[test] cargo test (workspace, release profile)"
 cargo test --release --workspace --exclude ms2-py
-if [ -d ms2-py/tests ]; then
-  echo "[test] pytest"
-  python -m pytest -q ms2-py/tests
-fi
+echo "[test] ruff (ms2-py)"
+ruff check ms2-py
+echo "[test] pytest (ms2-py/tests)"
+python -m pytest -q ms2-py/tests
+echo "[test] all tests passed in $(($(date +%s) - started)) s"

@@ -1,1 +1,58 @@
-//! ms2-physics (placeholder: being written).
+//! # ms2-physics: a rigid world over rapier3d
+//!
+//! A [`World`] steps rigid bodies at a fixed time step (500 Hz by default), z up, in metres,
+//! kilograms and seconds:
+//! - **actors** ([`World::add_actor`]): static, dynamic or kinematic bodies with box, sphere,
+//!   capsule, cylinder, convex-hull, compound and (static only) triangle-mesh shapes, each with a
+//!   [`Material`] and a [`MassSpec`];
+//! - **articulations** ([`World::add_articulation`], [`World::load_urdf`]): reduced-coordinate
+//!   multibodies with revolute, prismatic and fixed joints, limits, PD drives
+//!   ([`World::set_drive`], [`World::set_drive_targets`]), gravity compensation and
+//!   self-collision filtering; qpos / qvel / targets read and write, link poses and velocities;
+//! - **contacts** after each step ([`World::contacts`], [`World::contacts_between`]);
+//! - **state** as one flat vector ([`World::get_state`], [`World::set_state`]) that restores a
+//!   run bit for bit.
+//!
+//! The public API uses nalgebra (`f32`); rapier's glam types stay inside.
+//!
+//! ```
+//! use ms2_physics::{ActorDesc, ActorKind, ShapeDesc, ShapeSpec, World, WorldConfig, Pose3};
+//! let mut world = World::new(WorldConfig::default()).unwrap();
+//! let cube = world
+//!     .add_actor(
+//!         ActorDesc::new("cube", ActorKind::Dynamic)
+//!             .with_pose(Pose3::translation(0.0, 0.0, 0.5))
+//!             .with_shape(ShapeSpec::new(ShapeDesc::cuboid(0.04, 0.04, 0.04))),
+//!     )
+//!     .unwrap();
+//! world.step_n(500); // one second
+//! let z = world.body_pose(cube).unwrap().translation.z;
+//! assert!((z - 0.02).abs() < 2e-3, "the cube rests on the ground: z = {z}");
+//! ```
+
+pub mod articulation;
+pub mod config;
+pub mod contact;
+pub mod error;
+mod joints;
+pub mod math;
+pub mod mesh;
+pub mod panda;
+pub mod shape;
+pub mod state;
+pub mod urdf;
+pub mod world;
+
+pub use articulation::{
+    ArticulationDesc, ArticulationId, ArticulationOptions, DriveParams, Inertial, JointDesc,
+    JointInfo, JointType, LinkDesc, Mimic, SelfCollision,
+};
+pub use config::{GroundConfig, SolverConfig, WorldConfig};
+pub use contact::{ContactPoint, ContactReport};
+pub use error::{PhysicsError, Result, UrdfError};
+pub use math::Pose3;
+pub use mesh::MeshCollision;
+pub use panda::{add_panda, PandaOptions, PANDA_FINGER_FRICTION};
+pub use shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
+pub use urdf::{parse_urdf_file, parse_urdf_str, UrdfLoadOptions};
+pub use world::{ActorDesc, ActorKind, BodyId, BodyKind, World};

@@ -1,0 +1,49 @@
+//! Times the clay benchmark scene (`ms2_mpm::scenes::clay_block`) and prints one line of
+//! `key=value` pairs, the format `bench/compare_taichi.sh` reads.
+//!
+//! Usage: `cargo run --release -p ms2-mpm --example bench_step -- [particles] [threads] [substeps]`
+//! (defaults 32768, all cores, 400).
+
+use std::time::Instant;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let arg = |i: usize, default: usize| -> Result<usize, Box<dyn std::error::Error>> {
+        match args.get(i) {
+            Some(s) => Ok(s
+                .parse()
+                .map_err(|e| format!("argument {} = {s:?}: {e}", i + 1))?),
+            None => Ok(default),
+        }
+    };
+    let all = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let particles = arg(0, 32_768)?;
+    let threads = arg(1, all)?;
+    let substeps = arg(2, 400)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
+    let mut solver = ms2_mpm::scenes::clay_block(particles)?;
+    pool.install(|| -> Result<(), ms2_mpm::MpmError> {
+        for _ in 0..50 {
+            solver.substep()?;
+        }
+        let start = Instant::now();
+        for _ in 0..substeps {
+            solver.substep()?;
+        }
+        let secs = start.elapsed().as_secs_f64();
+        let top = solver
+            .positions()
+            .iter()
+            .map(|p| p.z)
+            .fold(f32::MIN, f32::max);
+        println!(
+            "engine=ms2-mpm particles={particles} threads={threads} substeps={substeps} \
+             seconds={secs:.3} particle_substeps_per_s={:.4e} top_z={top:.4}",
+            (particles * substeps) as f64 / secs
+        );
+        Ok(())
+    })?;
+    Ok(())
+}

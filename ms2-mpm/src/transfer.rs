@@ -1,0 +1,277 @@
+//! The MLS-MPM transfers (APIC, quadratic B-splines), parallel over particle bins.
+//!
+//! Particle-to-grid runs in eight colour phases: bins of one colour are at least one bin apart
+//! along some axis, so their grid neighbourhoods (nodes `4b − 1 .. 4b + 6` per axis) are
+//! disjoint and each bin adds its local accumulation to the grid without atomics. Within a bin
+//! particles are visited in order, and colours in a fixed order, so results are bitwise
+//! independent of the thread count.
+
+use glam::{Mat3, Vec3};
+use rayon::prelude::*;
+
+use crate::grid::{GridSpec, GridStorage, BLOCK};
+use crate::material::CompiledMaterial;
+use crate::math::{quadratic_weights, svd3_x4, Svd3};
+use crate::parallel::SyncPtr;
+use crate::particles::{Binning, Particles};
+
+/// Nodes per axis of a bin's grid neighbourhood: the bin's 4 base nodes, one node of slack
+/// below, one above, and the two extra B-spline nodes.
+const LOCAL: usize = BLOCK + 4;
+const LOCAL_NODES: usize = LOCAL * LOCAL * LOCAL;
+
+const IDENTITY_SVD: Svd3 = Svd3 {
+    u: Mat3::IDENTITY,
+    sigma: Vec3::ONE,
+    v: Mat3::IDENTITY,
+};
+
+type LocalGrid = [[f32; 4]; LOCAL_NODES];
+
+#[inline(always)]
+fn local_index(i: usize, j: usize, k: usize) -> usize {
+    (i * LOCAL + j) * LOCAL + k
+}
+
+/// Real node coordinates of the first node of bin `b`'s neighbourhood.
+#[inline(always)]
+fn bin_corner(b: u32, bins: [usize; 3]) -> [i32; 3] {
+    let b = b as usize;
+    let (x, y, z) = (
+        b / (bins[1] * bins[2]),
+        (b / bins[2]) % bins[1],
+        b % bins[2],
+    );
+    [
+        (x * BLOCK) as i32 - 1,
+        (y * BLOCK) as i32 - 1,
+        (z * BLOCK) as i32 - 1,
+    ]
+}
+
+/// Fixed per-step constants of the transfers.
+pub(crate) struct TransferParams<'a> {
+    pub spec: &'a GridSpec,
+    pub dt: f32,
+    pub materials: &'a [CompiledMaterial],
+    /// External force per particle (N), if any.
+    pub forces: Option<&'a [Vec3]>,
+}
+
+/// Particle to grid: updates each particle's deformation gradient (affine update, then the
+/// material's projection) and scatters mass and momentum (including stress and external
+/// force impulses) to the grid.
+pub(crate) fn particle_to_grid(
+    prm: &TransferParams<'_>,
+    p: &mut Particles,
+    binning: &Binning,
+    grid: &mut GridStorage,
+) {
+    let dx = prm.spec.cell_size;
+    let inv_dx = 1.0 / dx;
+    let origin = prm.spec.origin;
+    let dt = prm.dt;
+    let stress_scale = -dt * 4.0 * inv_dx * inv_dx;
+    let bins = grid.bins;
+    let f_ptr = SyncPtr::new(p.f.as_mut_ptr());
+    // Read-only view of F for the trial update; each F is overwritten only after its read.
+    let p_f: &[Mat3] = unsafe { std::slice::from_raw_parts(p.f.as_ptr(), p.f.len()) };
+    let (x, v, c, mass, volume, material) = (&p.x, &p.v, &p.c, &p.mass, &p.volume, &p.material);
+    let grid_ptr = SyncPtr::new(grid.nodes.as_mut_ptr());
+    let grid_ref = &*grid;
+    for color in &binning.colors {
+        color.par_iter().for_each(|&bi| {
+            let (bin, start, end) = binning.bins[bi as usize];
+            let corner = bin_corner(bin, bins);
+            let mut local: LocalGrid = [[0.0; 4]; LOCAL_NODES];
+            // Particles go in groups of four so that their SVDs run in the SIMD lanes.
+            for group in (start as usize..end as usize).step_by(4) {
+                let n = (end as usize - group).min(4);
+                let mut trial = [Mat3::IDENTITY; 4];
+                let mut any_svd = false;
+                for (l, t) in trial.iter_mut().enumerate().take(n) {
+                    let pi = group + l;
+                    *t = (Mat3::IDENTITY + dt * c[pi]) * p_f[pi];
+                    any_svd |= prm.materials[material[pi] as usize].needs_svd();
+                }
+                let svds = if any_svd {
+                    svd3_x4(&trial)
+                } else {
+                    [IDENTITY_SVD; 4]
+                };
+                for l in 0..n {
+                    let pi = group + l;
+                    let mat = &prm.materials[material[pi] as usize];
+                    let (f_new, tau) = mat.project_and_stress_svd(trial[l], &svds[l]);
+                    // SAFETY: bins own disjoint particle ranges and each F is written once,
+                    // after its last read above.
+                    unsafe { *f_ptr.get_mut(pi) = f_new };
+                    let (base, fx, w) = quadratic_weights((x[pi] - origin) * inv_dx);
+                    let m = mass[pi];
+                    let affine = (stress_scale * volume[pi]) * tau + m * c[pi];
+                    let mut mv = m * v[pi];
+                    if let Some(forces) = prm.forces {
+                        mv += dt * forces[pi];
+                    }
+                    // Momentum at node offset (i, j, k): mv + affine·((i, j, k) − fx)·dx.
+                    let a = affine * dx;
+                    let m0 = mv - a * fx;
+                    let o = [
+                        (base[0] - corner[0]) as usize,
+                        (base[1] - corner[1]) as usize,
+                        (base[2] - corner[2]) as usize,
+                    ];
+                    for i in 0..3 {
+                        let mi = m0 + a.x_axis * i as f32;
+                        for j in 0..3 {
+                            let mij = mi + a.y_axis * j as f32;
+                            let wij = w[0][i] * w[1][j];
+                            let row = local_index(o[0] + i, o[1] + j, o[2]);
+                            for k in 0..3 {
+                                let wt = wij * w[2][k];
+                                let mom = (mij + a.z_axis * k as f32) * wt;
+                                let node = &mut local[row + k];
+                                node[0] += mom.x;
+                                node[1] += mom.y;
+                                node[2] += mom.z;
+                                node[3] += wt * m;
+                            }
+                        }
+                    }
+                }
+            }
+            for i in 0..LOCAL {
+                for j in 0..LOCAL {
+                    for k in 0..LOCAL {
+                        let l = local[local_index(i, j, k)];
+                        if l[3] == 0.0 {
+                            continue;
+                        }
+                        let g = grid_ref.index(
+                            corner[0] + i as i32,
+                            corner[1] + j as i32,
+                            corner[2] + k as i32,
+                        );
+                        // SAFETY: same-colour bins have disjoint neighbourhoods (see module
+                        // docs), and phases of different colours do not overlap in time.
+                        let node = unsafe { grid_ptr.get_mut(g) };
+                        for e in 0..4 {
+                            node[e] += l[e];
+                        }
+                    }
+                }
+            }
+        });
+    }
+}
+
+/// Outcome of a grid-to-particle pass.
+pub(crate) struct G2pReport {
+    /// Some particle left its bin's slack: re-sort before the next particle-to-grid.
+    pub needs_sort: bool,
+    /// First particle whose velocity became non-finite, if any.
+    pub diverged: Option<usize>,
+}
+
+/// Grid to particle: gathers velocity and the APIC affine matrix, then advects the particle,
+/// confining it to `[lo, hi]` (m).
+pub(crate) fn grid_to_particle(
+    spec: &GridSpec,
+    dt: f32,
+    lo: Vec3,
+    hi: Vec3,
+    p: &mut Particles,
+    binning: &Binning,
+    grid: &GridStorage,
+) -> G2pReport {
+    let dx = spec.cell_size;
+    let inv_dx = 1.0 / dx;
+    let origin = spec.origin;
+    let bins = grid.bins;
+    let x_ptr = SyncPtr::new(p.x.as_mut_ptr());
+    let v_ptr = SyncPtr::new(p.v.as_mut_ptr());
+    let c_ptr = SyncPtr::new(p.c.as_mut_ptr());
+    let (needs_sort, diverged) = binning
+        .bins
+        .par_iter()
+        .map(|&(bin, start, end)| {
+            let corner = bin_corner(bin, bins);
+            let mut local: LocalGrid = [[0.0; 4]; LOCAL_NODES];
+            for i in 0..LOCAL {
+                for j in 0..LOCAL {
+                    for k in 0..LOCAL {
+                        local[local_index(i, j, k)] = grid.nodes[grid.index(
+                            corner[0] + i as i32,
+                            corner[1] + j as i32,
+                            corner[2] + k as i32,
+                        )];
+                    }
+                }
+            }
+            let (start, len) = (start as usize, (end - start) as usize);
+            // SAFETY: bins own disjoint particle ranges.
+            let (xs, vs, cs) = unsafe {
+                (
+                    x_ptr.slice_mut(start, len),
+                    v_ptr.slice_mut(start, len),
+                    c_ptr.slice_mut(start, len),
+                )
+            };
+            let mut out_of_bin = false;
+            let mut diverged = None;
+            for q in 0..len {
+                let (base, fx, w) = quadratic_weights((xs[q] - origin) * inv_dx);
+                let o = [
+                    (base[0] - corner[0]) as usize,
+                    (base[1] - corner[1]) as usize,
+                    (base[2] - corner[2]) as usize,
+                ];
+                let mut vel = Vec3::ZERO;
+                // Σ w·v·(i, j, k)ᵀ, as three columns.
+                let mut b = [Vec3::ZERO; 3];
+                for i in 0..3 {
+                    for j in 0..3 {
+                        let wij = w[0][i] * w[1][j];
+                        let row = local_index(o[0] + i, o[1] + j, o[2]);
+                        for k in 0..3 {
+                            let wt = wij * w[2][k];
+                            let n = local[row + k];
+                            let gv = Vec3::new(n[0], n[1], n[2]) * wt;
+                            vel += gv;
+                            b[0] += gv * i as f32;
+                            b[1] += gv * j as f32;
+                            b[2] += gv * k as f32;
+                        }
+                    }
+                }
+                // C = 4/dx² Σ w v (x_i − x_p)ᵀ with x_i − x_p = ((i, j, k) − fx)·dx.
+                let s = 4.0 * inv_dx;
+                cs[q] = Mat3::from_cols(
+                    (b[0] - vel * fx.x) * s,
+                    (b[1] - vel * fx.y) * s,
+                    (b[2] - vel * fx.z) * s,
+                );
+                vs[q] = vel;
+                if !vel.is_finite() && diverged.is_none() {
+                    diverged = Some(start + q);
+                }
+                let xn = (xs[q] + dt * vel).clamp(lo, hi);
+                xs[q] = xn;
+                let nb = crate::particles::base_node(xn, origin, inv_dx);
+                for a in 0..3 {
+                    let rel = nb[a] - corner[a];
+                    // Allowed bases: corner .. corner + BLOCK + 1 (one node of slack each side).
+                    out_of_bin |= !(0..=(BLOCK as i32 + 1)).contains(&rel);
+                }
+            }
+            (out_of_bin, diverged)
+        })
+        .reduce(
+            || (false, None),
+            |a, b| (a.0 | b.0, if a.1.is_some() { a.1 } else { b.1 }),
+        );
+    G2pReport {
+        needs_sort,
+        diverged,
+    }
+}

@@ -1,0 +1,177 @@
+//! Two-way coupling with the in-crate rigid backend, checked by simulating it.
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use ms2_mpm::rigid::{Motion, SimpleRigidWorld};
+use ms2_mpm::{sampling, Boundary, Coupling, CouplingParams, Material, MpmSolver};
+
+/// ManiSkill2's rates: rigid 500 Hz, MPM 2000 Hz.
+const SUBSTEPS: usize = 4;
+
+fn clay_bed(s: &mut MpmSolver, top: f32) {
+    let clay = s
+        .add_material(Material::clay(1000.0, 1e4, 0.3, 2e3))
+        .unwrap();
+    let (lo, hi) = s.usable_domain();
+    let pts = sampling::sample_box(
+        Vec3::new(0.08, 0.08, lo.z),
+        Vec3::new(hi.x.min(0.24), 0.24, top),
+        SPACING,
+    );
+    s.add_particles(&pts, clay, SPACING.powi(3), Vec3::ZERO)
+        .unwrap();
+}
+
+#[test]
+fn box_resting_on_clay_feels_its_weight() {
+    let mut s = solver(Boundary::default());
+    clay_bed(&mut s, 0.06);
+    // Let the bed settle under gravity first.
+    run(&mut s, 200);
+    let mut world = SimpleRigidWorld::new(s.config().gravity);
+    let half = Vec3::new(0.025, 0.025, 0.015);
+    let body = world.add_box(
+        half,
+        600.0,
+        Vec3::new(0.16, 0.16, 0.06 + half.z + 0.004),
+        Motion::Dynamic,
+    );
+    let weight = world.bodies[body].mass * 9.81;
+    let mut coupling =
+        Coupling::new(&world, CouplingParams::for_substep(s.config().substep_dt)).unwrap();
+    let rigid_dt = SUBSTEPS as f32 * s.config().substep_dt;
+    let mut support = Vec::new();
+    for step in 0..300 {
+        world.step(rigid_dt);
+        coupling.advance(&mut s, &mut world, SUBSTEPS).unwrap();
+        if step >= 200 {
+            support.push(coupling.last_wrenches()[body].force.z);
+        }
+    }
+    let mean = support.iter().sum::<f32>() / support.len() as f32;
+    assert!(
+        (mean - weight).abs() < 0.05 * weight,
+        "coupling force {mean} N vs weight {weight} N"
+    );
+    // At rest, resting on (not sunk into or bounced off) the bed.
+    let b = &world.bodies[body];
+    assert!(
+        b.linear_velocity.length() < 0.02,
+        "box still moving: {:?}",
+        b.linear_velocity
+    );
+    let bottom = b.position.z - half.z;
+    assert!((0.045..0.07).contains(&bottom), "box bottom at {bottom} m");
+    // No clay particle inside the box (beyond the contact offset).
+    let inside = s
+        .positions()
+        .iter()
+        .filter(|p| ((**p - b.position).abs() - half).max_element() < -0.003)
+        .count();
+    assert_eq!(inside, 0, "{inside} particles inside the box");
+}
+
+#[test]
+fn plate_pushed_into_clay_deforms_it_and_feels_the_reaction() {
+    let mut s = solver(Boundary::default());
+    clay_bed(&mut s, 0.07);
+    run(&mut s, 100);
+    let mut world = SimpleRigidWorld::new(s.config().gravity);
+    let half = Vec3::new(0.03, 0.03, 0.005);
+    let start_z = 0.07 + half.z + 0.002;
+    let plate = world.add_box(
+        half,
+        1000.0,
+        Vec3::new(0.16, 0.16, start_z),
+        Motion::Kinematic,
+    );
+    world.bodies[plate].linear_velocity = Vec3::new(0.0, 0.0, -0.2);
+    let mut coupling =
+        Coupling::new(&world, CouplingParams::for_substep(s.config().substep_dt)).unwrap();
+    let rigid_dt = SUBSTEPS as f32 * s.config().substep_dt;
+    let under_plate = |s: &MpmSolver, centre: Vec3| {
+        s.positions()
+            .iter()
+            .filter(|p| {
+                (p.x - centre.x).abs() < half.x - 0.005 && (p.y - centre.y).abs() < half.y - 0.005
+            })
+            .map(|p| p.z)
+            .fold(f32::MIN, f32::max)
+    };
+    let top_before = under_plate(&s, world.bodies[plate].position);
+    let mut early = 0.0;
+    for step in 0..75 {
+        world.step(rigid_dt);
+        coupling.advance(&mut s, &mut world, SUBSTEPS).unwrap();
+        if step == 25 {
+            early = coupling.last_wrenches()[plate].force.z;
+        }
+    }
+    // 75 steps × 2 ms × 0.2 m/s = 3 cm down, i.e. ~2.3 cm into the clay.
+    let p = world.bodies[plate].position;
+    let reaction = coupling.last_wrenches()[plate].force.z;
+    let top_after = under_plate(&s, p);
+    assert!(
+        top_after < top_before - 0.015,
+        "clay top under the plate {top_before} -> {top_after} m"
+    );
+    assert!(
+        top_after < p.z - half.z + 0.004,
+        "clay above the plate's bottom face"
+    );
+    assert!(reaction > 1.0, "plate feels only {reaction} N");
+    assert!(
+        reaction > early,
+        "reaction should grow with depth: {early} -> {reaction} N"
+    );
+    // The clay pushed sideways rises around the plate (plastic flow), conserving volume.
+    let rim = s
+        .positions()
+        .iter()
+        .filter(|q| (q.x - p.x).abs() > half.x + 0.005 || (q.y - p.y).abs() > half.y + 0.005)
+        .map(|q| q.z)
+        .fold(f32::MIN, f32::max);
+    assert!(
+        rim > top_before + 0.002,
+        "no bulge around the plate: rim {rim} m"
+    );
+}
+
+#[test]
+fn mesh_collider_pushes_like_the_equivalent_box() {
+    let half = Vec3::new(0.03, 0.03, 0.01);
+    let mut forces = Vec::new();
+    for use_mesh in [false, true] {
+        let mut s = solver(Boundary::default());
+        clay_bed(&mut s, 0.06);
+        let mut world = SimpleRigidWorld::new(s.config().gravity);
+        let plate = world.add_box(
+            half,
+            1000.0,
+            Vec3::new(0.16, 0.16, 0.06 + half.z),
+            Motion::Kinematic,
+        );
+        if use_mesh {
+            world.bodies[plate].shapes = vec![ms2_mpm::CollisionShape::at_body_origin(
+                ms2_mpm::ShapeGeometry::TriMesh(ms2_mpm::TriMesh::cuboid(half)),
+            )];
+        }
+        world.bodies[plate].linear_velocity = Vec3::new(0.0, 0.0, -0.2);
+        let mut coupling =
+            Coupling::new(&world, CouplingParams::for_substep(s.config().substep_dt)).unwrap();
+        for _ in 0..40 {
+            world.step(0.002);
+            coupling.advance(&mut s, &mut world, SUBSTEPS).unwrap();
+        }
+        forces.push(coupling.last_wrenches()[plate].force.z);
+    }
+    assert!(forces[0] > 0.5, "box reaction {} N", forces[0]);
+    assert!(
+        (forces[1] - forces[0]).abs() < 0.2 * forces[0],
+        "box {} N vs mesh {} N",
+        forces[0],
+        forces[1]
+    );
+}

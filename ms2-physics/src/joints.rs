@@ -1,0 +1,431 @@
+//! Reading and writing articulation state: joint positions and velocities, drives, link poses.
+
+use nalgebra::{DVector, Vector3};
+use rapier3d::dynamics::{MotorModel, Multibody};
+
+use crate::articulation::{ArticulationId, DriveParams, JointInfo};
+use crate::error::{check_finite, check_len, PhysicsError, Result};
+use crate::math::{pose_from_na, vec_from_na, Pose3};
+use crate::shape::VisualShape;
+use crate::world::{BodyId, World};
+
+impl World {
+    /// Every articulation id, in creation order.
+    pub fn articulations(&self) -> impl Iterator<Item = ArticulationId> + '_ {
+        (0..self.articulations.len() as u32).map(ArticulationId)
+    }
+
+    /// The articulation's name (the URDF `<robot name>`).
+    pub fn articulation_name(&self, art: ArticulationId) -> Result<&str> {
+        Ok(&self.articulation_ref(art)?.name)
+    }
+
+    /// Number of degrees of freedom (movable joints).
+    pub fn dof(&self, art: ArticulationId) -> Result<usize> {
+        Ok(self.articulation_ref(art)?.dofs.len())
+    }
+
+    /// Names of the movable joints, in dof (qpos) order.
+    pub fn joint_names(&self, art: ArticulationId) -> Result<Vec<&str>> {
+        let a = self.articulation_ref(art)?;
+        Ok(a.dofs
+            .iter()
+            .map(|d| a.joints[d.joint].name.as_str())
+            .collect())
+    }
+
+    /// Facts about the movable joints, in dof order.
+    pub fn joint_infos(&self, art: ArticulationId) -> Result<Vec<&JointInfo>> {
+        let a = self.articulation_ref(art)?;
+        Ok(a.dofs.iter().map(|d| &a.joints[d.joint]).collect())
+    }
+
+    /// Facts about every joint (fixed ones included), in the description's order.
+    pub fn all_joint_infos(&self, art: ArticulationId) -> Result<&[JointInfo]> {
+        Ok(&self.articulation_ref(art)?.joints)
+    }
+
+    /// Position limits `[lower, upper]` of the movable joints, in dof order (rad or m).
+    pub fn joint_limits(&self, art: ArticulationId) -> Result<Vec<[f32; 2]>> {
+        Ok(self.joint_infos(art)?.iter().map(|j| j.limits).collect())
+    }
+
+    /// The dof index of a movable joint.
+    pub fn dof_index(&self, art: ArticulationId, joint: &str) -> Result<usize> {
+        let a = self.articulation_ref(art)?;
+        a.dofs
+            .iter()
+            .position(|d| a.joints[d.joint].name == joint)
+            .ok_or_else(|| PhysicsError::UnknownName {
+                articulation: a.name.clone(),
+                kind: "movable joint",
+                name: joint.into(),
+            })
+    }
+
+    /// Names of the links, in the description's order.
+    pub fn link_names(&self, art: ArticulationId) -> Result<Vec<&str>> {
+        let a = self.articulation_ref(art)?;
+        Ok(a.links.iter().map(|l| l.name.as_str()).collect())
+    }
+
+    /// Index of a link by name.
+    pub fn link_index(&self, art: ArticulationId, link: &str) -> Result<usize> {
+        let a = self.articulation_ref(art)?;
+        a.links
+            .iter()
+            .position(|l| l.name == link)
+            .ok_or_else(|| PhysicsError::UnknownName {
+                articulation: a.name.clone(),
+                kind: "link",
+                name: link.into(),
+            })
+    }
+
+    fn link_checked(
+        &self,
+        art: ArticulationId,
+        link: usize,
+    ) -> Result<&crate::articulation::ArtLink> {
+        let a = self.articulation_ref(art)?;
+        a.links.get(link).ok_or_else(|| PhysicsError::UnknownName {
+            articulation: a.name.clone(),
+            kind: "link",
+            name: format!("#{link}"),
+        })
+    }
+
+    /// Index (in [`World::all_joint_infos`]) of the joint whose child is this link; `None` for
+    /// the root link.
+    pub fn link_parent_joint(&self, art: ArticulationId, link: usize) -> Result<Option<usize>> {
+        Ok(self.link_checked(art, link)?.parent_joint)
+    }
+
+    /// The rigid body carrying a link (links merged by fixed joints share a body).
+    pub fn link_body(&self, art: ArticulationId, link: usize) -> Result<BodyId> {
+        Ok(self.link_checked(art, link)?.body)
+    }
+
+    /// The distinct rigid bodies of the articulation (root first).
+    pub fn articulation_bodies(&self, art: ArticulationId) -> Result<&[BodyId]> {
+        Ok(&self.articulation_ref(art)?.bodies)
+    }
+
+    /// Pose of the link frame in the body frame of [`World::link_body`].
+    pub fn link_pose_in_body(&self, art: ArticulationId, link: usize) -> Result<Pose3> {
+        Ok(self.link_checked(art, link)?.pose_body_from_link)
+    }
+
+    /// Pose of a link frame in the world.
+    pub fn link_pose(&self, art: ArticulationId, link: usize) -> Result<Pose3> {
+        let l = self.link_checked(art, link)?;
+        Ok(self.body_pose(l.body)? * l.pose_body_from_link)
+    }
+
+    /// Poses of every link frame in the world, in link order.
+    pub fn link_poses(&self, art: ArticulationId) -> Result<Vec<Pose3>> {
+        let a = self.articulation_ref(art)?;
+        a.links
+            .iter()
+            .map(|l| Ok(self.body_pose(l.body)? * l.pose_body_from_link))
+            .collect()
+    }
+
+    /// Velocity of a link: (linear velocity of the link frame's origin in m/s, angular velocity
+    /// in rad/s), world frame.
+    pub fn link_velocity(
+        &self,
+        art: ArticulationId,
+        link: usize,
+    ) -> Result<(Vector3<f32>, Vector3<f32>)> {
+        let l = self.link_checked(art, link)?;
+        let origin = self.link_pose(art, link)?.translation.vector;
+        Ok((
+            self.body_point_velocity(l.body, origin.into())?,
+            self.body_angular_velocity(l.body)?,
+        ))
+    }
+
+    /// Visual shapes of a link, in the link frame.
+    pub fn link_visuals(&self, art: ArticulationId, link: usize) -> Result<&[VisualShape]> {
+        Ok(&self.link_checked(art, link)?.visuals)
+    }
+
+    /// Pose of the root link in the world.
+    pub fn root_pose(&self, art: ArticulationId) -> Result<Pose3> {
+        let a = self.articulation_ref(art)?;
+        self.body_pose(a.bodies[0])
+    }
+
+    fn multibody(&self, art: ArticulationId) -> Result<&Multibody> {
+        let a = self.articulation_ref(art)?;
+        Ok(self
+            .sim
+            .multibody_joints
+            .get_multibody(a.multibody)
+            .expect("articulation multibody exists"))
+    }
+
+    /// Joint positions (rad or m), dof order.
+    pub fn qpos(&self, art: ArticulationId) -> Result<Vec<f32>> {
+        let a = self.articulation_ref(art)?;
+        let mb = self.multibody(art)?;
+        Ok(a.dofs
+            .iter()
+            .map(|d| mb.link(d.mb_link).expect("link").joint.coords()[d.axis as usize])
+            .collect())
+    }
+
+    /// Joint velocities (rad/s or m/s), dof order.
+    pub fn qvel(&self, art: ArticulationId) -> Result<Vec<f32>> {
+        let a = self.articulation_ref(art)?;
+        let mb = self.multibody(art)?;
+        let v = mb.generalized_velocity();
+        Ok(a.dofs
+            .iter()
+            .map(|d| v[mb.link(d.mb_link).expect("link").assembly_id()])
+            .collect())
+    }
+
+    /// Sets the joint positions (teleport; velocities are kept). Exact: `qpos()` returns the
+    /// same bits.
+    pub fn set_qpos(&mut self, art: ArticulationId, qpos: &[f32]) -> Result<()> {
+        let a = self.articulation_ref(art)?;
+        check_len(
+            || format!("qpos of \"{}\"", a.name),
+            a.dofs.len(),
+            qpos.len(),
+        )?;
+        check_finite(|| format!("qpos of \"{}\"", a.name), qpos)?;
+        let (dofs, mbi) = (a.dofs.clone(), a.multibody);
+        let mb = self
+            .sim
+            .multibody_joints
+            .get_multibody_mut(mbi)
+            .expect("multibody");
+        for (d, &q) in dofs.iter().zip(qpos) {
+            let joint = &mut mb.link_mut(d.mb_link).expect("link").joint;
+            let current = joint.coords()[d.axis as usize];
+            // x + (-x) = 0 and 0 + q = q exactly: the coordinate ends up with q's bits.
+            joint.apply_displacement(&[-current]);
+            joint.apply_displacement(&[q]);
+        }
+        mb.forward_kinematics(&self.sim.bodies, true);
+        mb.update_rigid_bodies(&mut self.sim.bodies, true);
+        self.sync_link_velocities(art);
+        Ok(())
+    }
+
+    /// Sets the joint velocities (rad/s or m/s, dof order).
+    pub fn set_qvel(&mut self, art: ArticulationId, qvel: &[f32]) -> Result<()> {
+        let a = self.articulation_ref(art)?;
+        check_len(
+            || format!("qvel of \"{}\"", a.name),
+            a.dofs.len(),
+            qvel.len(),
+        )?;
+        check_finite(|| format!("qvel of \"{}\"", a.name), qvel)?;
+        let (dofs, mbi) = (a.dofs.clone(), a.multibody);
+        let mb = self
+            .sim
+            .multibody_joints
+            .get_multibody_mut(mbi)
+            .expect("multibody");
+        for (d, &v) in dofs.iter().zip(qvel) {
+            let i = mb.link(d.mb_link).expect("link").assembly_id();
+            mb.generalized_velocity_mut()[i] = v;
+        }
+        self.sync_link_velocities(art);
+        Ok(())
+    }
+
+    /// Recomputes the link bodies' velocities from the joint velocities (body Jacobians).
+    fn sync_link_velocities(&mut self, art: ArticulationId) {
+        let mbi = self.articulations[art.index()].multibody;
+        let mb = self
+            .sim
+            .multibody_joints
+            .get_multibody(mbi)
+            .expect("multibody");
+        let v = DVector::from_column_slice(mb.generalized_velocity().as_slice());
+        let mut updates = Vec::with_capacity(mb.num_links());
+        for (i, link) in mb.links().enumerate() {
+            let j = mb.body_jacobian(i);
+            if j.ncols() != v.len() {
+                continue;
+            }
+            let vel = j * &v;
+            updates.push((
+                link.rigid_body_handle(),
+                Vector3::new(vel[0], vel[1], vel[2]),
+                Vector3::new(vel[3], vel[4], vel[5]),
+            ));
+        }
+        for (h, lin, ang) in updates {
+            if let Some(rb) = self.sim.bodies.get_mut(h) {
+                if rb.is_dynamic() {
+                    rb.set_linvel(vec_from_na(&lin), false);
+                    rb.set_angvel(vec_from_na(&ang), false);
+                }
+            }
+        }
+    }
+
+    /// Moves the (fixed) root link to a new world pose, carrying the whole articulation.
+    pub fn set_root_pose(&mut self, art: ArticulationId, pose: &Pose3) -> Result<()> {
+        let a = self.articulation_ref(art)?;
+        let (root, mbi) = (a.bodies[0], a.multibody);
+        check_finite(
+            || "root pose".into(),
+            &[
+                pose.translation.x,
+                pose.translation.y,
+                pose.translation.z,
+                pose.rotation.i,
+                pose.rotation.j,
+                pose.rotation.k,
+                pose.rotation.w,
+            ],
+        )?;
+        let h = self.table[root.index()].handle;
+        self.sim.bodies[h].set_position(pose_from_na(pose), true);
+        let mb = self
+            .sim
+            .multibody_joints
+            .get_multibody_mut(mbi)
+            .expect("multibody");
+        mb.forward_kinematics(&self.sim.bodies, true);
+        mb.update_rigid_bodies(&mut self.sim.bodies, true);
+        Ok(())
+    }
+
+    /// Sets the PD drive of one degree of freedom (keeps its targets).
+    pub fn set_drive(&mut self, art: ArticulationId, dof: usize, drive: DriveParams) -> Result<()> {
+        drive.validate()?;
+        let a = self.articulation_ref(art)?;
+        let d = *a.dofs.get(dof).ok_or(PhysicsError::InvalidParameter {
+            name: "dof",
+            value: dof.to_string(),
+            expected: "an index below the articulation's dof count",
+        })?;
+        let mbi = a.multibody;
+        let mb = self
+            .sim
+            .multibody_joints
+            .get_multibody_mut(mbi)
+            .expect("multibody");
+        let data = &mut mb.link_mut(d.mb_link).expect("link").joint.data;
+        let (pos, vel) = data
+            .motor(d.axis)
+            .map(|m| (m.target_pos, m.target_vel))
+            .unwrap_or((0.0, 0.0));
+        data.set_motor(d.axis, pos, vel, drive.stiffness, drive.damping);
+        data.set_motor_max_force(d.axis, drive.force_limit);
+        data.set_motor_model(d.axis, MotorModel::ForceBased);
+        self.generation += 1;
+        Ok(())
+    }
+
+    /// Sets the same PD drive on every degree of freedom.
+    pub fn set_drives(&mut self, art: ArticulationId, drive: DriveParams) -> Result<()> {
+        for i in 0..self.dof(art)? {
+            self.set_drive(art, i, drive)?;
+        }
+        Ok(())
+    }
+
+    /// The PD drive of one degree of freedom (zero gains if never set).
+    pub fn drive(&self, art: ArticulationId, dof: usize) -> Result<DriveParams> {
+        let a = self.articulation_ref(art)?;
+        let d = *a.dofs.get(dof).ok_or(PhysicsError::InvalidParameter {
+            name: "dof",
+            value: dof.to_string(),
+            expected: "an index below the articulation's dof count",
+        })?;
+        let mb = self.multibody(art)?;
+        let data = &mb.link(d.mb_link).expect("link").joint.data;
+        Ok(data
+            .motor(d.axis)
+            .map(|m| DriveParams {
+                stiffness: m.stiffness,
+                damping: m.damping,
+                force_limit: m.max_force,
+            })
+            .unwrap_or(DriveParams {
+                stiffness: 0.0,
+                damping: 0.0,
+                force_limit: f32::MAX,
+            }))
+    }
+
+    fn write_targets(
+        &mut self,
+        art: ArticulationId,
+        values: &[f32],
+        what: &str,
+        velocity: bool,
+    ) -> Result<()> {
+        let a = self.articulation_ref(art)?;
+        check_len(
+            || format!("{what} of \"{}\"", a.name),
+            a.dofs.len(),
+            values.len(),
+        )?;
+        check_finite(|| format!("{what} of \"{}\"", a.name), values)?;
+        let (dofs, mbi) = (a.dofs.clone(), a.multibody);
+        let mb = self
+            .sim
+            .multibody_joints
+            .get_multibody_mut(mbi)
+            .expect("multibody");
+        for (d, &v) in dofs.iter().zip(values) {
+            let data = &mut mb.link_mut(d.mb_link).expect("link").joint.data;
+            let m = data.motor(d.axis).copied().unwrap_or_default();
+            let (pos, vel) = if velocity {
+                (m.target_pos, v)
+            } else {
+                (v, m.target_vel)
+            };
+            data.set_motor(d.axis, pos, vel, m.stiffness, m.damping);
+        }
+        Ok(())
+    }
+
+    /// Sets the drives' position targets (rad or m, dof order).
+    pub fn set_drive_targets(&mut self, art: ArticulationId, qpos_target: &[f32]) -> Result<()> {
+        self.write_targets(art, qpos_target, "drive position targets", false)
+    }
+
+    /// Sets the drives' velocity targets (rad/s or m/s, dof order).
+    pub fn set_drive_velocity_targets(
+        &mut self,
+        art: ArticulationId,
+        qvel_target: &[f32],
+    ) -> Result<()> {
+        self.write_targets(art, qvel_target, "drive velocity targets", true)
+    }
+
+    fn read_targets(&self, art: ArticulationId, velocity: bool) -> Result<Vec<f32>> {
+        let a = self.articulation_ref(art)?;
+        let mb = self.multibody(art)?;
+        Ok(a.dofs
+            .iter()
+            .map(|d| {
+                let data = &mb.link(d.mb_link).expect("link").joint.data;
+                data.motor(d.axis)
+                    .map(|m| if velocity { m.target_vel } else { m.target_pos })
+                    .unwrap_or(0.0)
+            })
+            .collect())
+    }
+
+    /// The drives' position targets (dof order).
+    pub fn drive_targets(&self, art: ArticulationId) -> Result<Vec<f32>> {
+        self.read_targets(art, false)
+    }
+
+    /// The drives' velocity targets (dof order).
+    pub fn drive_velocity_targets(&self, art: ArticulationId) -> Result<Vec<f32>> {
+        self.read_targets(art, true)
+    }
+}

@@ -1,0 +1,115 @@
+//! Mesh files (OBJ, STL, COLLADA/DAE) through `mesh-loader`, and their collision shapes.
+
+use std::path::Path;
+
+use nalgebra::{Point3, Vector3};
+use rapier3d::prelude::SharedShape;
+
+use crate::math::{pose_to_na, vec_from_na, vec_to_na};
+use crate::shape::ShapeDesc;
+
+/// How a mesh becomes a collision shape.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MeshCollision {
+    /// One convex hull of all the mesh's vertices (fast, conservative).
+    #[default]
+    ConvexHull,
+    /// An approximate convex decomposition (V-HACD) into a compound of convex parts.
+    ConvexDecomposition,
+}
+
+/// A triangle mesh read from a file, scaled, in the file's frame (m).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleMesh {
+    /// Vertices (m).
+    pub vertices: Vec<Point3<f32>>,
+    /// Triangles.
+    pub indices: Vec<[u32; 3]>,
+}
+
+/// Reads every mesh of an OBJ / STL / DAE file into one triangle mesh, scaled per axis.
+///
+/// Errors are plain strings; the URDF loader wraps them with the file, link and element.
+pub fn load_mesh_file(path: &Path, scale: Vector3<f32>) -> Result<TriangleMesh, String> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    if !matches!(ext.as_str(), "obj" | "stl" | "dae") {
+        return Err(format!(
+            "unsupported mesh format \"{ext}\": expected .obj, .stl or .dae"
+        ));
+    }
+    let scene = mesh_loader::Loader::default()
+        .load(path)
+        .map_err(|e| format!("cannot parse mesh: {e}"))?;
+    let mut out = TriangleMesh {
+        vertices: Vec::new(),
+        indices: Vec::new(),
+    };
+    for m in &scene.meshes {
+        let base = out.vertices.len() as u32;
+        out.vertices.extend(
+            m.vertices
+                .iter()
+                .map(|v| Point3::new(v[0] * scale.x, v[1] * scale.y, v[2] * scale.z)),
+        );
+        out.indices.extend(
+            m.faces
+                .iter()
+                .map(|f| [f[0] + base, f[1] + base, f[2] + base]),
+        );
+    }
+    if out.vertices.is_empty() || out.indices.is_empty() {
+        return Err("the file holds no triangles".into());
+    }
+    if let Some(p) = out
+        .vertices
+        .iter()
+        .find(|p| !p.coords.iter().all(|v| v.is_finite()))
+    {
+        return Err(format!("vertex {p:?} is not finite"));
+    }
+    Ok(out)
+}
+
+/// Turns a triangle mesh into a convex collision shape description.
+pub fn mesh_collision_shape(mesh: &TriangleMesh, mode: MeshCollision) -> Result<ShapeDesc, String> {
+    match mode {
+        MeshCollision::ConvexHull => Ok(ShapeDesc::ConvexHull {
+            points: mesh.vertices.clone(),
+        }),
+        MeshCollision::ConvexDecomposition => {
+            let verts: Vec<_> = mesh
+                .vertices
+                .iter()
+                .map(|p| vec_from_na(&p.coords))
+                .collect();
+            let shape = SharedShape::convex_decomposition(&verts, &mesh.indices);
+            let compound = shape
+                .as_compound()
+                .ok_or_else(|| "convex decomposition did not produce a compound".to_string())?;
+            let mut parts = Vec::new();
+            for (pose, part) in compound.shapes() {
+                let poly = part
+                    .as_convex_polyhedron()
+                    .ok_or_else(|| "convex decomposition produced a non-convex part".to_string())?;
+                parts.push((
+                    pose_to_na(pose),
+                    ShapeDesc::ConvexHull {
+                        points: poly
+                            .points()
+                            .iter()
+                            .map(|p| Point3::from(vec_to_na(*p)))
+                            .collect(),
+                    },
+                ));
+            }
+            if parts.is_empty() {
+                return Err("convex decomposition produced no part".into());
+            }
+            Ok(ShapeDesc::Compound { parts })
+        }
+    }
+}

@@ -1,0 +1,75 @@
+//! The Franka Panda of `ms2-assets`, set up as ManiSkill2 sets it up.
+
+use crate::articulation::{ArticulationId, ArticulationOptions, DriveParams, SelfCollision};
+use crate::error::Result;
+use crate::math::Pose3;
+use crate::shape::Material;
+use crate::urdf::{parse_urdf_str, UrdfLoadOptions};
+use crate::world::World;
+
+/// Friction coefficient of the finger pads (ManiSkill2 uses 2.0 so grasps hold).
+pub const PANDA_FINGER_FRICTION: f32 = 2.0;
+
+/// How to add a Panda to a world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PandaOptions {
+    /// Pose of `panda_link0` in the world (ManiSkill2's tabletop tasks: (-0.615, 0, 0)).
+    pub base_pose: Pose3,
+    /// Initial joint positions, also used as initial drive targets (7 arm joints in rad, then
+    /// 2 fingers in m).
+    pub qpos: [f32; 9],
+    /// Drive of the 7 arm joints.
+    pub arm_drive: DriveParams,
+    /// Drive of the 2 finger joints.
+    pub gripper_drive: DriveParams,
+    /// Material of the two fingers.
+    pub finger_material: Material,
+    /// Material of the other links.
+    pub link_material: Material,
+}
+
+impl Default for PandaOptions {
+    fn default() -> Self {
+        PandaOptions {
+            base_pose: Pose3::translation(-0.615, 0.0, 0.0),
+            qpos: ms2_assets::PANDA_REST_QPOS.map(|q| q as f32),
+            arm_drive: DriveParams::MANISKILL2_ARM,
+            gripper_drive: DriveParams::MANISKILL2_ARM,
+            finger_material: Material::new(PANDA_FINGER_FRICTION, 0.0),
+            link_material: Material::default(),
+        }
+    }
+}
+
+/// Adds the Panda (9 degrees of freedom: `panda_joint1..7`, `panda_finger_joint1/2`) with
+/// gravity-compensated links, PD drives and finger friction; drive targets start at `qpos`.
+pub fn add_panda(world: &mut World, options: &PandaOptions) -> Result<ArticulationId> {
+    let desc = parse_urdf_str(
+        ms2_assets::PANDA_URDF,
+        std::path::Path::new("."),
+        "ms2-assets/robots/panda/panda.urdf",
+        &UrdfLoadOptions::default(),
+    )?;
+    let art_options = ArticulationOptions {
+        root_pose: options.base_pose,
+        gravity_compensation: true,
+        self_collision: SelfCollision::NonAdjacent,
+        default_material: options.link_material,
+        link_materials: vec![
+            ("panda_leftfinger".into(), options.finger_material),
+            ("panda_rightfinger".into(), options.finger_material),
+        ],
+        initial_qpos: Some(options.qpos.to_vec()),
+    };
+    let art =
+        world.add_articulation_from(&desc, &art_options, "ms2-assets/robots/panda/panda.urdf")?;
+    for i in 0..7 {
+        world.set_drive(art, i, options.arm_drive)?;
+    }
+    for i in 7..9 {
+        world.set_drive(art, i, options.gripper_drive)?;
+    }
+    world.set_drive_targets(art, &options.qpos)?;
+    world.set_drive_velocity_targets(art, &[0.0; 9])?;
+    Ok(art)
+}

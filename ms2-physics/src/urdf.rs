@@ -1,0 +1,338 @@
+//! URDF loading (through `urdf-rs`) into an [`ArticulationDesc`].
+//!
+//! Errors name the file, the element and the reason ([`UrdfError`]). Before `urdf-rs` reads the
+//! text, a light XML pass (roxmltree) reports malformed XML with its position and joint types
+//! that are unknown or unsupported, so each of these gets its own error.
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::articulation::{
+    ArticulationDesc, ArticulationId, ArticulationOptions, Inertial, JointDesc, JointType,
+    LinkDesc, Mimic,
+};
+use crate::error::{Result, UrdfError};
+use crate::math::{pose_f64_to_f32, pose_from_xyz_rpy};
+use crate::mesh::{load_mesh_file, mesh_collision_shape, MeshCollision};
+use crate::shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
+use crate::world::World;
+
+/// Options of URDF parsing.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct UrdfLoadOptions {
+    /// How mesh collision geometry becomes convex shapes.
+    pub mesh_collision: MeshCollision,
+}
+
+/// Default colour of visuals without a material (linear RGBA).
+pub const DEFAULT_VISUAL_RGBA: [f32; 4] = [0.7, 0.7, 0.7, 1.0];
+
+/// Reads a URDF file; mesh paths are resolved relative to the file's folder.
+pub fn parse_urdf_file(
+    path: &Path,
+    options: &UrdfLoadOptions,
+) -> std::result::Result<ArticulationDesc, UrdfError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| UrdfError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    parse_urdf_str(&text, &base, &file, options)
+}
+
+/// Parses URDF text. `base_dir` resolves relative mesh paths; `file` names the source in errors.
+pub fn parse_urdf_str(
+    text: &str,
+    base_dir: &Path,
+    file: &str,
+    options: &UrdfLoadOptions,
+) -> std::result::Result<ArticulationDesc, UrdfError> {
+    precheck(text, file)?;
+    let robot = urdf_rs::read_from_string(text).map_err(|e| UrdfError::Malformed {
+        file: file.into(),
+        reason: e.to_string(),
+    })?;
+    let mut links = Vec::with_capacity(robot.links.len());
+    for l in &robot.links {
+        let inertial = {
+            let i = &l.inertial;
+            let m = i.mass.value as f32;
+            let inertia = Matrix3::new(
+                i.inertia.ixx,
+                i.inertia.ixy,
+                i.inertia.ixz,
+                i.inertia.ixy,
+                i.inertia.iyy,
+                i.inertia.iyz,
+                i.inertia.ixz,
+                i.inertia.iyz,
+                i.inertia.izz,
+            )
+            .cast::<f32>();
+            if m == 0.0 && inertia.iter().all(|v| *v == 0.0) {
+                None
+            } else {
+                Some(Inertial {
+                    mass: m,
+                    pose_link_from_inertial: pose_f64_to_f32(&pose_from_xyz_rpy(
+                        i.origin.xyz.0,
+                        i.origin.rpy.0,
+                    )),
+                    inertia,
+                })
+            }
+        };
+        let mut collisions = Vec::new();
+        for c in &l.collision {
+            let shape = geometry(
+                &c.geometry,
+                base_dir,
+                file,
+                &l.name,
+                "collision",
+                Some(options.mesh_collision),
+            )?;
+            collisions.push(ShapeSpec {
+                shape,
+                pose_body_from_shape: pose_f64_to_f32(&pose_from_xyz_rpy(
+                    c.origin.xyz.0,
+                    c.origin.rpy.0,
+                )),
+                material: Material::default(),
+                mass: MassSpec::Massless,
+            });
+        }
+        let mut visuals = Vec::new();
+        for v in &l.visual {
+            let shape = geometry(&v.geometry, base_dir, file, &l.name, "visual", None)?;
+            let rgba = v
+                .material
+                .as_ref()
+                .and_then(|m| {
+                    m.color.as_ref().map(|c| c.rgba.0).or_else(|| {
+                        robot
+                            .materials
+                            .iter()
+                            .find(|g| g.name == m.name)
+                            .and_then(|g| g.color.as_ref().map(|c| c.rgba.0))
+                    })
+                })
+                .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32])
+                .unwrap_or(DEFAULT_VISUAL_RGBA);
+            visuals.push(VisualShape {
+                shape,
+                pose_body_from_shape: pose_f64_to_f32(&pose_from_xyz_rpy(
+                    v.origin.xyz.0,
+                    v.origin.rpy.0,
+                )),
+                rgba,
+            });
+        }
+        links.push(LinkDesc {
+            name: l.name.clone(),
+            inertial,
+            collisions,
+            visuals,
+        });
+    }
+    let mut joints = Vec::with_capacity(robot.joints.len());
+    for j in &robot.joints {
+        let joint_type = match j.joint_type {
+            urdf_rs::JointType::Revolute => JointType::Revolute,
+            urdf_rs::JointType::Continuous => JointType::Continuous,
+            urdf_rs::JointType::Prismatic => JointType::Prismatic,
+            urdf_rs::JointType::Fixed => JointType::Fixed,
+            ref other => {
+                return Err(UrdfError::UnsupportedJointType {
+                    file: file.into(),
+                    joint: j.name.clone(),
+                    joint_type: format!("{other:?}").to_lowercase(),
+                })
+            }
+        };
+        let limits = match joint_type {
+            JointType::Revolute | JointType::Prismatic => {
+                Some([j.limit.lower as f32, j.limit.upper as f32])
+            }
+            _ => None,
+        };
+        joints.push(JointDesc {
+            name: j.name.clone(),
+            joint_type,
+            parent: j.parent.link.clone(),
+            child: j.child.link.clone(),
+            pose_parent_from_joint: pose_f64_to_f32(&pose_from_xyz_rpy(
+                j.origin.xyz.0,
+                j.origin.rpy.0,
+            )),
+            axis: Vector3::from(j.axis.xyz.0).cast::<f32>(),
+            limits,
+            effort_limit: j.limit.effort as f32,
+            velocity_limit: j.limit.velocity as f32,
+            damping: j.dynamics.as_ref().map(|d| d.damping as f32).unwrap_or(0.0),
+            friction: j
+                .dynamics
+                .as_ref()
+                .map(|d| d.friction as f32)
+                .unwrap_or(0.0),
+            mimic: j.mimic.as_ref().map(|m| Mimic {
+                joint: m.joint.clone(),
+                multiplier: m.multiplier.unwrap_or(1.0) as f32,
+                offset: m.offset.unwrap_or(0.0) as f32,
+            }),
+        });
+    }
+    Ok(ArticulationDesc {
+        name: robot.name.clone(),
+        links,
+        joints,
+    })
+}
+
+/// Checks XML well-formedness and joint types, with positions, before `urdf-rs` runs.
+fn precheck(text: &str, file: &str) -> std::result::Result<(), UrdfError> {
+    let doc = roxmltree::Document::parse(text).map_err(|e| UrdfError::Malformed {
+        file: file.into(),
+        reason: e.to_string(),
+    })?;
+    let root = doc.root_element();
+    if root.tag_name().name() != "robot" {
+        return Err(UrdfError::Malformed {
+            file: file.into(),
+            reason: format!(
+                "root element is <{}>: expected <robot>",
+                root.tag_name().name()
+            ),
+        });
+    }
+    for joint in root.children().filter(|n| n.has_tag_name("joint")) {
+        let name = joint.attribute("name").unwrap_or("").to_string();
+        let ty = joint.attribute("type").unwrap_or("");
+        match ty {
+            "revolute" | "continuous" | "prismatic" | "fixed" => {}
+            "floating" | "planar" | "spherical" => {
+                return Err(UrdfError::UnsupportedJointType {
+                    file: file.into(),
+                    joint: name,
+                    joint_type: ty.into(),
+                })
+            }
+            _ => {
+                return Err(UrdfError::UnknownJointType {
+                    file: file.into(),
+                    joint: name,
+                    joint_type: ty.into(),
+                })
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Resolves a mesh file name (`package://`, `file://` or relative) against `base_dir`.
+fn resolve_mesh_path(filename: &str, base_dir: &Path) -> PathBuf {
+    let stripped = filename
+        .strip_prefix("file://")
+        .or_else(|| filename.strip_prefix("package://"))
+        .unwrap_or(filename);
+    let p = Path::new(stripped);
+    if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        base_dir.join(p)
+    }
+}
+
+fn geometry(
+    g: &urdf_rs::Geometry,
+    base_dir: &Path,
+    file: &str,
+    link: &str,
+    element: &'static str,
+    mesh_collision: Option<MeshCollision>,
+) -> std::result::Result<ShapeDesc, UrdfError> {
+    let bad = |reason: String| UrdfError::Invalid {
+        file: file.into(),
+        element: format!("<link name=\"{link}\"> <{element}> <geometry>"),
+        reason,
+    };
+    let positive = |what: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(v as f32)
+        } else {
+            Err(bad(format!(
+                "{what} = {v}: expected a positive length in metres"
+            )))
+        }
+    };
+    Ok(match g {
+        urdf_rs::Geometry::Box { size } => ShapeDesc::cuboid(
+            positive("box size x", size.0[0])?,
+            positive("box size y", size.0[1])?,
+            positive("box size z", size.0[2])?,
+        ),
+        urdf_rs::Geometry::Sphere { radius } => ShapeDesc::Sphere {
+            radius: positive("sphere radius", *radius)?,
+        },
+        urdf_rs::Geometry::Cylinder { radius, length } => ShapeDesc::Cylinder {
+            radius: positive("cylinder radius", *radius)?,
+            half_length: positive("cylinder length", *length)? / 2.0,
+        },
+        urdf_rs::Geometry::Capsule { radius, length } => ShapeDesc::Capsule {
+            radius: positive("capsule radius", *radius)?,
+            half_length: positive("capsule length", *length)? / 2.0,
+        },
+        urdf_rs::Geometry::Mesh { filename, scale } => {
+            let path = resolve_mesh_path(filename, base_dir);
+            if !path.is_file() {
+                return Err(UrdfError::MissingMesh {
+                    file: file.into(),
+                    link: link.into(),
+                    element,
+                    mesh: path,
+                });
+            }
+            let s = scale.as_ref().map(|s| s.0).unwrap_or([1.0; 3]);
+            let mesh_err = |reason: String| UrdfError::MeshLoad {
+                file: file.into(),
+                link: link.into(),
+                element,
+                mesh: path.clone(),
+                reason,
+            };
+            let mesh = load_mesh_file(&path, Vector3::from(s).cast::<f32>()).map_err(mesh_err)?;
+            match mesh_collision {
+                Some(mode) => mesh_collision_shape(&mesh, mode).map_err(mesh_err)?,
+                None => ShapeDesc::TriMesh {
+                    vertices: mesh.vertices,
+                    indices: mesh.indices,
+                },
+            }
+        }
+    })
+}
+
+impl World {
+    /// Loads a URDF file and adds it as an articulation (mesh collision as convex hulls).
+    pub fn load_urdf(
+        &mut self,
+        path: &Path,
+        options: &ArticulationOptions,
+    ) -> Result<ArticulationId> {
+        let desc = parse_urdf_file(path, &UrdfLoadOptions::default())?;
+        self.add_articulation_from(&desc, options, &path.display().to_string())
+    }
+
+    /// Loads URDF text (meshes relative to `base_dir`) and adds it as an articulation.
+    pub fn load_urdf_str(
+        &mut self,
+        urdf: &str,
+        base_dir: &Path,
+        options: &ArticulationOptions,
+    ) -> Result<ArticulationId> {
+        let desc = parse_urdf_str(urdf, base_dir, "<string>", &UrdfLoadOptions::default())?;
+        self.add_articulation_from(&desc, options, "<string>")
+    }
+}

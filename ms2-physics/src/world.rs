@@ -1,0 +1,677 @@
+//! The rigid world: rapier's sets, the body table, actors, stepping and body queries.
+
+use std::collections::HashSet;
+use std::sync::Mutex;
+
+use nalgebra::{Point3, Vector3};
+use rapier3d::prelude::{
+    ActiveHooks, BroadPhaseBvh, CCDSolver, ColliderBuilder, ColliderHandle, ColliderSet,
+    ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet, NarrowPhase,
+    PairFilterContext, PhysicsHooks, PhysicsPipeline, RigidBodyBuilder, RigidBodyHandle,
+    RigidBodySet, RigidBodyType, SoftBodySet, SolverFlags, SpringCoefficients,
+};
+
+use crate::articulation::{Articulation, ArticulationId};
+use crate::config::WorldConfig;
+use crate::error::{check_finite, PhysicsError, Result};
+use crate::math::{pose_from_na, pose_to_na, vec_from_na, vec_to_na, Pose3};
+use crate::shape::{ShapeSpec, VisualShape};
+use crate::state::SnapshotCache;
+
+/// Identifies a rigid body of a [`World`]: an actor or an articulation link body.
+///
+/// Ids are indices in creation order and stay valid for the life of the world.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct BodyId(pub(crate) u32);
+
+impl BodyId {
+    /// The id as an index (creation order, starting at 0).
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// How an actor moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ActorKind {
+    /// Never moves (walls, tables, the ground).
+    Static,
+    /// Moved by forces and contacts.
+    Dynamic,
+    /// Moved only by the user, through [`World::set_kinematic_target`]; pushes dynamic bodies.
+    Kinematic,
+}
+
+/// What kind of body a [`BodyId`] names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyKind {
+    /// A static actor (including the ground).
+    Static,
+    /// A dynamic actor.
+    Dynamic,
+    /// A kinematic actor.
+    Kinematic,
+    /// A link body of an articulation.
+    Link(ArticulationId),
+}
+
+/// Description of an actor: a single rigid body with its shapes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActorDesc {
+    /// Name (for errors, contacts and renderers; need not be unique).
+    pub name: String,
+    /// How the actor moves.
+    pub kind: ActorKind,
+    /// Initial pose of the actor frame in the world.
+    pub pose: Pose3,
+    /// Collision shapes in the actor frame.
+    pub shapes: Vec<ShapeSpec>,
+    /// Visual shapes in the actor frame (empty: renderers draw the collision shapes).
+    pub visuals: Vec<VisualShape>,
+    /// Linear velocity damping (1/s).
+    pub linear_damping: f32,
+    /// Angular velocity damping (1/s).
+    pub angular_damping: f32,
+}
+
+impl ActorDesc {
+    /// An actor with no shapes at the origin.
+    pub fn new(name: impl Into<String>, kind: ActorKind) -> Self {
+        ActorDesc {
+            name: name.into(),
+            kind,
+            pose: Pose3::identity(),
+            shapes: Vec::new(),
+            visuals: Vec::new(),
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+        }
+    }
+
+    /// Sets the initial pose.
+    pub fn with_pose(mut self, pose: Pose3) -> Self {
+        self.pose = pose;
+        self
+    }
+
+    /// Adds a collision shape.
+    pub fn with_shape(mut self, shape: ShapeSpec) -> Self {
+        self.shapes.push(shape);
+        self
+    }
+
+    /// Adds a visual shape.
+    pub fn with_visual(mut self, visual: VisualShape) -> Self {
+        self.visuals.push(visual);
+        self
+    }
+}
+
+/// One entry of the body table.
+#[derive(Clone, Debug)]
+pub(crate) struct BodyEntry {
+    pub(crate) name: String,
+    pub(crate) kind: BodyKind,
+    pub(crate) handle: RigidBodyHandle,
+    pub(crate) colliders: Vec<ColliderHandle>,
+    pub(crate) shapes: Vec<ShapeSpec>,
+    pub(crate) visuals: Vec<VisualShape>,
+}
+
+/// Body pairs whose contacts are ignored (robot links that touch at rest), as a rapier hook.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ExcludedPairs {
+    pub(crate) pairs: HashSet<(u32, u32)>,
+}
+
+impl ExcludedPairs {
+    pub(crate) fn key(a: BodyId, b: BodyId) -> (u32, u32) {
+        (a.0.min(b.0), a.0.max(b.0))
+    }
+}
+
+impl PhysicsHooks for ExcludedPairs {
+    fn filter_contact_pair(&self, context: &PairFilterContext) -> Option<SolverFlags> {
+        let b1 = context.colliders[context.collider1].user_data as u32;
+        let b2 = context.colliders[context.collider2].user_data as u32;
+        if self
+            .pairs
+            .contains(&ExcludedPairs::key(BodyId(b1), BodyId(b2)))
+        {
+            None
+        } else {
+            Some(SolverFlags::default())
+        }
+    }
+}
+
+/// rapier's simulation state: everything a step reads and writes, cloneable as one.
+#[derive(Clone)]
+pub(crate) struct Sim {
+    pub(crate) islands: IslandManager,
+    pub(crate) broad_phase: BroadPhaseBvh,
+    pub(crate) narrow_phase: NarrowPhase,
+    pub(crate) bodies: RigidBodySet,
+    pub(crate) colliders: ColliderSet,
+    pub(crate) impulse_joints: ImpulseJointSet,
+    pub(crate) multibody_joints: MultibodyJointSet,
+    pub(crate) soft_bodies: SoftBodySet,
+}
+
+/// A rigid-body world over rapier3d: actors, articulations, contacts and a flat state.
+///
+/// The world is z-up, in metres, kilograms and seconds. Every [`step`](World::step) advances
+/// the simulation by one fixed time step ([`WorldConfig::timestep`], 1/500 s by default).
+pub struct World {
+    pub(crate) config: WorldConfig,
+    pub(crate) params: IntegrationParameters,
+    pub(crate) pipeline: PhysicsPipeline,
+    pub(crate) ccd: CCDSolver,
+    pub(crate) sim: Sim,
+    pub(crate) hooks: ExcludedPairs,
+    pub(crate) table: Vec<BodyEntry>,
+    pub(crate) articulations: Vec<Articulation>,
+    pub(crate) ground: Option<BodyId>,
+    pub(crate) forced: Vec<RigidBodyHandle>,
+    /// Bumped by every change that a state vector does not capture (added bodies, gains,
+    /// materials, ...): snapshots of an older generation are never restored.
+    pub(crate) generation: u64,
+    pub(crate) snapshots: Mutex<SnapshotCache>,
+    pub(crate) steps: u64,
+}
+
+impl World {
+    /// Creates a world (with its ground plane, if configured).
+    pub fn new(config: WorldConfig) -> Result<World> {
+        config.validate()?;
+        let mut params = IntegrationParameters {
+            dt: config.timestep,
+            ..IntegrationParameters::default()
+        };
+        let s = &config.solver;
+        params.num_solver_iterations = s.solver_iterations;
+        params.num_internal_pgs_iterations = s.pgs_iterations;
+        params.contact_softness =
+            SpringCoefficients::new(s.contact_frequency_hz, s.contact_damping_ratio);
+        params.static_contact_softness =
+            SpringCoefficients::new(s.contact_frequency_hz, s.contact_damping_ratio);
+        params.friction_in_bias_pass = s.friction_in_bias_pass;
+        params.normalized_prediction_distance = s.prediction_distance;
+        params.normalized_max_corrective_velocity = s.max_corrective_velocity;
+        let mut world = World {
+            params,
+            pipeline: PhysicsPipeline::new(),
+            ccd: CCDSolver::new(),
+            sim: Sim {
+                islands: IslandManager::new(),
+                broad_phase: BroadPhaseBvh::new(),
+                narrow_phase: NarrowPhase::new(),
+                bodies: RigidBodySet::new(),
+                colliders: ColliderSet::new(),
+                impulse_joints: ImpulseJointSet::new(),
+                multibody_joints: MultibodyJointSet::new(),
+                soft_bodies: SoftBodySet::default(),
+            },
+            hooks: ExcludedPairs::default(),
+            table: Vec::new(),
+            articulations: Vec::new(),
+            ground: None,
+            forced: Vec::new(),
+            generation: 0,
+            snapshots: Mutex::new(SnapshotCache::default()),
+            steps: 0,
+            config,
+        };
+        if let Some(g) = world.config.ground {
+            let handle = world.sim.bodies.insert(
+                RigidBodyBuilder::fixed()
+                    .translation(vec_from_na(&Vector3::new(0.0, 0.0, g.altitude))),
+            );
+            let id = BodyId(world.table.len() as u32);
+            let collider = ColliderBuilder::new(rapier3d::prelude::SharedShape::halfspace(
+                rapier3d::math::Vector::Z,
+            ))
+            .friction(g.material.static_friction)
+            .restitution(g.material.restitution)
+            .user_data(id.0 as u128)
+            .build();
+            let ch =
+                world
+                    .sim
+                    .colliders
+                    .insert_with_parent(collider, handle, &mut world.sim.bodies);
+            world.table.push(BodyEntry {
+                name: "ground".into(),
+                kind: BodyKind::Static,
+                handle,
+                colliders: vec![ch],
+                shapes: Vec::new(),
+                visuals: Vec::new(),
+            });
+            world.ground = Some(id);
+        }
+        Ok(world)
+    }
+
+    /// The configuration the world was built with.
+    pub fn config(&self) -> &WorldConfig {
+        &self.config
+    }
+
+    /// The physics time step (s).
+    pub fn timestep(&self) -> f32 {
+        self.config.timestep
+    }
+
+    /// Number of steps taken since creation.
+    pub fn step_count(&self) -> u64 {
+        self.steps
+    }
+
+    /// The ground plane's body, if the world has one.
+    pub fn ground(&self) -> Option<BodyId> {
+        self.ground
+    }
+
+    /// Sets gravity (m/s², world frame).
+    pub fn set_gravity(&mut self, gravity: Vector3<f32>) -> Result<()> {
+        check_finite(|| "gravity".into(), gravity.as_slice())?;
+        self.config.gravity = gravity;
+        self.generation += 1;
+        Ok(())
+    }
+
+    /// Sets the number of velocity-solver iterations per step.
+    pub fn set_solver_iterations(&mut self, iterations: usize) -> Result<()> {
+        if iterations == 0 || iterations > 1000 {
+            return Err(PhysicsError::InvalidParameter {
+                name: "solver_iterations",
+                value: iterations.to_string(),
+                expected: "an integer in [1, 1000]",
+            });
+        }
+        self.config.solver.solver_iterations = iterations;
+        self.params.num_solver_iterations = iterations;
+        self.generation += 1;
+        Ok(())
+    }
+
+    /// Adds an actor; returns its body id.
+    ///
+    /// Errors: a triangle mesh on a non-static actor, an invalid shape, material or mass, or a
+    /// non-finite pose.
+    pub fn add_actor(&mut self, desc: ActorDesc) -> Result<BodyId> {
+        let pose_values: Vec<f32> = desc
+            .pose
+            .translation
+            .vector
+            .iter()
+            .chain(desc.pose.rotation.coords.iter())
+            .copied()
+            .collect();
+        check_finite(|| format!("pose of actor \"{}\"", desc.name), &pose_values)?;
+        if desc.kind != ActorKind::Static {
+            if let Some(s) = desc.shapes.iter().find(|s| s.shape.is_static_only()) {
+                let _ = s;
+                return Err(PhysicsError::InvalidShape(format!(
+                    "actor \"{}\": triangle meshes are only allowed on static actors; use a \
+                     convex hull or a compound of convex parts",
+                    desc.name
+                )));
+            }
+        }
+        for (name, v) in [
+            ("linear_damping", desc.linear_damping),
+            ("angular_damping", desc.angular_damping),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(PhysicsError::InvalidParameter {
+                    name,
+                    value: v.to_string(),
+                    expected: "a finite damping >= 0 in 1/s",
+                });
+            }
+        }
+        let builders = desc
+            .shapes
+            .iter()
+            .map(|s| s.to_collider())
+            .collect::<Result<Vec<_>>>()?;
+        let rb = match desc.kind {
+            ActorKind::Static => RigidBodyBuilder::fixed(),
+            ActorKind::Dynamic => RigidBodyBuilder::dynamic(),
+            ActorKind::Kinematic => RigidBodyBuilder::kinematic_position_based(),
+        }
+        .pose(pose_from_na(&desc.pose))
+        .linear_damping(desc.linear_damping)
+        .angular_damping(desc.angular_damping);
+        let handle = self.sim.bodies.insert(rb);
+        let id = BodyId(self.table.len() as u32);
+        let mut colliders = Vec::with_capacity(builders.len());
+        for b in builders {
+            let c = b.user_data(id.0 as u128).build();
+            colliders.push(
+                self.sim
+                    .colliders
+                    .insert_with_parent(c, handle, &mut self.sim.bodies),
+            );
+        }
+        self.table.push(BodyEntry {
+            name: desc.name,
+            kind: match desc.kind {
+                ActorKind::Static => BodyKind::Static,
+                ActorKind::Dynamic => BodyKind::Dynamic,
+                ActorKind::Kinematic => BodyKind::Kinematic,
+            },
+            handle,
+            colliders,
+            shapes: desc.shapes,
+            visuals: desc.visuals,
+        });
+        self.generation += 1;
+        Ok(id)
+    }
+
+    /// Advances the simulation by one time step.
+    ///
+    /// Forces and torques applied with [`apply_force`](World::apply_force) and
+    /// [`apply_torque`](World::apply_torque) act during this step only.
+    pub fn step(&mut self) {
+        let gravity = vec_from_na(&self.config.gravity);
+        let sim = &mut self.sim;
+        self.pipeline.step(
+            gravity,
+            &self.params,
+            &mut sim.islands,
+            &mut sim.broad_phase,
+            &mut sim.narrow_phase,
+            &mut sim.bodies,
+            &mut sim.colliders,
+            &mut sim.impulse_joints,
+            &mut sim.multibody_joints,
+            &mut sim.soft_bodies,
+            &mut self.ccd,
+            &self.hooks,
+            &(),
+        );
+        for h in self.forced.drain(..) {
+            if let Some(rb) = sim.bodies.get_mut(h) {
+                rb.reset_forces(false);
+                rb.reset_torques(false);
+            }
+        }
+        self.steps += 1;
+    }
+
+    /// Advances the simulation by `n` time steps.
+    pub fn step_n(&mut self, n: usize) {
+        for _ in 0..n {
+            self.step();
+        }
+    }
+
+    pub(crate) fn entry(&self, body: BodyId) -> Result<&BodyEntry> {
+        self.table.get(body.index()).ok_or(PhysicsError::UnknownId {
+            kind: "body",
+            id: body.index(),
+        })
+    }
+
+    /// Every body id, in creation order.
+    pub fn bodies(&self) -> impl Iterator<Item = BodyId> + '_ {
+        (0..self.table.len() as u32).map(BodyId)
+    }
+
+    /// The body's name (actor name, link name, or `ground`).
+    pub fn body_name(&self, body: BodyId) -> Result<&str> {
+        Ok(&self.entry(body)?.name)
+    }
+
+    /// What kind of body this is.
+    pub fn body_kind(&self, body: BodyId) -> Result<BodyKind> {
+        Ok(self.entry(body)?.kind)
+    }
+
+    /// Finds the first actor (not link) with this name.
+    pub fn find_actor(&self, name: &str) -> Option<BodyId> {
+        self.table
+            .iter()
+            .position(|e| e.name == name && !matches!(e.kind, BodyKind::Link(_)))
+            .map(|i| BodyId(i as u32))
+    }
+
+    /// Pose of the body frame in the world (for a link body: the frame of the URDF link the body
+    /// was built from; merged fixed links have their own poses through
+    /// [`World::link_pose`](World::link_pose)).
+    pub fn body_pose(&self, body: BodyId) -> Result<Pose3> {
+        let e = self.entry(body)?;
+        Ok(pose_to_na(self.sim.bodies[e.handle].position()))
+    }
+
+    /// Linear velocity of the body's centre of mass (m/s, world frame).
+    pub fn body_linear_velocity(&self, body: BodyId) -> Result<Vector3<f32>> {
+        let e = self.entry(body)?;
+        Ok(vec_to_na(self.sim.bodies[e.handle].linvel()))
+    }
+
+    /// Angular velocity of the body (rad/s, world frame).
+    pub fn body_angular_velocity(&self, body: BodyId) -> Result<Vector3<f32>> {
+        let e = self.entry(body)?;
+        Ok(vec_to_na(self.sim.bodies[e.handle].angvel()))
+    }
+
+    /// Velocity (m/s, world frame) of the body's material point currently at `point_world`.
+    pub fn body_point_velocity(
+        &self,
+        body: BodyId,
+        point_world: Point3<f32>,
+    ) -> Result<Vector3<f32>> {
+        let e = self.entry(body)?;
+        Ok(vec_to_na(
+            self.sim.bodies[e.handle].velocity_at_point(vec_from_na(&point_world.coords)),
+        ))
+    }
+
+    /// Centre of mass in the world frame (m).
+    pub fn body_center_of_mass(&self, body: BodyId) -> Result<Point3<f32>> {
+        let e = self.entry(body)?;
+        Ok(Point3::from(vec_to_na(
+            self.sim.bodies[e.handle].center_of_mass(),
+        )))
+    }
+
+    /// Centre of mass in the body frame (m).
+    pub fn body_local_center_of_mass(&self, body: BodyId) -> Result<Point3<f32>> {
+        let e = self.entry(body)?;
+        Ok(Point3::from(vec_to_na(
+            self.sim.bodies[e.handle].local_center_of_mass(),
+        )))
+    }
+
+    /// Mass (kg); 0 for static and kinematic bodies.
+    pub fn body_mass(&self, body: BodyId) -> Result<f32> {
+        let e = self.entry(body)?;
+        let rb = &self.sim.bodies[e.handle];
+        Ok(if rb.body_type() == RigidBodyType::Dynamic {
+            rb.mass()
+        } else {
+            0.0
+        })
+    }
+
+    /// The body's collision shapes, in the body frame.
+    pub fn body_shapes(&self, body: BodyId) -> Result<&[ShapeSpec]> {
+        Ok(&self.entry(body)?.shapes)
+    }
+
+    /// The body's visual shapes, in the body frame (may be empty: draw the collision shapes).
+    pub fn body_visuals(&self, body: BodyId) -> Result<&[VisualShape]> {
+        Ok(&self.entry(body)?.visuals)
+    }
+
+    /// True when the body is asleep (only actors can sleep; robot links never do).
+    pub fn body_is_sleeping(&self, body: BodyId) -> Result<bool> {
+        let e = self.entry(body)?;
+        Ok(self.sim.bodies[e.handle].is_sleeping())
+    }
+
+    fn actor_handle(&self, body: BodyId, what: &str) -> Result<RigidBodyHandle> {
+        let e = self.entry(body)?;
+        if matches!(e.kind, BodyKind::Link(_)) {
+            return Err(PhysicsError::InvalidParameter {
+                name: "body",
+                value: format!("link body \"{}\"", e.name),
+                expected: match what {
+                    "pose" => "an actor: move articulation links through set_qpos / set_root_pose",
+                    _ => "an actor: set articulation velocities through set_qvel",
+                },
+            });
+        }
+        Ok(e.handle)
+    }
+
+    /// Teleports an actor (static, dynamic or kinematic) to a pose; wakes it.
+    pub fn set_body_pose(&mut self, body: BodyId, pose: &Pose3) -> Result<()> {
+        let h = self.actor_handle(body, "pose")?;
+        check_finite(
+            || "body pose".into(),
+            &[
+                pose.translation.x,
+                pose.translation.y,
+                pose.translation.z,
+                pose.rotation.i,
+                pose.rotation.j,
+                pose.rotation.k,
+                pose.rotation.w,
+            ],
+        )?;
+        let rb = &mut self.sim.bodies[h];
+        rb.set_position(pose_from_na(pose), true);
+        if rb.is_kinematic() {
+            rb.set_next_kinematic_position(pose_from_na(pose));
+        }
+        Ok(())
+    }
+
+    /// Sets an actor's linear (m/s, of its centre of mass) and angular (rad/s) velocity, world
+    /// frame; wakes it.
+    pub fn set_body_velocity(
+        &mut self,
+        body: BodyId,
+        linear: &Vector3<f32>,
+        angular: &Vector3<f32>,
+    ) -> Result<()> {
+        let h = self.actor_handle(body, "velocity")?;
+        check_finite(|| "linear velocity".into(), linear.as_slice())?;
+        check_finite(|| "angular velocity".into(), angular.as_slice())?;
+        let rb = &mut self.sim.bodies[h];
+        rb.set_linvel(vec_from_na(linear), true);
+        rb.set_angvel(vec_from_na(angular), true);
+        Ok(())
+    }
+
+    /// Sets where a kinematic actor will be at the end of the next step (it moves there with
+    /// the matching velocity, pushing dynamic bodies).
+    pub fn set_kinematic_target(&mut self, body: BodyId, pose: &Pose3) -> Result<()> {
+        let e = self.entry(body)?;
+        if e.kind != BodyKind::Kinematic {
+            return Err(PhysicsError::InvalidParameter {
+                name: "body",
+                value: format!("\"{}\" ({:?})", e.name, e.kind),
+                expected: "a kinematic actor",
+            });
+        }
+        let h = e.handle;
+        self.sim.bodies[h].set_next_kinematic_position(pose_from_na(pose));
+        Ok(())
+    }
+
+    fn force_target(
+        &mut self,
+        body: BodyId,
+        values: &[f32],
+        what: &str,
+    ) -> Result<RigidBodyHandle> {
+        let e = self.entry(body)?;
+        check_finite(|| what.to_string(), values)?;
+        if !matches!(e.kind, BodyKind::Dynamic | BodyKind::Link(_)) {
+            return Err(PhysicsError::InvalidParameter {
+                name: "body",
+                value: format!("\"{}\" ({:?})", e.name, e.kind),
+                expected: "a dynamic actor or an articulation link",
+            });
+        }
+        let h = e.handle;
+        self.forced.push(h);
+        Ok(h)
+    }
+
+    /// Applies a force (N, world frame) at the body's centre of mass during the next step.
+    pub fn apply_force(&mut self, body: BodyId, force: &Vector3<f32>) -> Result<()> {
+        let h = self.force_target(body, force.as_slice(), "force")?;
+        self.sim.bodies[h].add_force(vec_from_na(force), true);
+        Ok(())
+    }
+
+    /// Applies a torque (N·m, world frame) to the body during the next step.
+    pub fn apply_torque(&mut self, body: BodyId, torque: &Vector3<f32>) -> Result<()> {
+        let h = self.force_target(body, torque.as_slice(), "torque")?;
+        self.sim.bodies[h].add_torque(vec_from_na(torque), true);
+        Ok(())
+    }
+
+    /// Applies a force (N, world frame) at a world point (m) during the next step.
+    pub fn apply_force_at_point(
+        &mut self,
+        body: BodyId,
+        force: &Vector3<f32>,
+        point_world: &Point3<f32>,
+    ) -> Result<()> {
+        let h = self.force_target(body, force.as_slice(), "force")?;
+        check_finite(|| "force point".into(), point_world.coords.as_slice())?;
+        self.sim.bodies[h].add_force_at_point(
+            vec_from_na(force),
+            vec_from_na(&point_world.coords),
+            true,
+        );
+        Ok(())
+    }
+
+    /// Wakes a sleeping actor.
+    pub fn wake_up(&mut self, body: BodyId) -> Result<()> {
+        let h = self.entry(body)?.handle;
+        self.sim.bodies[h].wake_up(true);
+        Ok(())
+    }
+
+    /// Ignores (or restores) contacts between two bodies.
+    pub fn set_collision_between(&mut self, a: BodyId, b: BodyId, enabled: bool) -> Result<()> {
+        self.entry(a)?;
+        self.entry(b)?;
+        let key = ExcludedPairs::key(a, b);
+        if enabled {
+            self.hooks.pairs.remove(&key);
+        } else {
+            self.hooks.pairs.insert(key);
+            for id in [a, b] {
+                let colliders = self.table[id.index()].colliders.clone();
+                for c in colliders {
+                    if let Some(co) = self.sim.colliders.get_mut(c) {
+                        co.set_active_hooks(co.active_hooks() | ActiveHooks::FILTER_CONTACT_PAIRS);
+                    }
+                }
+            }
+        }
+        self.generation += 1;
+        Ok(())
+    }
+
+    pub(crate) fn articulation_ref(&self, id: ArticulationId) -> Result<&Articulation> {
+        self.articulations
+            .get(id.index())
+            .ok_or(PhysicsError::UnknownId {
+                kind: "articulation",
+                id: id.index(),
+            })
+    }
+}

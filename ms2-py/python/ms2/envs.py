@@ -1,0 +1,196 @@
+"""``Ms2Env``: one ms2 environment as a ``gymnasium.Env``.
+
+Made by ``gymnasium.make("PickCube-v0", obs_mode=..., control_mode=...)`` after ``import ms2``, or
+directly as ``Ms2Env("PickCube-v0", ...)``. Observations are (nested dicts of) numpy arrays made
+in Rust; actions are converted once to a contiguous float32 array and stepped with the GIL
+released.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from . import _native
+from .spaces import to_gym_space
+
+#: Native episode limit used when gymnasium's ``TimeLimit`` wrapper enforces the limit instead
+#: (``gymnasium.make`` applies one with the registered or the given ``max_episode_steps``).
+UNLIMITED_EPISODE_STEPS = 2**31 - 1
+
+
+def _seed_from(rng: np.random.Generator) -> int:
+    """A 63-bit seed drawn from ``rng``."""
+    return int(rng.integers(0, 2**63 - 1))
+
+
+class Ms2Env(gym.Env):
+    """An ms2 task (``PickCube-v0``, ``LiftCube-v0``, ``StackCube-v0``, ...) as a gymnasium env.
+
+    Args:
+        env_id: registered task id (``ms2.env_ids()`` lists them).
+        obs_mode: ``"state_dict"`` (nested dict of arrays) or ``"state"`` (one flat float32 array).
+        control_mode: e.g. ``"pd_ee_delta_pose"``; ``None`` = ``"pd_joint_delta_pos"``.
+        reward_mode: ``"sparse"``, ``"dense"`` or ``"normalized_dense"`` (``None``).
+        render_mode: ``None`` or ``"rgb_array"``.
+        sim_freq: physics frequency in Hz (500 by default).
+        control_freq: env step frequency in Hz (20 by default); ``sim_freq`` must be a multiple.
+        max_episode_steps: episode limit in env steps after which ``truncated`` is set;
+            ``None`` = the task's default (200).
+
+    Unknown ids or modes raise ``ValueError`` listing the valid ones.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+
+    def __init__(
+        self,
+        env_id: str = "PickCube-v0",
+        obs_mode: str = "state_dict",
+        control_mode: str | None = None,
+        reward_mode: str | None = None,
+        render_mode: str | None = None,
+        sim_freq: float = 500.0,
+        control_freq: float = 20.0,
+        max_episode_steps: int | None = None,
+    ) -> None:
+        self._native = _native.NativeEnv(
+            env_id,
+            obs_mode=obs_mode,
+            control_mode=control_mode,
+            reward_mode=reward_mode,
+            render_mode=render_mode,
+            sim_freq=float(sim_freq),
+            control_freq=float(control_freq),
+            max_episode_steps=max_episode_steps,
+        )
+        config = self._native.config()
+        self.env_id: str = config["env_id"]
+        self.obs_mode: str = config["obs_mode"]
+        self.control_mode: str = config["control_mode"]
+        self.reward_mode: str = config["reward_mode"]
+        self.render_mode = render_mode
+        self.sim_freq: float = config["sim_freq"]
+        self.control_freq: float = config["control_freq"]
+        self.observation_space = to_gym_space(self._native.observation_space())
+        self.action_space = to_gym_space(self._native.action_space())
+        self.metadata = {**self.metadata, "render_fps": self.control_freq}
+        self._seeded = False
+
+    # --- gymnasium API -------------------------------------------------------------------------
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        """Starts an episode. ``seed`` makes it reproducible; ``seed=None`` continues the env's
+        random sequence (seeded from OS entropy on the first reset). ``options={"reconfigure":
+        True}`` rebuilds the scene (ManiSkill2's option)."""
+        if seed is not None:
+            if not isinstance(seed, (int, np.integer)) or seed < 0:
+                raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+            seed = int(seed)
+        super().reset(seed=seed)
+        if seed is None and not self._seeded:
+            seed = _seed_from(self.np_random)
+        if seed is not None:
+            self._seeded = True
+        reconfigure = bool((options or {}).get("reconfigure", False))
+        return self._native.reset(seed=seed, reconfigure=reconfigure)
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """One control step (``sim_freq / control_freq`` physics steps). ``action`` must have the
+        action space's shape and be finite (``ValueError`` otherwise)."""
+        action = np.ascontiguousarray(action, dtype=np.float32)
+        if action.shape != self.action_space.shape:
+            raise ValueError(
+                f"action for control_mode {self.control_mode!r} must have shape "
+                f"{self.action_space.shape}, got {action.shape}"
+            )
+        return self._native.step(action)
+
+    def render(self) -> np.ndarray | None:
+        """An RGB image (uint8 [H, W, 3]) of the scene when ``render_mode="rgb_array"``."""
+        if self.render_mode is None:
+            gym.logger.warn(
+                "render() called without render_mode; make the env with render_mode='rgb_array'"
+            )
+            return None
+        render = getattr(self._native, "render", None)
+        if render is None:
+            raise NotImplementedError("this build of ms2 has no renderer yet")
+        return render()
+
+    def close(self) -> None:
+        """Releases the native env."""
+        self._native = None  # type: ignore[assignment]
+
+    # --- ManiSkill2-style extras ----------------------------------------------------------------
+
+    def get_state(self) -> np.ndarray:
+        """The full simulation state (float32 vector) to restore with :meth:`set_state`."""
+        return self._native.get_state()
+
+    def set_state(self, state: np.ndarray) -> None:
+        """Restores a state from :meth:`get_state` (``ValueError`` on a wrong length or NaN)."""
+        state = np.ascontiguousarray(state, dtype=np.float32)
+        if state.ndim != 1:
+            raise ValueError(f"state must be a 1-D array, got shape {state.shape}")
+        self._native.set_state(state)
+
+    @property
+    def elapsed_steps(self) -> int:
+        """Env steps taken in this episode."""
+        return self._native.elapsed_steps()
+
+    @property
+    def max_episode_steps(self) -> int:
+        """The native episode limit in env steps."""
+        return self._native.max_episode_steps()
+
+    @property
+    def supported_control_modes(self) -> list[str]:
+        """Control modes of this env's robot."""
+        return self._native.control_modes()
+
+    @property
+    def supported_obs_modes(self) -> list[str]:
+        """Observation modes of this env."""
+        return self._native.obs_modes()
+
+    @property
+    def supported_reward_modes(self) -> list[str]:
+        """Reward modes of this env."""
+        return self._native.reward_modes()
+
+
+def make_registered(**kwargs: Any) -> Ms2Env:
+    """Entry point of the ids registered with gymnasium: an :class:`Ms2Env` whose episode limit
+    is left to the ``TimeLimit`` wrapper ``gymnasium.make`` adds (so ``gymnasium.make(id,
+    max_episode_steps=N)`` works as for any gymnasium env)."""
+    kwargs.setdefault("max_episode_steps", UNLIMITED_EPISODE_STEPS)
+    return Ms2Env(**kwargs)
+
+
+class ScriptedPolicy:
+    """The runtime's scripted (oracle, privileged-state) policy for an env.
+
+    ``policy = ScriptedPolicy(env)`` (a gymnasium env made from ms2, wrappers allowed); call
+    :meth:`reset` after each ``env.reset`` and :meth:`act` for each step's action. ``ValueError``
+    if the task has no scripted policy for the env's control mode.
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        unwrapped = env.unwrapped
+        if not isinstance(unwrapped, Ms2Env):
+            raise TypeError(f"ScriptedPolicy needs an ms2 env, got {type(unwrapped).__name__}")
+        self._native = _native.NativeScriptedPolicy(unwrapped._native)
+
+    def reset(self) -> None:
+        """Starts a new episode (call after ``env.reset``)."""
+        self._native.reset()
+
+    def act(self) -> np.ndarray:
+        """The action for the env's current state (float32, the action space's shape)."""
+        return self._native.act()

@@ -1,0 +1,132 @@
+"""``Ms2VectorEnv``: N ms2 envs stepped in parallel in native threads, as a gymnasium
+``VectorEnv``.
+
+All envs step on the extension's thread pool with the GIL released; observations come back
+stacked per key (``[num_envs, ...]`` arrays built in Rust). Sub-envs autoreset in gymnasium 1.x's
+default "next step" mode: the step after an episode ends resets that env (its action is ignored)
+and returns the first observation of the new episode with reward 0 and both flags false.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from . import _native
+from .envs import _seed_from
+from .spaces import to_gym_space
+
+
+class Ms2VectorEnv(VectorEnv):
+    """``num_envs`` copies of one ms2 task, stepped in parallel.
+
+    Takes the same keyword arguments as :class:`ms2.envs.Ms2Env`. ``reset(seed=s)`` seeds env
+    ``i`` with ``s + i`` (or pass one seed per env); ``options={"reset_mask": mask}`` resets only
+    the envs where the boolean ``mask`` is true.
+    """
+
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+
+    def __init__(
+        self,
+        env_id: str = "PickCube-v0",
+        num_envs: int = 1,
+        obs_mode: str = "state_dict",
+        control_mode: str | None = None,
+        reward_mode: str | None = None,
+        render_mode: str | None = None,
+        sim_freq: float = 500.0,
+        control_freq: float = 20.0,
+        max_episode_steps: int | None = None,
+    ) -> None:
+        if int(num_envs) < 1:
+            raise ValueError(f"num_envs must be at least 1, got {num_envs}")
+        self._native = _native.NativeVecEnv(
+            env_id,
+            int(num_envs),
+            obs_mode=obs_mode,
+            control_mode=control_mode,
+            reward_mode=reward_mode,
+            render_mode=render_mode,
+            sim_freq=float(sim_freq),
+            control_freq=float(control_freq),
+            max_episode_steps=max_episode_steps,
+        )
+        config = self._native.config()
+        self.env_id: str = config["env_id"]
+        self.obs_mode: str = config["obs_mode"]
+        self.control_mode: str = config["control_mode"]
+        self.reward_mode: str = config["reward_mode"]
+        self.render_mode = render_mode
+        self.num_envs = int(num_envs)
+        self.single_observation_space = to_gym_space(self._native.single_observation_space())
+        self.single_action_space = to_gym_space(self._native.single_action_space())
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self._seeded = False
+
+    def reset(
+        self,
+        *,
+        seed: int | Sequence[int | None] | None = None,
+        options: dict[str, Any] | None = None,
+    ) -> tuple[Any, dict[str, Any]]:
+        """Resets all envs (or those in ``options["reset_mask"]``): ``(batched obs, info)``."""
+        super().reset(seed=seed if isinstance(seed, int) else None)
+        n = self.num_envs
+        if seed is None:
+            if self._seeded:
+                seeds: list[int | None] = [None] * n
+            else:
+                seeds = [_seed_from(self.np_random) for _ in range(n)]
+        elif isinstance(seed, (int, np.integer)):
+            seeds = [int(seed) + i for i in range(n)]
+        else:
+            seeds = [None if s is None else int(s) for s in seed]
+            if len(seeds) != n:
+                raise ValueError(f"expected one seed per env ({n}), got {len(seeds)}")
+        if any(s is not None and s < 0 for s in seeds):
+            raise ValueError(f"seeds must be non-negative integers, got {seeds}")
+        mask = None
+        if options is not None and "reset_mask" in options:
+            mask_array = np.asarray(options["reset_mask"])
+            if mask_array.shape != (n,) or mask_array.dtype != np.bool_:
+                raise ValueError(
+                    f"options['reset_mask'] must be a bool array of shape ({n},), got "
+                    f"{mask_array.dtype} {mask_array.shape}"
+                )
+            mask = mask_array.tolist()
+        if any(s is not None for s in seeds):
+            self._seeded = True
+        return self._native.reset(seeds, mask)
+
+    def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Steps all envs with ``actions`` of shape ``(num_envs, *single_action_space.shape)``."""
+        actions = np.ascontiguousarray(actions, dtype=np.float32)
+        if actions.shape != self.action_space.shape:
+            raise ValueError(
+                f"actions for control_mode {self.control_mode!r} must have shape "
+                f"{self.action_space.shape}, got {actions.shape}"
+            )
+        return self._native.step(actions.reshape(self.num_envs, -1))
+
+    def get_state(self, index: int) -> np.ndarray:
+        """Env ``index``'s simulation state (see :meth:`ms2.envs.Ms2Env.get_state`)."""
+        return self._native.get_state(int(index))
+
+    def close_extras(self, **kwargs: Any) -> None:
+        """Releases the native envs."""
+        self._native = None  # type: ignore[assignment]
+
+
+def make_vec(env_id: str, num_envs: int = 1, **kwargs: Any) -> Ms2VectorEnv:
+    """A vector env of ``num_envs`` copies of ``env_id`` stepped in parallel in native threads.
+
+    Keyword arguments are those of ``gymnasium.make`` for ms2 (``obs_mode``, ``control_mode``,
+    ``reward_mode``, ``render_mode``, ``sim_freq``, ``control_freq``, ``max_episode_steps``).
+    """
+    return Ms2VectorEnv(env_id, num_envs=num_envs, **kwargs)

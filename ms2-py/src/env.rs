@@ -1,0 +1,172 @@
+//! `NativeEnv`: one environment, stepped with the GIL released.
+
+use std::sync::Mutex;
+
+use ms2_tasks::{make_env, Env};
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use pyo3::IntoPyObjectExt;
+
+use crate::config::{config_to_py, make_config};
+use crate::convert::{box_space_to_py, info_to_py, obs_to_py, space_to_py};
+use crate::errors::{catch_panics, lock, NativeError};
+
+/// Copies a 1-D float32 numpy array into a `Vec` (it must be contiguous: the Python wrapper
+/// passes `np.ascontiguousarray(x, dtype=np.float32)`).
+pub fn contiguous_vec(array: &PyReadonlyArray1<'_, f32>, what: &str) -> PyResult<Vec<f32>> {
+    Ok(array
+        .as_slice()
+        .map_err(|_| NativeError::Input(format!("{what} must be a contiguous float32 array")))?
+        .to_vec())
+}
+
+/// One ms2 environment (the Rust `ms2_tasks::Env`). Python's `ms2.envs.Ms2Env` wraps it into a
+/// `gymnasium.Env`; use that instead of this class directly.
+///
+/// Every call that simulates releases the GIL. A panic inside the runtime raises `RuntimeError`
+/// and leaves this object unusable (see `errors`).
+#[pyclass(frozen, module = "ms2._native")]
+pub struct NativeEnv {
+    pub(crate) inner: Mutex<Env>,
+}
+
+impl NativeEnv {
+    /// Runs `f` on the env with the GIL released, catching panics.
+    pub(crate) fn with_env<T: Send>(
+        &self,
+        py: Python<'_>,
+        f: impl FnOnce(&mut Env) -> Result<T, NativeError> + Send,
+    ) -> Result<T, NativeError> {
+        py.detach(|| catch_panics(|| f(&mut *lock(&self.inner, "env")?)))
+    }
+
+    /// Runs a cheap read-only `f` on the env without releasing the GIL.
+    fn read<T>(&self, f: impl FnOnce(&Env) -> T) -> PyResult<T> {
+        let out = catch_panics(|| Ok(f(&*lock(&self.inner, "env")?)))?;
+        Ok(out)
+    }
+}
+
+#[pymethods]
+impl NativeEnv {
+    /// Makes an env; `None` arguments take the task's defaults.
+    #[new]
+    #[pyo3(signature = (env_id, obs_mode="state_dict".to_owned(), control_mode=None, reward_mode=None,
+                        render_mode=None, sim_freq=500.0, control_freq=20.0, max_episode_steps=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        env_id: String,
+        obs_mode: String,
+        control_mode: Option<String>,
+        reward_mode: Option<String>,
+        render_mode: Option<String>,
+        sim_freq: f64,
+        control_freq: f64,
+        max_episode_steps: Option<u32>,
+    ) -> PyResult<Self> {
+        let cfg = make_config(
+            env_id,
+            obs_mode,
+            control_mode,
+            reward_mode,
+            render_mode,
+            sim_freq,
+            control_freq,
+            max_episode_steps,
+        );
+        let env = py.detach(|| catch_panics(|| Ok(make_env(&cfg)?)))?;
+        Ok(NativeEnv {
+            inner: Mutex::new(env),
+        })
+    }
+
+    /// Resets the episode: `(obs, info)`. `seed` re-seeds the env's generator; `None` continues
+    /// its sequence.
+    #[pyo3(signature = (seed=None, reconfigure=false))]
+    fn reset<'py>(
+        &self,
+        py: Python<'py>,
+        seed: Option<u64>,
+        reconfigure: bool,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let (obs, info) = self.with_env(py, |env| Ok(env.reset(seed, reconfigure)?))?;
+        PyTuple::new(py, [obs_to_py(py, obs)?, info_to_py(py, &info)?.into_any()])
+    }
+
+    /// Steps with a 1-D float32 action: `(obs, reward, terminated, truncated, info)`.
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        action: PyReadonlyArray1<'py, f32>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let action = contiguous_vec(&action, "action")?;
+        let out = self.with_env(py, |env| Ok(env.step(&action)?))?;
+        PyTuple::new(
+            py,
+            [
+                obs_to_py(py, out.obs)?,
+                out.reward.into_bound_py_any(py)?,
+                out.terminated.into_bound_py_any(py)?,
+                out.truncated.into_bound_py_any(py)?,
+                info_to_py(py, &out.info)?.into_any(),
+            ],
+        )
+    }
+
+    /// The observation space as a tree of `("box", shape, low, high, dtype)` leaves.
+    fn observation_space<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let space = self.read(|env| env.observation_space().clone())?;
+        space_to_py(py, &space)
+    }
+
+    /// The action space as `("box", shape, low, high, dtype)`.
+    fn action_space<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let space = self.read(|env| env.action_space().clone())?;
+        box_space_to_py(py, &space)
+    }
+
+    /// The full simulation state as a float32 vector (restore it with `set_state`).
+    fn get_state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        let state = self.read(|env| env.get_state())?;
+        Ok(PyArray1::from_vec(py, state))
+    }
+
+    /// Restores a state from `get_state`.
+    fn set_state(&self, py: Python<'_>, state: PyReadonlyArray1<'_, f32>) -> PyResult<()> {
+        let state = contiguous_vec(&state, "state")?;
+        Ok(self.with_env(py, |env| Ok(env.set_state(&state)?))?)
+    }
+
+    /// Env steps taken in this episode.
+    fn elapsed_steps(&self) -> PyResult<u32> {
+        self.read(|env| env.elapsed_steps())
+    }
+
+    /// Episode length limit in env steps.
+    fn max_episode_steps(&self) -> PyResult<u32> {
+        self.read(|env| env.max_episode_steps())
+    }
+
+    /// The resolved config (task defaults filled in) as a dict of constructor kwargs.
+    fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let cfg = self.read(|env| env.config().clone())?;
+        config_to_py(py, &cfg)
+    }
+
+    /// Control modes this env's robot supports.
+    fn control_modes(&self) -> PyResult<Vec<String>> {
+        self.read(|env| env.control_modes())
+    }
+
+    /// Observation modes this env supports.
+    fn obs_modes(&self) -> PyResult<Vec<String>> {
+        self.read(|env| env.obs_modes())
+    }
+
+    /// Reward modes this env supports.
+    fn reward_modes(&self) -> PyResult<Vec<String>> {
+        self.read(|env| env.reward_modes())
+    }
+}

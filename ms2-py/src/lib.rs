@@ -1,0 +1,67 @@
+//! `ms2._native`: the pyo3 extension behind the `ms2` Python package.
+//!
+//! It binds `ms2-tasks` (the Rust env runtime) with as little Python-side work per step as
+//! possible: actions arrive as float32 numpy arrays, observations leave as numpy arrays built
+//! from the runtime's buffers, and every call that simulates releases the GIL. The Python package
+//! (`python/ms2`) turns these classes into `gymnasium.Env` / `gymnasium.vector.VectorEnv`.
+//!
+//! * [`env::NativeEnv`] — one env.
+//! * [`vec_env::NativeVecEnv`] — N envs stepped in parallel on rayon's thread pool, with
+//!   gymnasium's next-step autoreset.
+//! * [`policy::NativeScriptedPolicy`] — the runtime's scripted (oracle) policy of an env.
+//! * [`errors`] — how runtime errors and panics become Python exceptions.
+
+mod config;
+mod convert;
+mod env;
+mod errors;
+mod policy;
+mod vec_env;
+
+use pyo3::prelude::*;
+
+/// The registered env ids, e.g. `["PickCube-v0", ...]`.
+#[pyfunction]
+fn env_ids() -> PyResult<Vec<String>> {
+    let ids = errors::infallible(ms2_tasks::env_ids)?;
+    Ok(ids.into_iter().map(str::to_owned).collect())
+}
+
+/// The default episode limit (env steps) of task `env_id` (`ValueError` for an unknown id).
+#[pyfunction]
+fn default_max_episode_steps(py: Python<'_>, env_id: String) -> PyResult<u32> {
+    let cfg = ms2_tasks::EnvConfig::new(&env_id);
+    let steps =
+        py.detach(|| errors::catch_panics(|| Ok(ms2_tasks::make_env(&cfg)?.max_episode_steps())))?;
+    Ok(steps)
+}
+
+/// Panics inside a guarded native call with `message`: a test hook showing that a Rust panic
+/// reaches Python as `RuntimeError` (see `errors`).
+#[pyfunction]
+fn _panic_for_tests(py: Python<'_>, message: String) -> PyResult<()> {
+    py.detach(|| {
+        errors::catch_panics(|| -> Result<(), errors::NativeError> { panic!("{message}") })
+    })?;
+    Ok(())
+}
+
+/// Number of threads in the pool that steps vector envs.
+#[pyfunction]
+fn num_threads() -> usize {
+    rayon::current_num_threads()
+}
+
+/// The extension module `ms2._native`.
+#[pymodule]
+#[pyo3(name = "_native")]
+fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<env::NativeEnv>()?;
+    m.add_class::<vec_env::NativeVecEnv>()?;
+    m.add_class::<policy::NativeScriptedPolicy>()?;
+    m.add_function(wrap_pyfunction!(env_ids, m)?)?;
+    m.add_function(wrap_pyfunction!(num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(default_max_episode_steps, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,59 @@
+"""Shared helpers of the ms2 Python tests."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import ms2
+import numpy as np
+import pytest
+
+ENV_IDS = ms2.env_ids()
+#: The task single-env tests use.
+MAIN_ID = "PickCube-v0" if "PickCube-v0" in ENV_IDS else ENV_IDS[0]
+
+
+def leaves(obs, prefix=""):
+    """(path, array) pairs of a (nested dict) observation, in layout order."""
+    if isinstance(obs, dict):
+        out = []
+        for key, value in obs.items():
+            out.extend(leaves(value, f"{prefix}/{key}"))
+        return out
+    return [(prefix or "/", np.asarray(obs))]
+
+
+def assert_obs_equal(a, b):
+    """Observations have the same layout and bit-identical arrays."""
+    la, lb = leaves(a), leaves(b)
+    assert [p for p, _ in la] == [p for p, _ in lb]
+    for (path, x), (_, y) in zip(la, lb, strict=True):
+        assert x.dtype == y.dtype, path
+        np.testing.assert_array_equal(x, y, err_msg=path)
+
+
+def obs_differs(a, b) -> bool:
+    return any(
+        not np.array_equal(x, y) for (_, x), (_, y) in zip(leaves(a), leaves(b), strict=True)
+    )
+
+
+@pytest.fixture(params=ENV_IDS)
+def env_id(request):
+    """Every registered task."""
+    return request.param
+
+
+def random_actions(space, rng: np.random.Generator, count: int) -> np.ndarray:
+    """``count`` uniform random float32 actions within a Box ``space``."""
+    return rng.uniform(space.low, space.high, size=(count, *space.shape)).astype(np.float32)
+
+
+def preferred_control_mode(env_id: str) -> str | None:
+    """``pd_ee_delta_pose`` where the robot supports it, else the task's default."""
+    modes = ms2.Ms2Env(env_id).supported_control_modes
+    return "pd_ee_delta_pose" if "pd_ee_delta_pose" in modes else None
+
+
+def make(env_id=MAIN_ID, **kwargs) -> gym.Env:
+    """A gymnasium-made env without the passive checker's warnings."""
+    return gym.make(env_id, disable_env_checker=True, **kwargs)

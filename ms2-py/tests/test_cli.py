@@ -1,0 +1,62 @@
+"""The ``ms2`` command line."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+
+from conftest import ENV_IDS, MAIN_ID
+from ms2.cli import main
+
+
+def test_envs_lists_tasks(capsys):
+    assert main(["envs"]) == 0
+    assert capsys.readouterr().out.split() == ENV_IDS
+
+
+def test_run_scripted_prints_success_rate_and_speed(capsys):
+    assert main(["run", MAIN_ID, "--policy", "scripted", "--episodes", "2"]) == 0
+    out = capsys.readouterr().out
+    m = re.search(
+        r"success rate (\d+)/2 = ([\d.]+) %, (\d+) env steps in [\d.]+ s = (\d+) steps/s", out
+    )
+    assert m, out
+    assert int(m.group(1)) >= 1
+    assert int(m.group(3)) > 0 and int(m.group(4)) > 0
+
+
+def test_run_random_and_bad_env(capsys):
+    assert main(["run", ENV_IDS[-1], "--policy", "random", "--episodes", "1"]) == 0
+    assert "success rate 0/1" in capsys.readouterr().out
+    assert main(["run", "NoSuchEnv-v0", "--episodes", "1"]) == 2
+    assert MAIN_ID in capsys.readouterr().err
+
+
+def test_python_dash_m_and_bench_smoke():
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "ms2",
+            "bench",
+            "--steps",
+            "40",
+            "--num-envs",
+            "2",
+            "--env-id",
+            MAIN_ID,
+            "--control-modes",
+            "pd_joint_delta_pos",
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    ).stdout
+    rows = [line for line in out.splitlines() if line.startswith("pd_joint_delta_pos")]
+    assert len(rows) == 2, out
+    assert "make_vec(2)" in rows[1]
+    for row in rows:
+        steps_per_s, peak_rss = float(row.split()[-4]), float(row.split()[-1])
+        assert steps_per_s > 0 and peak_rss > 10

@@ -1,0 +1,47 @@
+"""The scripted (oracle) policies solve their tasks through the gymnasium API."""
+
+from __future__ import annotations
+
+import ms2
+import pytest
+from conftest import MAIN_ID, make, preferred_control_mode
+
+#: Episodes per task; the success-rate floor leaves room for the odd hard initial state.
+EPISODES = 10
+MIN_SUCCESS_RATE = 0.8
+
+
+def test_scripted_policy_success_rate(env_id):
+    env = make(env_id, obs_mode="state", control_mode=preferred_control_mode(env_id))
+    policy = ms2.ScriptedPolicy(env)
+    successes = 0
+    for seed in range(EPISODES):
+        env.reset(seed=seed)
+        policy.reset()
+        while True:
+            _, _, terminated, truncated, info = env.step(policy.act())
+            if terminated or truncated:
+                break
+        successes += bool(info["success"])
+    assert successes / EPISODES >= MIN_SUCCESS_RATE, f"{env_id}: {successes}/{EPISODES}"
+
+
+def test_random_policy_rarely_succeeds():
+    env = make(MAIN_ID, obs_mode="state", control_mode=preferred_control_mode(MAIN_ID))
+    successes = 0
+    for seed in range(3):
+        env.reset(seed=seed)
+        env.action_space.seed(seed)
+        while True:
+            _, _, terminated, truncated, info = env.step(env.action_space.sample())
+            if terminated or truncated:
+                break
+        successes += bool(info["success"])
+    assert successes == 0
+
+
+def test_scripted_policy_needs_an_ms2_env():
+    import gymnasium as gym
+
+    with pytest.raises(TypeError, match="ms2 env"):
+        ms2.ScriptedPolicy(gym.make("CartPole-v1"))

@@ -1,0 +1,165 @@
+//! Camera images per second at 128×128: one camera per submission versus 2 cameras × 16 scenes
+//! batched in one submission, for a light (~2 k triangles) and a heavy (~70 k triangles) scene.
+//! Also pipelined batches (submit the next batch before collecting the previous one), as an
+//! environment does when it steps physics while the previous step's images render.
+//!
+//! `cargo bench -p ms2-render` (prints a table; set `MS2_RENDER_BACKEND=gl` for the GL backend,
+//! `MS2_RENDER_BENCH_SECONDS` to change the time per measurement, default 3).
+
+use ms2_render::*;
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
+use std::time::{Duration, Instant};
+
+/// A tabletop: ground, a cube and `spheres` spheres of `segments` × `segments / 2` quads
+/// (a stand-in for robot link meshes).
+fn tabletop(renderer: &Renderer, spheres: usize, segments: u32) -> Scene {
+    let ground = renderer.add_mesh(&MeshData::plane(1.0, 1.0)).unwrap();
+    let cube = renderer
+        .add_mesh(&MeshData::cuboid([0.02, 0.02, 0.02]))
+        .unwrap();
+    let sphere = renderer
+        .add_mesh(&MeshData::sphere(0.03, segments, segments / 2))
+        .unwrap();
+    let mut scene = Scene::new();
+    let ids = |k| SegmentationIds { actor: k, link: k };
+    scene.add_instance(Instance::new(
+        ground,
+        Material::color(0.6, 0.6, 0.6),
+        Isometry3::identity(),
+        ids(1),
+    ));
+    scene.add_instance(Instance::new(
+        cube,
+        Material::color(0.8, 0.1, 0.1),
+        Isometry3::translation(0.0, 0.0, 0.02),
+        ids(2),
+    ));
+    for k in 0..spheres {
+        let angle = k as f32 * 0.7;
+        scene.add_instance(Instance::new(
+            sphere,
+            Material::color(0.2, 0.3, 0.8),
+            Isometry3::from_parts(
+                Vector3::new(
+                    -0.4 + 0.2 * angle.cos(),
+                    0.2 * angle.sin(),
+                    0.05 + 0.04 * k as f32,
+                )
+                .into(),
+                UnitQuaternion::identity(),
+            ),
+            ids(3 + k as u32),
+        ));
+    }
+    scene
+}
+
+fn cameras() -> [Camera; 2] {
+    let camera = Camera::new(128, 128, std::f32::consts::FRAC_PI_2, 0.01, 10.0);
+    [
+        camera.looking_at(
+            Point3::new(0.3, 0.0, 0.6),
+            Point3::new(-0.1, 0.0, 0.1),
+            Vector3::z(),
+        ),
+        camera.looking_at(
+            Point3::new(-0.2, 0.5, 0.4),
+            Point3::new(-0.1, 0.0, 0.1),
+            Vector3::z(),
+        ),
+    ]
+}
+
+/// Rate of `step` (which renders `images_per_step` images) over about `budget`, images/s.
+fn rate(budget: Duration, images_per_step: usize, step: &mut dyn FnMut()) -> f64 {
+    let start = Instant::now();
+    let mut steps = 0;
+    while start.elapsed() < budget || steps < 2 {
+        step();
+        steps += 1;
+    }
+    (steps * images_per_step) as f64 / start.elapsed().as_secs_f64()
+}
+
+/// A benchmarked way of rendering: its label, images per step, and the step.
+type Mode<'a> = (&'static str, usize, Box<dyn FnMut() + 'a>);
+
+/// Measures all modes side by side: `rounds` rounds, each running every mode for `budget` in
+/// turn; returns each mode's best round (robust to other load on the machine).
+fn measure_side_by_side(rounds: usize, budget: Duration, modes: &mut [Mode<'_>]) -> Vec<f64> {
+    for (_, _, step) in modes.iter_mut() {
+        step(); // warm-up: allocates pooled buffers
+    }
+    let mut best = vec![0.0f64; modes.len()];
+    for _ in 0..rounds {
+        for (k, (_, images, step)) in modes.iter_mut().enumerate() {
+            best[k] = best[k].max(rate(budget, *images, step.as_mut()));
+        }
+    }
+    best
+}
+
+fn main() {
+    // `cargo bench` passes `--bench`; nothing else is parsed.
+    let seconds: f64 = std::env::var("MS2_RENDER_BENCH_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3.0);
+    let rounds = 5;
+    let budget = Duration::from_secs_f64(seconds / rounds as f64);
+    let renderer = Renderer::new(RendererConfig::default()).expect("a render adapter");
+    let a = renderer.adapter();
+    println!(
+        "adapter: {} ({}, {}), {}",
+        a.name, a.backend, a.device_type, a.driver
+    );
+    println!("128x128 images; best of {rounds} interleaved rounds, {seconds} s per mode in all");
+    println!(
+        "{:<8} {:>10}  {:<46} {:>9} {:>7}",
+        "scene", "triangles", "mode", "images/s", "ratio"
+    );
+    let [cam0, cam1] = cameras();
+    let cams = [cam0, cam1];
+    for (label, spheres, segments) in [("light", 8, 16), ("heavy", 12, 96)] {
+        let template = tabletop(&renderer, spheres, segments);
+        let triangles = template.triangle_count(&renderer);
+        let scenes: Vec<Scene> = (0..16).map(|_| template.clone()).collect();
+        let views: Vec<(&Scene, &[Camera])> = scenes.iter().map(|s| (s, &cams[..])).collect();
+        let mut modes: Vec<Mode<'_>> = vec![
+            (
+                "1 camera per submission",
+                1,
+                Box::new(|| {
+                    renderer.render(&[(&template, &[cam0][..])]).unwrap();
+                }),
+            ),
+            (
+                "2 cameras x 16 scenes, one submission",
+                32,
+                Box::new(|| {
+                    renderer.render(&views).unwrap();
+                }),
+            ),
+            (
+                "same, 4 batches pipelined (submit k+1, wait k)",
+                4 * 32,
+                Box::new(|| {
+                    let mut pending = renderer.submit(&views).unwrap();
+                    for _ in 1..4 {
+                        let next = renderer.submit(&views).unwrap();
+                        pending.wait().unwrap();
+                        pending = next;
+                    }
+                    pending.wait().unwrap();
+                }),
+            ),
+        ];
+        let rates = measure_side_by_side(rounds, budget, &mut modes);
+        for ((name, _, _), rate) in modes.iter().zip(&rates) {
+            println!(
+                "{label:<8} {triangles:>10}  {name:<46} {rate:>9.0} {:>7.2}",
+                rate / rates[0]
+            );
+        }
+    }
+}

@@ -1,0 +1,337 @@
+//! Batched rendering: many cameras of many scenes in one GPU submission, with pipelined readback.
+//!
+//! [`Renderer::submit`] encodes and submits one batch and returns at once with a
+//! [`PendingFrame`]; the GPU (or lavapipe's worker threads) renders while the caller steps
+//! physics, and [`PendingFrame::wait`] collects the images. Per-batch GPU objects (targets,
+//! uniform, instance and readback buffers) are pooled by batch shape and reused. Each camera
+//! has its own small targets and render pass: on lavapipe that beat one shared atlas texture
+//! (llvmpipe bins per-draw state into every tile of a render pass's framebuffer).
+
+use crate::renderer::{Renderer, ResourceStore, CAMERA_BLOCK_BYTES, INSTANCE_BYTES};
+use crate::scene::MAX_DIRECTIONAL_LIGHTS;
+use crate::targets::{linear_to_srgb8, CameraTargets, FrameResources};
+use crate::{Camera, CameraOutput, RenderError, Scene};
+use std::sync::{Arc, Mutex};
+
+/// One instance to draw: which mesh, which texture (if any), which instance record.
+struct Draw {
+    mesh: usize,
+    texture: Option<usize>,
+    record: u64,
+}
+
+/// Packs an instance's per-draw data (see `VertexIn` in `shader.wgsl`).
+fn instance_record(instance: &crate::Instance) -> [u32; 32] {
+    let rot = instance.pose_world_from_mesh.rotation.to_rotation_matrix();
+    let r = rot.matrix();
+    let t = instance.pose_world_from_mesh.translation.vector;
+    let s = instance.scale;
+    let mut words = [0u32; 32];
+    for i in 0..3 {
+        for j in 0..3 {
+            words[4 * i + j] = (r[(i, j)] * s[j]).to_bits();
+            words[12 + 4 * i + j] = (r[(i, j)] / s[j]).to_bits();
+        }
+        words[4 * i + 3] = t[i].to_bits();
+    }
+    for (k, c) in instance.material.base_color.iter().enumerate() {
+        words[24 + k] = c.to_bits();
+    }
+    words[28] = instance.segmentation.actor;
+    words[29] = instance.segmentation.link;
+    words
+}
+
+/// Packs a camera's uniform block (see `CameraBlock` in `shader.wgsl`).
+fn camera_block(camera: &Camera, scene: &Scene) -> [u32; 64] {
+    let mut words = [0u32; 64];
+    let put = |words: &mut [u32; 64], at: usize, values: &[f32]| {
+        for (k, v) in values.iter().enumerate() {
+            words[at + k] = v.to_bits();
+        }
+    };
+    put(&mut words, 0, camera.clip_from_world().as_slice()); // column-major
+    let pose = camera.pose_world_from_camera_gl;
+    let eye = pose.translation.vector;
+    let forward = pose.rotation * -nalgebra::Vector3::z();
+    put(&mut words, 16, &[eye.x, eye.y, eye.z, 1.0]);
+    put(&mut words, 20, &[forward.x, forward.y, forward.z, 0.0]);
+    let l = &scene.lighting;
+    put(
+        &mut words,
+        24,
+        &[l.ambient[0], l.ambient[1], l.ambient[2], 0.0],
+    );
+    for (k, light) in l
+        .directional
+        .iter()
+        .take(MAX_DIRECTIONAL_LIGHTS)
+        .enumerate()
+    {
+        let d = light.direction_world.normalize();
+        put(&mut words, 28 + 4 * k, &[d.x, d.y, d.z, 0.0]);
+        put(
+            &mut words,
+            44 + 4 * k,
+            &[light.color[0], light.color[1], light.color[2], 0.0],
+        );
+    }
+    words[60] = l.directional.len().min(MAX_DIRECTIONAL_LIGHTS) as u32;
+    words
+}
+
+/// Outcome of the readback buffer's mapping, set by wgpu's callback.
+type MapState = Arc<Mutex<Option<Result<(), wgpu::BufferAsyncError>>>>;
+
+/// A submitted batch whose images are still being rendered or copied back.
+/// Collect them with [`PendingFrame::wait`]; dropping it discards them.
+pub struct PendingFrame {
+    renderer: Renderer,
+    /// `None` for an empty batch.
+    work: Option<(FrameResources, wgpu::SubmissionIndex, MapState)>,
+    cameras: Vec<Camera>,
+    /// Background colour of each camera's scene, sRGB.
+    backgrounds: Vec<[u8; 3]>,
+}
+
+impl Renderer {
+    /// Renders every camera of every scene, in one submission, and waits for the images.
+    /// Outputs are in order: all cameras of the first scene, then of the second, and so on.
+    pub fn render(&self, views: &[(&Scene, &[Camera])]) -> Result<Vec<CameraOutput>, RenderError> {
+        self.submit(views)?.wait()
+    }
+
+    /// Encodes and submits one batch (as [`Renderer::render`]) without waiting: the caller may
+    /// step physics while it renders, then call [`PendingFrame::wait`].
+    pub fn submit(&self, views: &[(&Scene, &[Camera])]) -> Result<PendingFrame, RenderError> {
+        let mut cameras = Vec::new();
+        let mut camera_scene = Vec::new();
+        for (scene_index, (scene, scene_cameras)) in views.iter().enumerate() {
+            scene.validate()?;
+            for camera in scene_cameras.iter() {
+                camera.validate()?;
+                cameras.push(*camera);
+                camera_scene.push(scene_index);
+            }
+        }
+        if cameras.is_empty() {
+            return Ok(PendingFrame {
+                renderer: self.clone(),
+                work: None,
+                cameras,
+                backgrounds: Vec::new(),
+            });
+        }
+        let store = self
+            .inner
+            .store
+            .read()
+            .expect("resource store lock poisoned");
+        // Instance records of all scenes, and per scene the draws referring to them.
+        let mut records: Vec<[u32; 32]> = Vec::new();
+        let mut draws: Vec<Vec<Draw>> = Vec::with_capacity(views.len());
+        for (scene, _) in views {
+            let mut scene_draws = Vec::new();
+            for instance in scene.instances().iter().filter(|i| i.visible) {
+                scene_draws.push(check_draw(&store, instance, records.len() as u64)?);
+                records.push(instance_record(instance));
+            }
+            draws.push(scene_draws);
+        }
+        let sizes: Vec<(u32, u32)> = cameras.iter().map(|c| (c.width, c.height)).collect();
+        let taken = self
+            .inner
+            .pool
+            .lock()
+            .expect("frame pool lock poisoned")
+            .take(&sizes);
+        let mut resources = match taken {
+            Some(resources) => resources,
+            None => FrameResources::new(self, &sizes)?,
+        };
+        let gpu = &self.inner.gpu;
+        resources.ensure_instance_capacity(&gpu.device, records.len() as u64);
+        let instances = resources
+            .instances
+            .as_ref()
+            .expect("instance buffer allocated above");
+        if !records.is_empty() {
+            gpu.queue
+                .write_buffer(instances, 0, bytemuck::cast_slice(&records));
+        }
+        let mut uniform_bytes = vec![0u8; (gpu.uniform_stride as usize) * cameras.len()];
+        for (c, camera) in cameras.iter().enumerate() {
+            let block = camera_block(camera, views[camera_scene[c]].0);
+            let at = c * gpu.uniform_stride as usize;
+            uniform_bytes[at..at + CAMERA_BLOCK_BYTES as usize]
+                .copy_from_slice(bytemuck::cast_slice(&block));
+        }
+        gpu.queue
+            .write_buffer(&resources.uniforms, 0, &uniform_bytes);
+
+        let error_scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("ms2-render batch"),
+            });
+        for (c, targets) in resources.targets.iter().enumerate() {
+            let mut pass = begin_pass(&mut encoder, targets);
+            pass.set_pipeline(&gpu.pipeline);
+            let offset = (c as u64 * gpu.uniform_stride) as u32;
+            pass.set_bind_group(0, &resources.camera_bind_group, &[offset]);
+            for draw in &draws[camera_scene[c]] {
+                let mesh = &store.meshes[draw.mesh];
+                let texture = draw
+                    .texture
+                    .map_or(&gpu.white_texture, |t| &store.textures[t]);
+                pass.set_bind_group(1, texture, &[]);
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                let start = draw.record * INSTANCE_BYTES;
+                pass.set_vertex_buffer(1, instances.slice(start..start + INSTANCE_BYTES));
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+            }
+        }
+        resources.encode_copies(&mut encoder);
+        drop(store);
+        let submission = gpu.queue.submit([encoder.finish()]);
+        if let Some(error) = pollster::block_on(error_scope.pop()) {
+            return Err(RenderError::Gpu(error.to_string()));
+        }
+        let map_state: MapState = Arc::new(Mutex::new(None));
+        let callback_state = Arc::clone(&map_state);
+        resources
+            .readback
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |result| {
+                *callback_state.lock().expect("map state lock poisoned") = Some(result);
+            });
+        let backgrounds = camera_scene
+            .iter()
+            .map(|&k| views[k].0.lighting.background.map(linear_to_srgb8))
+            .collect();
+        Ok(PendingFrame {
+            renderer: self.clone(),
+            work: Some((resources, submission, map_state)),
+            cameras,
+            backgrounds,
+        })
+    }
+}
+
+/// Begins a camera's render pass, clearing its targets.
+fn begin_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    targets: &CameraTargets,
+) -> wgpu::RenderPass<'e> {
+    let clear = |view, value| {
+        Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(value),
+                store: wgpu::StoreOp::Store,
+            },
+        })
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("ms2-render camera"),
+        color_attachments: &[
+            clear(&targets.color_view, wgpu::Color::BLACK),
+            clear(&targets.gbuffer_view, wgpu::Color::TRANSPARENT),
+        ],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &targets.depth_view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
+/// Resolves an instance's mesh and texture handles against the store.
+fn check_draw(
+    store: &ResourceStore,
+    instance: &crate::Instance,
+    record: u64,
+) -> Result<Draw, RenderError> {
+    let mesh = instance.mesh.0 as usize;
+    if mesh >= store.meshes.len() {
+        return Err(RenderError::UnknownMesh(
+            instance.mesh.0,
+            store.meshes.len(),
+        ));
+    }
+    let texture = match instance.material.texture {
+        Some(t) if t.0 as usize >= store.textures.len() => {
+            return Err(RenderError::UnknownTexture(t.0, store.textures.len()))
+        }
+        Some(t) => Some(t.0 as usize),
+        None => None,
+    };
+    Ok(Draw {
+        mesh,
+        texture,
+        record,
+    })
+}
+
+impl PendingFrame {
+    /// Whether the images are ready (never blocks).
+    pub fn is_ready(&self) -> bool {
+        match &self.work {
+            None => true,
+            Some((_, _, state)) => {
+                let _ = self.renderer.inner.gpu.device.poll(wgpu::PollType::Poll);
+                state.lock().expect("map state lock poisoned").is_some()
+            }
+        }
+    }
+
+    /// Blocks until the batch is rendered and copied back, and returns one output per camera in
+    /// submission order.
+    pub fn wait(mut self) -> Result<Vec<CameraOutput>, RenderError> {
+        let Some((resources, submission, state)) = self.work.take() else {
+            return Ok(Vec::new());
+        };
+        let device = &self.renderer.inner.gpu.device;
+        let mapped = loop {
+            if let Some(result) = state.lock().expect("map state lock poisoned").take() {
+                break result;
+            }
+            device
+                .poll(wgpu::PollType::Wait {
+                    submission_index: Some(submission.clone()),
+                    timeout: None,
+                })
+                .map_err(|e| RenderError::Gpu(e.to_string()))?;
+        };
+        mapped.map_err(|e| RenderError::Gpu(format!("reading images back failed: {e}")))?;
+        let outputs = {
+            let view = resources
+                .readback
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| RenderError::Gpu(format!("reading images back failed: {e}")))?;
+            let bytes: &[u8] = &view;
+            (0..self.cameras.len())
+                .map(|c| resources.targets[c].decode(bytes, self.cameras[c], self.backgrounds[c]))
+                .collect()
+        };
+        resources.readback.unmap();
+        self.renderer
+            .inner
+            .pool
+            .lock()
+            .expect("frame pool lock poisoned")
+            .give(resources);
+        Ok(outputs)
+    }
+}

@@ -1,0 +1,218 @@
+//! Scenes: instances of shared meshes with poses, materials and segmentation ids, plus lights.
+//!
+//! A [`Scene`] is plain CPU data owned by its caller (one per environment); it holds handles to
+//! meshes and textures stored once in the [`crate::Renderer`], so many scenes share one GPU copy
+//! of each asset. Per frame, callers update poses only ([`Scene::set_pose`]).
+
+use crate::{MeshHandle, RenderError, TextureHandle};
+use nalgebra::{Isometry3, Vector3};
+
+/// Surface appearance: a base colour, optionally multiplied by a texture.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// Linear RGBA base colour, each channel in `[0, 1]` (alpha is ignored: surfaces are opaque).
+    pub base_color: [f32; 4],
+    /// Optional texture (sRGB) sampled with the mesh's uvs and multiplied with `base_color`.
+    pub texture: Option<TextureHandle>,
+}
+
+impl Material {
+    /// An untextured material of the given linear RGB colour.
+    pub fn color(r: f32, g: f32, b: f32) -> Material {
+        Material {
+            base_color: [r, g, b, 1.0],
+            texture: None,
+        }
+    }
+}
+
+/// Segmentation ids written to the segmentation images where an instance is visible.
+/// 0 is reserved for background: use ids ≥ 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub struct SegmentationIds {
+    /// Id of the actor: a whole object or articulation (e.g. the robot, a cube).
+    pub actor: u32,
+    /// Id of the rigid link: one link of an articulation, or the actor itself for single bodies.
+    pub link: u32,
+}
+
+/// One placed copy of a mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Instance {
+    /// Which shared mesh to draw.
+    pub mesh: MeshHandle,
+    /// Its appearance.
+    pub material: Material,
+    /// Pose of the mesh's local frame in the world.
+    pub pose_world_from_mesh: Isometry3<f32>,
+    /// Scale applied along the mesh's local axes before the pose (1 = as stored).
+    pub scale: Vector3<f32>,
+    /// Ids written to the segmentation images.
+    pub segmentation: SegmentationIds,
+    /// Whether the instance is drawn (hidden instances keep their slot).
+    pub visible: bool,
+}
+
+impl Instance {
+    /// A visible instance at the given pose with unit scale.
+    pub fn new(
+        mesh: MeshHandle,
+        material: Material,
+        pose_world_from_mesh: Isometry3<f32>,
+        segmentation: SegmentationIds,
+    ) -> Instance {
+        Instance {
+            mesh,
+            material,
+            pose_world_from_mesh,
+            scale: Vector3::new(1.0, 1.0, 1.0),
+            segmentation,
+            visible: true,
+        }
+    }
+
+    /// This instance with a scale along its local axes.
+    pub fn with_scale(mut self, scale: Vector3<f32>) -> Instance {
+        self.scale = scale;
+        self
+    }
+}
+
+/// Index of an instance within its [`Scene`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct InstanceId(pub u32);
+
+/// A directional light such as the sun.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalLight {
+    /// Direction the light travels in (from the light towards the scene), world frame; need not
+    /// be normalised but must be non-zero.
+    pub direction_world: Vector3<f32>,
+    /// Linear RGB intensity.
+    pub color: [f32; 3],
+}
+
+/// Maximum number of directional lights per scene.
+pub const MAX_DIRECTIONAL_LIGHTS: usize = 4;
+
+/// Lights and background of a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lighting {
+    /// Linear RGB ambient light.
+    pub ambient: [f32; 3],
+    /// Up to [`MAX_DIRECTIONAL_LIGHTS`] directional lights.
+    pub directional: Vec<DirectionalLight>,
+    /// Linear RGB colour of background pixels.
+    pub background: [f32; 3],
+}
+
+impl Default for Lighting {
+    /// ManiSkill2-like defaults: ambient 0.3, a sun from above-front, a dimmer fill light and a
+    /// black background.
+    fn default() -> Lighting {
+        Lighting {
+            ambient: [0.3, 0.3, 0.3],
+            directional: vec![
+                DirectionalLight {
+                    direction_world: Vector3::new(0.0, 1.0, -1.0),
+                    color: [1.0, 1.0, 1.0],
+                },
+                DirectionalLight {
+                    direction_world: Vector3::new(0.0, 0.0, -1.0),
+                    color: [0.5, 0.5, 0.5],
+                },
+            ],
+            background: [0.0, 0.0, 0.0],
+        }
+    }
+}
+
+/// Everything that is drawn for one environment: instances and lighting.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Scene {
+    instances: Vec<Instance>,
+    /// Lights and background colour.
+    pub lighting: Lighting,
+}
+
+impl Scene {
+    /// An empty scene with default lighting.
+    pub fn new() -> Scene {
+        Scene::default()
+    }
+
+    /// Adds an instance and returns its id.
+    pub fn add_instance(&mut self, instance: Instance) -> InstanceId {
+        self.instances.push(instance);
+        InstanceId(self.instances.len() as u32 - 1)
+    }
+
+    /// All instances, indexed by [`InstanceId`].
+    pub fn instances(&self) -> &[Instance] {
+        &self.instances
+    }
+
+    /// Mutable access to one instance.
+    pub fn instance_mut(&mut self, id: InstanceId) -> Result<&mut Instance, RenderError> {
+        let n = self.instances.len();
+        self.instances.get_mut(id.0 as usize).ok_or_else(|| {
+            RenderError::InvalidScene(format!("instance id {} out of range (scene has {n})", id.0))
+        })
+    }
+
+    /// Moves an instance: the per-frame update.
+    pub fn set_pose(
+        &mut self,
+        id: InstanceId,
+        pose_world_from_mesh: Isometry3<f32>,
+    ) -> Result<(), RenderError> {
+        self.instance_mut(id)?.pose_world_from_mesh = pose_world_from_mesh;
+        Ok(())
+    }
+
+    /// Shows or hides an instance.
+    pub fn set_visible(&mut self, id: InstanceId, visible: bool) -> Result<(), RenderError> {
+        self.instance_mut(id)?.visible = visible;
+        Ok(())
+    }
+
+    /// Total number of triangles drawn per camera, given the renderer's meshes.
+    pub fn triangle_count(&self, renderer: &crate::Renderer) -> usize {
+        self.instances
+            .iter()
+            .filter(|i| i.visible)
+            .map(|i| renderer.mesh_triangle_count(i.mesh).unwrap_or(0))
+            .sum()
+    }
+
+    /// Checks lights and instance values for finiteness and range.
+    pub(crate) fn validate(&self) -> Result<(), RenderError> {
+        let l = &self.lighting;
+        if l.directional.len() > MAX_DIRECTIONAL_LIGHTS {
+            return Err(RenderError::InvalidScene(format!(
+                "{} directional lights, at most {MAX_DIRECTIONAL_LIGHTS} supported",
+                l.directional.len()
+            )));
+        }
+        for light in &l.directional {
+            let d = light.direction_world;
+            if !(d.iter().all(|v| v.is_finite()) && d.norm() > 0.0) {
+                return Err(RenderError::InvalidScene(format!(
+                    "light direction {d:?} must be finite and non-zero"
+                )));
+            }
+        }
+        for (k, inst) in self.instances.iter().enumerate() {
+            let m = inst.pose_world_from_mesh.to_homogeneous();
+            if !(m.iter().all(|v| v.is_finite())
+                && inst.scale.iter().all(|v| v.is_finite() && *v != 0.0))
+            {
+                return Err(RenderError::InvalidScene(format!(
+                    "instance {k}: pose and scale must be finite and scale non-zero (scale {:?})",
+                    inst.scale
+                )));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,94 @@
+// ms2-render: one forward pass writing shaded colour and a G-buffer of
+// (linear depth bits, actor id, link id, coverage) per pixel.
+
+struct CameraBlock {
+    clip_from_world: mat4x4<f32>,
+    eye_world: vec4<f32>,
+    // Unit viewing direction (OpenGL camera -z) in the world frame.
+    forward_world: vec4<f32>,
+    ambient: vec4<f32>,
+    // xyz: direction the light travels (normalised), w unused.
+    light_direction: array<vec4<f32>, 4>,
+    light_color: array<vec4<f32>, 4>,
+    // x: number of lights.
+    counts: vec4<u32>,
+};
+
+@group(0) @binding(0) var<uniform> camera: CameraBlock;
+@group(1) @binding(0) var base_texture: texture_2d<f32>;
+@group(1) @binding(1) var base_sampler: sampler;
+
+struct VertexIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    // Rows of the 3x4 world-from-mesh matrix (scale included).
+    @location(3) model_row0: vec4<f32>,
+    @location(4) model_row1: vec4<f32>,
+    @location(5) model_row2: vec4<f32>,
+    // Rows of the 3x3 normal matrix (inverse transpose), padded.
+    @location(6) normal_row0: vec4<f32>,
+    @location(7) normal_row1: vec4<f32>,
+    @location(8) normal_row2: vec4<f32>,
+    @location(9) base_color: vec4<f32>,
+    // x: actor id, y: link id.
+    @location(10) ids: vec4<u32>,
+};
+
+struct VertexOut {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) world_normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) view_depth: f32,
+    @location(4) base_color: vec4<f32>,
+    @location(5) @interpolate(flat) ids: vec4<u32>,
+};
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    let p = vec4<f32>(v.position, 1.0);
+    let world = vec3<f32>(dot(v.model_row0, p), dot(v.model_row1, p), dot(v.model_row2, p));
+    let n = vec3<f32>(
+        dot(v.normal_row0.xyz, v.normal),
+        dot(v.normal_row1.xyz, v.normal),
+        dot(v.normal_row2.xyz, v.normal),
+    );
+    var out: VertexOut;
+    out.clip_position = camera.clip_from_world * vec4<f32>(world, 1.0);
+    out.world_position = world;
+    out.world_normal = n;
+    out.uv = v.uv;
+    // Depth along the optical axis, metres.
+    out.view_depth = dot(world - camera.eye_world.xyz, camera.forward_world.xyz);
+    out.base_color = v.base_color;
+    out.ids = v.ids;
+    return out;
+}
+
+struct FragmentOut {
+    @location(0) color: vec4<f32>,
+    @location(1) gbuffer: vec4<u32>,
+};
+
+@fragment
+fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
+    var n = normalize(in.world_normal);
+    if (!front) {
+        n = -n;
+    }
+    let albedo = in.base_color.rgb * textureSample(base_texture, base_sampler, in.uv).rgb;
+    let to_eye = normalize(camera.eye_world.xyz - in.world_position);
+    var light = camera.ambient.rgb * albedo;
+    for (var i = 0u; i < camera.counts.x; i = i + 1u) {
+        let l = -camera.light_direction[i].xyz;
+        let lambert = max(dot(n, l), 0.0);
+        let h = normalize(l + to_eye);
+        let specular = select(0.0, pow(max(dot(n, h), 0.0), 32.0), lambert > 0.0);
+        light = light + camera.light_color[i].rgb * (albedo * lambert + vec3<f32>(0.15 * specular));
+    }
+    var out: FragmentOut;
+    out.color = vec4<f32>(light, 1.0);
+    out.gbuffer = vec4<u32>(bitcast<u32>(in.view_depth), in.ids.x, in.ids.y, 1u);
+    return out;
+}
