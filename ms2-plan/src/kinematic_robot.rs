@@ -69,7 +69,12 @@ impl KinematicRobot {
             )));
         }
         let mut limits = Vec::with_capacity(chain.dof());
-        for ((l, name), &acc) in chain.limits().iter().zip(chain.joint_names()).zip(max_accelerations) {
+        for ((l, name), &acc) in chain
+            .limits()
+            .iter()
+            .zip(chain.joint_names())
+            .zip(max_accelerations)
+        {
             if !(l.velocity.is_finite() && l.velocity > 0.0) {
                 return Err(PlanError::RobotDescription(format!(
                     "joint {name} has no finite velocity limit ({}), expected > 0",
@@ -93,7 +98,13 @@ impl KinematicRobot {
         let model_q = model
             .dof_limits()
             .iter()
-            .map(|l| if l.lower.is_finite() && l.upper.is_finite() { 0.5 * (l.lower + l.upper) } else { 0.0 })
+            .map(|l| {
+                if l.lower.is_finite() && l.upper.is_finite() {
+                    0.5 * (l.lower + l.upper)
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let mut links = Vec::with_capacity(model.link_names().len());
         for name in model.link_names() {
@@ -105,7 +116,11 @@ impl KinematicRobot {
                 .position(|l| l.name == name)
                 .ok_or_else(|| PlanError::UnknownLink {
                     name: name.to_owned(),
-                    known: links.iter().map(|l| l.name.as_str()).collect::<Vec<_>>().join(", "),
+                    known: links
+                        .iter()
+                        .map(|l| l.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
                 })
         };
         let mut skip = Vec::new();
@@ -166,7 +181,11 @@ impl KinematicRobot {
     /// [`PlanError::NonFinite`] for a non-finite value.
     pub fn set_held_joint(&mut self, name: &str, value: f64) -> Result<(), PlanError> {
         if !value.is_finite() {
-            return Err(PlanError::NonFinite { what: "held joint value", index: 0, value });
+            return Err(PlanError::NonFinite {
+                what: "held joint value",
+                index: 0,
+                value,
+            });
         }
         let index = self.model.dof_index(name).ok_or_else(|| {
             PlanError::RobotDescription(format!(
@@ -214,7 +233,12 @@ impl KinematicRobot {
             .position(|l| l.name == name)
             .ok_or_else(|| PlanError::UnknownLink {
                 name: name.to_owned(),
-                known: self.links.iter().map(|l| l.name.as_str()).collect::<Vec<_>>().join(", "),
+                known: self
+                    .links
+                    .iter()
+                    .map(|l| l.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
             })
     }
 
@@ -225,7 +249,11 @@ impl KinematicRobot {
         let mut candidates: Option<Vec<(usize, usize)>> = None;
         let mut poses = Vec::new();
         for _ in 0..samples {
-            let q: Vec<f64> = self.limits.iter().map(|l| rng.random_range(l.lower..=l.upper)).collect();
+            let q: Vec<f64> = self
+                .limits
+                .iter()
+                .map(|l| rng.random_range(l.lower..=l.upper))
+                .collect();
             self.link_poses(&q, &mut poses);
             let colliding = self.colliding_link_pairs(&poses);
             candidates = Some(match candidates {
@@ -242,20 +270,42 @@ impl KinematicRobot {
             .links
             .iter()
             .zip(poses_base_from_link)
-            .map(|(l, p)| l.shapes.iter().map(|s| pose_to_parry(&(p * s.pose_link_from_shape))).collect())
+            .map(|(l, p)| {
+                l.shapes
+                    .iter()
+                    .map(|s| pose_to_parry(&(p * s.pose_link_from_shape)))
+                    .collect()
+            })
             .collect();
         let mut pairs = Vec::new();
         for a in 0..self.links.len() {
             for b in (a + 1)..self.links.len() {
-                if self.skip.iter().any(|&(x, y)| (x, y) == (a, b) || (y, x) == (a, b)) {
+                if self
+                    .skip
+                    .iter()
+                    .any(|&(x, y)| (x, y) == (a, b) || (y, x) == (a, b))
+                {
                     continue;
                 }
-                let hit = self.links[a].shapes.iter().zip(&shape_poses[a]).any(|(sa, pa)| {
-                    self.links[b].shapes.iter().zip(&shape_poses[b]).any(|(sb, pb)| {
-                        parry3d::query::intersection_test(pa, sa.shape.as_ref(), pb, sb.shape.as_ref())
-                            .is_ok_and(|r| r.intersecting)
-                    })
-                });
+                let hit = self.links[a]
+                    .shapes
+                    .iter()
+                    .zip(&shape_poses[a])
+                    .any(|(sa, pa)| {
+                        self.links[b]
+                            .shapes
+                            .iter()
+                            .zip(&shape_poses[b])
+                            .any(|(sb, pb)| {
+                                parry3d::query::intersection_test(
+                                    pa,
+                                    sa.shape.as_ref(),
+                                    pb,
+                                    sb.shape.as_ref(),
+                                )
+                                .is_ok_and(|r| r.intersecting)
+                            })
+                    });
                 if hit {
                     pairs.push((a, b));
                 }
@@ -268,7 +318,11 @@ impl KinematicRobot {
     ///
     /// # Errors
     /// As [`CollisionChecker::new`].
-    pub fn checker(&self, scene: &CollisionScene, options: CheckerOptions) -> Result<CollisionChecker<'_, Self>, PlanError> {
+    pub fn checker(
+        &self,
+        scene: &CollisionScene,
+        options: CheckerOptions,
+    ) -> Result<CollisionChecker<'_, Self>, PlanError> {
         CollisionChecker::new(self, scene, options)
     }
 }
@@ -303,14 +357,20 @@ impl PlanningRobot for KinematicRobot {
     }
 
     fn tcp_pose(&self, q: &[f64]) -> Isometry3<f64> {
-        self.chain.forward_kinematics(q).unwrap_or_else(|_| Isometry3::identity())
+        self.chain
+            .forward_kinematics(q)
+            .unwrap_or_else(|_| Isometry3::identity())
     }
 
     fn grasp_link(&self) -> usize {
         self.carrier_link
     }
 
-    fn inverse_kinematics(&self, pose_base_from_tcp: &Isometry3<f64>, seed: &[f64]) -> Result<Vec<f64>, PlanError> {
+    fn inverse_kinematics(
+        &self,
+        pose_base_from_tcp: &Isometry3<f64>,
+        seed: &[f64],
+    ) -> Result<Vec<f64>, PlanError> {
         self.ik
             .solve(&self.chain, pose_base_from_tcp, seed, None)
             .map(|s| s.q)
