@@ -6,8 +6,8 @@ mod planar_arm;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use ms2_plan::{
-    CheckerOptions, CollisionChecker, CollisionScene, CubicSplinePath, MotionPlanner,
-    PlannerConfig, PlanningRobot,
+    find_grasps, CheckerOptions, CollisionChecker, CollisionScene, CubicSplinePath, GripperSpec,
+    KinematicRobot, MotionPlanner, OrientedBox, PlannerConfig, PlanningRobot,
 };
 use nalgebra::{Isometry3, Vector3};
 use planar_arm::PlanarArm;
@@ -57,10 +57,17 @@ fn panda_queries(c: &mut Criterion) {
     scene.add_ground("ground", 0.0).expect("fresh scene");
     scene.allow_collision("panda_link0", "ground");
     scene
-        .add_box("post", Vector3::new(0.08, 0.08, 0.25), Isometry3::translation(0.6, 0.0, 0.125))
+        .add_box(
+            "post",
+            Vector3::new(0.08, 0.08, 0.25),
+            Isometry3::translation(0.6, 0.0, 0.125),
+        )
         .expect("unique name");
-    let checker = CollisionChecker::new(&panda, &scene, CheckerOptions::default()).expect("valid scene");
-    c.bench_function("panda/collision_check", |b| b.iter(|| checker.is_valid(&rest)));
+    let checker =
+        CollisionChecker::new(&panda, &scene, CheckerOptions::default()).expect("valid scene");
+    c.bench_function("panda/collision_check", |b| {
+        b.iter(|| checker.is_valid(&rest))
+    });
 
     let (mut start, mut goal) = (rest.clone(), rest.clone());
     start[0] = -1.2;
@@ -69,15 +76,21 @@ fn panda_queries(c: &mut Criterion) {
     c.bench_function("panda/plan_over_post (rrt+shortcut+timing)", |b| {
         b.iter(|| {
             seed += 1;
-            MotionPlanner::new(&panda, PlannerConfig { seed, ..Default::default() })
-                .expect("valid config")
-                .plan_to_configuration(&scene, &start, &goal)
-                .expect("plan found")
+            MotionPlanner::new(
+                &panda,
+                PlannerConfig {
+                    seed,
+                    ..Default::default()
+                },
+            )
+            .expect("valid config")
+            .plan_to_configuration(&scene, &start, &goal)
+            .expect("plan found")
         })
     });
 
     let from = panda.tcp_pose(&rest);
-    let down = nalgebra::Translation3::new(0.0, 0.1, -0.1) * from;
+    let down = Isometry3::translation(0.0, 0.1, -0.1) * from;
     c.bench_function("panda/screw_10cm (ik+timing)", |b| {
         b.iter(|| {
             MotionPlanner::new(&panda, PlannerConfig::default())
@@ -92,12 +105,23 @@ fn panda_queries(c: &mut Criterion) {
     cube_scene
         .add_box("cube", Vector3::new(0.04, 0.04, 0.04), cube_pose)
         .expect("unique name");
-    let cube = OrientedBox { pose_base_from_box: cube_pose, half_extents: Vector3::new(0.02, 0.02, 0.02) };
+    let cube = OrientedBox {
+        pose_base_from_box: cube_pose,
+        half_extents: Vector3::new(0.02, 0.02, 0.02),
+    };
     let gripper = GripperSpec::panda();
     c.bench_function("panda/find_grasps_cube", |b| {
         b.iter(|| {
-            find_grasps(&panda, &cube_scene, Some("cube"), &cube, &gripper, &rest, CheckerOptions::default())
-                .expect("reachable cube")
+            find_grasps(
+                &panda,
+                &cube_scene,
+                Some("cube"),
+                &cube,
+                &gripper,
+                &rest,
+                CheckerOptions::default(),
+            )
+            .expect("reachable cube")
         })
     });
 }
