@@ -13,8 +13,11 @@
 //! also remembers a full snapshot of the simulation, keyed by the exact bits of the returned
 //! vector, for the last [`SNAPSHOT_CACHE_LEN`] calls. [`World::set_state`] with such a vector
 //! (and no configuration change in between) restores that snapshot, so stepping afterwards
-//! reproduces the original run bit for bit. Any other vector is written body by body; the run
-//! from it is deterministic but starts with cold solver caches.
+//! reproduces the original run bit for bit. Any other vector is written body by body onto the
+//! simulation as it was when the world's configuration last changed (bodies added, drive gains,
+//! gravity, static poses, ...): the run from it depends only on the vector and that
+//! configuration, never on what was simulated since, so resetting to a saved vector always
+//! replays the same episode.
 
 use std::collections::VecDeque;
 
@@ -31,6 +34,8 @@ struct Snapshot {
     bits: Vec<u32>,
     generation: u64,
     sim: Box<Sim>,
+    /// Bodies carrying forces applied for the next step when the snapshot was taken.
+    forced: Vec<rapier3d::prelude::RigidBodyHandle>,
 }
 
 /// Recent snapshots taken by `get_state`.
@@ -107,6 +112,7 @@ impl World {
                 bits,
                 generation: self.generation,
                 sim: Box::new(self.sim.clone()),
+                forced: self.forced.clone(),
             });
         }
         out
@@ -127,13 +133,13 @@ impl World {
                 .find(|s| s.generation == self.generation && s.bits == bits)
             {
                 self.sim = (*s.sim).clone();
+                self.forced = s.forced.clone();
                 drop(cache);
-                self.forced.clear();
                 self.pipeline = rapier3d::prelude::PhysicsPipeline::new();
                 return Ok(());
             }
         }
-        // Validate quaternions before writing anything.
+        // Validate quaternions before writing anything (below).
         let mut offset = 0;
         let mut poses = Vec::new();
         for e in &self.table {
@@ -157,6 +163,18 @@ impl World {
                     value: format!("norm² {n} at index {}", o + 3),
                     expected: "unit quaternions (w, x, y, z)",
                 });
+            }
+        }
+        // Write onto the configuration's cold template, not onto the current run's caches.
+        self.ensure_cold_template();
+        let template = self.cold_template.as_ref().expect("just ensured");
+        self.sim = (*template.1).clone();
+        self.pipeline = rapier3d::prelude::PhysicsPipeline::new();
+        // The template may hold forces applied for the step it was taken before: drop them.
+        for e in &self.table {
+            if let Some(rb) = self.sim.bodies.get_mut(e.handle) {
+                rb.reset_forces(false);
+                rb.reset_torques(false);
             }
         }
         let mut o = 0;

@@ -70,33 +70,39 @@ fn cameras() -> [Camera; 2] {
     ]
 }
 
-/// Rate of `step` (which renders `images_per_step` images) over about `budget`, images/s.
-fn rate(budget: Duration, images_per_step: usize, step: &mut dyn FnMut()) -> f64 {
+/// Runs `step` for about `budget`; returns (steps done, seconds taken).
+fn run(budget: Duration, step: &mut dyn FnMut()) -> (usize, f64) {
     let start = Instant::now();
     let mut steps = 0;
     while start.elapsed() < budget || steps < 2 {
         step();
         steps += 1;
     }
-    (steps * images_per_step) as f64 / start.elapsed().as_secs_f64()
+    (steps, start.elapsed().as_secs_f64())
 }
 
 /// A benchmarked way of rendering: its label, images per step, and the step.
 type Mode<'a> = (&'static str, usize, Box<dyn FnMut() + 'a>);
 
 /// Measures all modes side by side: `rounds` rounds, each running every mode for `budget` in
-/// turn; returns each mode's best round (robust to other load on the machine).
+/// turn, so that other load on the machine hits all modes alike; returns images/s per mode
+/// over all its rounds.
 fn measure_side_by_side(rounds: usize, budget: Duration, modes: &mut [Mode<'_>]) -> Vec<f64> {
     for (_, _, step) in modes.iter_mut() {
         step(); // warm-up: allocates pooled buffers
     }
-    let mut best = vec![0.0f64; modes.len()];
+    let mut totals = vec![(0usize, 0.0f64); modes.len()];
     for _ in 0..rounds {
         for (k, (_, images, step)) in modes.iter_mut().enumerate() {
-            best[k] = best[k].max(rate(budget, *images, step.as_mut()));
+            let (steps, seconds) = run(budget, step.as_mut());
+            totals[k].0 += steps * *images;
+            totals[k].1 += seconds;
         }
     }
-    best
+    totals
+        .iter()
+        .map(|&(images, seconds)| images as f64 / seconds)
+        .collect()
 }
 
 fn main() {
@@ -113,7 +119,7 @@ fn main() {
         "adapter: {} ({}, {}), {}",
         a.name, a.backend, a.device_type, a.driver
     );
-    println!("128x128 images; best of {rounds} interleaved rounds, {seconds} s per mode in all");
+    println!("128x128 images; {rounds} interleaved rounds, {seconds} s per mode in all");
     println!(
         "{:<8} {:>10}  {:<46} {:>9} {:>7}",
         "scene", "triangles", "mode", "images/s", "ratio"
