@@ -5,7 +5,9 @@ use std::sync::Arc;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use super::{gather, per_joint, BuildContext, BuildError, PartController, PartConversion};
+use super::{
+    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+};
 use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
 use crate::kinematics::{
@@ -207,17 +209,7 @@ impl EePoseController {
             low.extend([-config.rot_bound; 3]);
             high.extend([config.rot_bound; 3]);
         }
-        if let Some(i) = (0..low.len())
-            .find(|&i| !(low[i] < high[i]) || !low[i].is_finite() || !high[i].is_finite())
-        {
-            return Err(BuildError::BadConfig {
-                controller: name.into(),
-                message: format!(
-                    "action bound {i} is [{}, {}]; bounds must be finite with low < high",
-                    low[i], high[i]
-                ),
-            });
-        }
+        check_bounds(name, &low, &high)?;
         if let EeIkSolver::Qp(QpIkOptions {
             max_displacement_from_seed: Some(d),
             ..
@@ -485,7 +477,7 @@ impl PartController for EePoseController {
         }
         if self.config.use_target {
             let q = nalgebra::Quaternion::new(state[3], state[4], state[5], state[6]);
-            if !(q.norm() > 0.0) || state.iter().any(|v| !v.is_finite()) {
+            if q.norm() <= 0.0 || q.norm().is_nan() || state.iter().any(|v| !v.is_finite()) {
                 return Err(format!(
                     "{}: target pose state {state:?} is not a valid pose",
                     self.config.name
