@@ -302,7 +302,7 @@ impl EePoseController {
         &self,
         target: &Isometry3<f64>,
         seed: &[f64],
-    ) -> Result<Vec<f64>, (IkError, Option<Vec<f64>>)> {
+    ) -> Result<(Vec<f64>, usize), (IkError, Option<Vec<f64>>)> {
         let result = match &self.config.ik {
             EeIkSolver::Dls(opts) => {
                 DlsIk::new(opts.clone()).solve(&self.chain, target, seed, Some(&self.free))
@@ -312,7 +312,7 @@ impl EePoseController {
             }
         };
         match result {
-            Ok(sol) => Ok(sol.q),
+            Ok(sol) => Ok((sol.q, sol.iterations)),
             Err(e) => {
                 let best = e.best().map(|b| b.q.clone());
                 Err((e, best))
@@ -365,8 +365,8 @@ impl PartController for EePoseController {
         let (dp, dr) = self.physical_delta(action);
         self.target_pose = self.config.frame.apply(&prev, &dp, &dr);
         let chain_q = match self.solve_ik(&self.target_pose, &seed) {
-            Ok(q) => {
-                self.last_ik = Some(report(&self.chain, &q, &self.target_pose, true, 0));
+            Ok((q, iterations)) => {
+                self.last_ik = Some(report(&self.chain, &q, &self.target_pose, true, iterations));
                 Some(q)
             }
             Err((err, best)) => {

@@ -107,8 +107,8 @@ pub enum IkError {
         limits_active: bool,
     },
     /// The QP solver reported a failure.
-    #[error("QP solver failed: {0}")]
-    QpSolver(String),
+    #[error("linear or QP solver failed: {0}")]
+    SolverFailed(String),
 }
 
 impl IkError {
@@ -383,9 +383,9 @@ impl StepRule for DlsRule {
                 jjt[(i, j)] + if i == j { lambda2 } else { 0.0 }
             });
             let mut rhs = Mat::<f64>::from_fn(6, 1, |i, _| err[i]);
-            let llt = a
-                .llt(Side::Lower)
-                .map_err(|e| IkError::QpSolver(format!("Cholesky of J·Jᵀ + λ²I failed: {e:?}")))?;
+            let llt = a.llt(Side::Lower).map_err(|e| {
+                IkError::SolverFailed(format!("Cholesky of J·Jᵀ + λ²I failed: {e:?}"))
+            })?;
             llt.solve_in_place(rhs.as_mut());
             let y = Vector6::from_fn(|i, _| rhs[(i, 0)]);
             let mut blocked = false;
@@ -520,13 +520,13 @@ impl StepRule for QpRule {
             .verbose(false)
             .presolve_enable(false)
             .build()
-            .map_err(|e| IkError::QpSolver(e.to_string()))?;
+            .map_err(|e| IkError::SolverFailed(e.to_string()))?;
         let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
-            .map_err(|e| IkError::QpSolver(e.to_string()))?;
+            .map_err(|e| IkError::SolverFailed(e.to_string()))?;
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {}
-            other => return Err(IkError::QpSolver(format!("clarabel status {other:?}"))),
+            other => return Err(IkError::SolverFailed(format!("clarabel status {other:?}"))),
         }
         // The interior-point solution can sit a hair outside the box: project it back.
         Ok(solver
