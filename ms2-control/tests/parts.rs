@@ -75,8 +75,8 @@ fn base_velocity_is_ego_centric() {
     let config = PartControllerConfig::BaseVelocity(BaseVelocityConfig {
         name: "base_pd_joint_vel".into(),
         joint_names: names,
-        lower: vec![-0.5, -0.5, -3.14],
-        upper: vec![0.5, 0.5, 3.14],
+        lower: vec![-0.5, -0.5, -3.0],
+        upper: vec![0.5, 0.5, 3.0],
         normalize_action: true,
         damping: 1000.0,
         force_limit: 500.0,
@@ -99,7 +99,7 @@ fn base_velocity_is_ego_centric() {
     ctrl.set_action(&mut robot, &[1.0, 0.5, -0.5]).unwrap();
     assert_relative_eq!(
         robot.velocity_targets[..],
-        [-0.25, 0.5, -1.57][..],
+        [-0.25, 0.5, -1.5][..],
         epsilon = 1e-12
     );
     // Conversion inverts it: reach (1 − 0.0125, 2.025) in one 0.05 s control step.

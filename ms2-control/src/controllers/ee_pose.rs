@@ -11,7 +11,7 @@ use super::{
 use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
 use crate::kinematics::{
-    DlsIk, IkError, IkOptions, KinematicChain, KinematicModel, QpIk, QpIkOptions,
+    DlsIk, IkError, IkOptions, IkSolution, KinematicChain, KinematicModel, QpIk, QpIkOptions,
 };
 
 /// The frame an end-effector delta `T_a = (Δp, exp([Δr]×))` is applied in. `T` is the previous
@@ -298,24 +298,13 @@ impl EePoseController {
         (dp, UnitQuaternion::from_scaled_axis(r))
     }
 
-    fn solve_ik(
-        &self,
-        target: &Isometry3<f64>,
-        seed: &[f64],
-    ) -> Result<(Vec<f64>, usize), (IkError, Option<Vec<f64>>)> {
-        let result = match &self.config.ik {
+    fn solve_ik(&self, target: &Isometry3<f64>, seed: &[f64]) -> Result<IkSolution, IkError> {
+        match &self.config.ik {
             EeIkSolver::Dls(opts) => {
                 DlsIk::new(opts.clone()).solve(&self.chain, target, seed, Some(&self.free))
             }
             EeIkSolver::Qp(opts) => {
                 QpIk::new(opts.clone()).solve(&self.chain, target, seed, Some(&self.free))
-            }
-        };
-        match result {
-            Ok(sol) => Ok((sol.q, sol.iterations)),
-            Err(e) => {
-                let best = e.best().map(|b| b.q.clone());
-                Err((e, best))
             }
         }
     }
@@ -365,18 +354,24 @@ impl PartController for EePoseController {
         let (dp, dr) = self.physical_delta(action);
         self.target_pose = self.config.frame.apply(&prev, &dp, &dr);
         let chain_q = match self.solve_ik(&self.target_pose, &seed) {
-            Ok((q, iterations)) => {
-                self.last_ik = Some(report(&self.chain, &q, &self.target_pose, true, iterations));
-                Some(q)
+            Ok(sol) => {
+                self.last_ik = Some(report(
+                    &self.chain,
+                    &sol.q,
+                    &self.target_pose,
+                    true,
+                    sol.iterations,
+                ));
+                Some(sol.q)
             }
-            Err((err, best)) => {
-                let iterations = err.best().map_or(0, |b| b.iterations);
+            Err(err) => {
+                let best = err.best().cloned();
                 self.last_ik = best
                     .as_ref()
-                    .map(|q| report(&self.chain, q, &self.target_pose, false, iterations));
+                    .map(|b| report(&self.chain, &b.q, &self.target_pose, false, b.iterations));
                 match self.config.on_ik_failure {
                     IkFailurePolicy::HoldCurrent => None,
-                    IkFailurePolicy::UseBest => best,
+                    IkFailurePolicy::UseBest => best.map(|b| b.q),
                 }
             }
         };
