@@ -153,6 +153,23 @@ fn report_per_action_cost() {
         "  ratio pd_ee_delta_pose / pd_joint_delta_pos: {:.1}x",
         costs[0].1 / costs[1].1
     );
+    // The failure path: a target 2 m away, where IK gives up (and the arm holds still).
+    let chain = chain();
+    let far = Isometry3::translation(2.0, 0.0, 0.5);
+    let dls = DlsIk::default();
+    let reps = 200;
+    let start = Instant::now();
+    for _ in 0..reps {
+        assert!(dls
+            .solve(&chain, black_box(&far), &REST[..7], None)
+            .is_err());
+    }
+    let fail = start.elapsed().as_secs_f64() / reps as f64;
+    println!(
+        "  DLS IK on an unreachable target (failure path): {:.1} µs = {:.1} % of an env step",
+        fail * 1e6,
+        100.0 * fail / ENV_STEP_S
+    );
 }
 
 criterion_group!(benches, kinematics, controllers);

@@ -177,6 +177,11 @@ fn attempt(
     rule: &mut dyn StepRule,
 ) -> Result<(IkSolution, bool, bool), IkError> {
     const MAX_DAMPING: f64 = 1e3;
+    /// An accepted step reducing `‖Δp‖ + ‖Δθ‖` by less than this (m + rad) makes no progress.
+    const STALL_GAIN: f64 = 1e-9;
+    /// Consecutive accepted steps without progress that end an attempt.
+    const STALL_STEPS: usize = 5;
+    let mut stalled_steps = 0;
     let n = chain.dof();
     let mut q = start.to_vec();
     let mut jac_full = Matrix6xX::zeros(n);
@@ -225,10 +230,21 @@ fn attempt(
         let candidate_pose = chain.pose_and_jacobian_into(&candidate, &mut candidate_jac);
         let candidate_e = pose_error(&candidate_pose, target);
         if moved && score(&candidate_e) < score(&e) {
+            // Accepted steps that no longer reduce the error (an unreachable target's closest
+            // point) end the attempt early.
+            let gain = score(&e) - score(&candidate_e);
+            stalled_steps = if gain < STALL_GAIN {
+                stalled_steps + 1
+            } else {
+                0
+            };
             q = candidate;
             e = candidate_e;
             std::mem::swap(&mut jac_full, &mut candidate_jac);
             damping = (damping * 0.5).max(opts.damping);
+            if stalled_steps >= STALL_STEPS {
+                break;
+            }
         } else {
             damping *= 4.0;
             if damping > MAX_DAMPING {
