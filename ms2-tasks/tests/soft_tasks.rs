@@ -166,3 +166,55 @@ fn excavate_is_deterministic_and_state_round_trips() {
     run_scoop(&mut fresh, &plan, 6, 3);
     assert_eq!(a.get_state(), fresh.get_state(), "restored run diverged");
 }
+
+#[test]
+fn kinematic_plate_lifts_a_clay_block() {
+    use ms2_tasks::tasks::soft::{SoftConfig, SoftWorld};
+    let (mut solver, clay) = SoftWorld::solver_for(&SoftConfig::default()).unwrap();
+    let plate_top = solver.usable_domain().0.z + 0.03;
+    let pts = sampling::sample_box(
+        Vec3::new(0.13, 0.13, plate_top),
+        Vec3::new(0.19, 0.19, plate_top + 0.03),
+        SPACING,
+    );
+    solver
+        .add_particles(&pts, clay, SPACING.powi(3), Vec3::ZERO)
+        .unwrap();
+    let mut world = World::new(WorldConfig::default()).unwrap();
+    let mut z = plate_top - 0.005;
+    let plate = world
+        .add_actor(
+            ActorDesc::new("plate", ActorKind::Kinematic)
+                .with_pose(Pose3::translation(0.16, 0.16, z))
+                .with_shape(ShapeSpec::new(ShapeDesc::Box {
+                    half_extents: Vector3::new(0.05, 0.05, 0.005),
+                })),
+        )
+        .unwrap();
+    let mut soft = SoftWorld::new(solver, &mut world, vec![plate]).unwrap();
+    // Settle for 0.2 s, then lift at 0.1 m/s for 0.5 s (5 cm).
+    for step in 0..350 {
+        if step >= 100 {
+            z += 0.0002;
+        }
+        world
+            .set_kinematic_target(plate, &Pose3::translation(0.16, 0.16, z))
+            .unwrap();
+        soft.step(&mut world).unwrap();
+    }
+    let plate_top_now = z + 0.005;
+    let lowest = soft
+        .solver()
+        .positions()
+        .iter()
+        .map(|p| p.z)
+        .fold(f32::INFINITY, f32::min);
+    assert!(
+        plate_top_now > plate_top + 0.045,
+        "plate did not move: top at {plate_top_now} m"
+    );
+    assert!(
+        (plate_top_now..plate_top_now + 0.01).contains(&lowest),
+        "clay bottom at {lowest} m, plate top at {plate_top_now} m"
+    );
+}
