@@ -2,10 +2,11 @@
 //!
 //! - [`physics_articulation`]: an ms2-physics articulation as ms2-control's
 //!   [`ms2_control::Articulation`] (controllers drive the simulated robot through it).
+//! - [`mpm_rigid`]: the ms2-physics world as ms2-mpm's rigid backend (two-way coupling).
 //!
-//! Later phases add the renderer-scene adapter (ms2-render) and the rigid-backend adapter for the
-//! soft-body solver (ms2-mpm) next to it.
+//! A later phase adds the renderer-scene adapter (ms2-render) next to them.
 
+pub mod mpm_rigid;
 pub mod physics_articulation;
 
 pub use physics_articulation::{snapshot_articulation, PhysicsArticulation};
