@@ -80,11 +80,27 @@ fn controller_setup(
     (robot, ctrl)
 }
 
-/// Actions of a small back-and-forth motion; the robot tracks perfectly so IK is seeded as in
-/// an env (from the current qpos, one step from the target).
+/// Normalised pd_ee_delta_pose actions of a closed back-and-forth motion: 10 steps of a delta
+/// (1 cm, 0.5 cm, −1 cm, 0.02 rad about z, in the TCP frame), then 10 steps of its exact inverse,
+/// so the arm stays in the workspace however long the benchmark runs. The robot tracks
+/// perfectly, so IK is seeded as in an env: from the current qpos, one step from the target.
 fn ee_action(i: usize) -> [f64; 7] {
-    let s = if (i / 10) % 2 == 0 { 1.0 } else { -1.0 };
-    [0.1 * s, 0.05 * s, -0.1 * s, 0.0, 0.0, 0.2 * s, 1.0]
+    let dp = Vector3::new(0.01, 0.005, -0.01);
+    let dr = Vector3::new(0.0, 0.0, 0.02);
+    let (p, r) = if (i / 10) % 2 == 0 {
+        (dp, dr)
+    } else {
+        (-(UnitQuaternion::from_scaled_axis(dr).inverse() * dp), -dr)
+    };
+    [
+        p.x / 0.1,
+        p.y / 0.1,
+        p.z / 0.1,
+        r.x / 0.1,
+        r.y / 0.1,
+        r.z / 0.1,
+        1.0,
+    ]
 }
 
 fn controllers(c: &mut Criterion) {
@@ -116,7 +132,7 @@ fn report_per_action_cost() {
             let a = ee_action(i);
             let action: Vec<f64> = match mode {
                 ControlMode::PdEeDeltaPose => a.to_vec(),
-                _ => vec![0.1 * a[0], -0.1, 0.1, -0.1, 0.1, -0.1, 0.1, 1.0],
+                _ => vec![a[0], -0.1, 0.1, -0.1, 0.1, -0.1, 0.1, 1.0],
             };
             ctrl.set_action(&mut robot, &action).unwrap();
             robot.step(0.05);
@@ -136,6 +152,23 @@ fn report_per_action_cost() {
     println!(
         "  ratio pd_ee_delta_pose / pd_joint_delta_pos: {:.1}x",
         costs[0].1 / costs[1].1
+    );
+    // The failure path: a target 2 m away, where IK gives up (and the arm holds still).
+    let chain = chain();
+    let far = Isometry3::translation(2.0, 0.0, 0.5);
+    let dls = DlsIk::default();
+    let reps = 200;
+    let start = Instant::now();
+    for _ in 0..reps {
+        assert!(dls
+            .solve(&chain, black_box(&far), &REST[..7], None)
+            .is_err());
+    }
+    let fail = start.elapsed().as_secs_f64() / reps as f64;
+    println!(
+        "  DLS IK on an unreachable target (failure path): {:.1} µs = {:.1} % of an env step",
+        fail * 1e6,
+        100.0 * fail / ENV_STEP_S
     );
 }
 

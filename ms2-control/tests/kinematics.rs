@@ -22,14 +22,15 @@ fn random_q(chain: &KinematicChain, rng: &mut ChaCha8Rng) -> Vec<f64> {
         .collect()
 }
 
+use std::f64::consts::{FRAC_PI_4, FRAC_PI_8};
 const REST: [f64; 7] = [
     0.0,
-    0.39269908,
+    FRAC_PI_8,
     0.0,
-    -1.96349541,
+    -5.0 * FRAC_PI_8,
     0.0,
-    2.35619449,
-    0.78539816,
+    3.0 * FRAC_PI_4,
+    FRAC_PI_4,
 ];
 
 #[test]

@@ -1,6 +1,8 @@
 //! Ego-centric velocity control of a mobile base (`base_pd_joint_vel`).
 
-use super::{gather, per_joint, BuildContext, BuildError, PartController, PartConversion};
+use super::{
+    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+};
 use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
 
@@ -53,6 +55,7 @@ impl BaseVelocityController {
         }
         let low = per_joint(&config.name, "lower", &config.lower, n)?;
         let high = per_joint(&config.name, "upper", &config.upper, n)?;
+        check_bounds(&config.name, &low, &high)?;
         let scaling = if config.normalize_action {
             ActionScaling::Normalized
         } else {

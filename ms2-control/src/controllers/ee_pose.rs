@@ -5,11 +5,13 @@ use std::sync::Arc;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use super::{gather, per_joint, BuildContext, BuildError, PartController, PartConversion};
+use super::{
+    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+};
 use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
 use crate::kinematics::{
-    DlsIk, IkError, IkOptions, KinematicChain, KinematicModel, QpIk, QpIkOptions,
+    DlsIk, IkError, IkOptions, IkSolution, KinematicChain, KinematicModel, QpIk, QpIkOptions,
 };
 
 /// The frame an end-effector delta `T_a = (Δp, exp([Δr]×))` is applied in. `T` is the previous
@@ -207,17 +209,7 @@ impl EePoseController {
             low.extend([-config.rot_bound; 3]);
             high.extend([config.rot_bound; 3]);
         }
-        if let Some(i) = (0..low.len())
-            .find(|&i| !(low[i] < high[i]) || !low[i].is_finite() || !high[i].is_finite())
-        {
-            return Err(BuildError::BadConfig {
-                controller: name.into(),
-                message: format!(
-                    "action bound {i} is [{}, {}]; bounds must be finite with low < high",
-                    low[i], high[i]
-                ),
-            });
-        }
+        check_bounds(name, &low, &high)?;
         if let EeIkSolver::Qp(QpIkOptions {
             max_displacement_from_seed: Some(d),
             ..
@@ -306,24 +298,13 @@ impl EePoseController {
         (dp, UnitQuaternion::from_scaled_axis(r))
     }
 
-    fn solve_ik(
-        &self,
-        target: &Isometry3<f64>,
-        seed: &[f64],
-    ) -> Result<Vec<f64>, (IkError, Option<Vec<f64>>)> {
-        let result = match &self.config.ik {
+    fn solve_ik(&self, target: &Isometry3<f64>, seed: &[f64]) -> Result<IkSolution, IkError> {
+        match &self.config.ik {
             EeIkSolver::Dls(opts) => {
                 DlsIk::new(opts.clone()).solve(&self.chain, target, seed, Some(&self.free))
             }
             EeIkSolver::Qp(opts) => {
                 QpIk::new(opts.clone()).solve(&self.chain, target, seed, Some(&self.free))
-            }
-        };
-        match result {
-            Ok(sol) => Ok(sol.q),
-            Err(e) => {
-                let best = e.best().map(|b| b.q.clone());
-                Err((e, best))
             }
         }
     }
@@ -373,18 +354,24 @@ impl PartController for EePoseController {
         let (dp, dr) = self.physical_delta(action);
         self.target_pose = self.config.frame.apply(&prev, &dp, &dr);
         let chain_q = match self.solve_ik(&self.target_pose, &seed) {
-            Ok(q) => {
-                self.last_ik = Some(report(&self.chain, &q, &self.target_pose, true, 0));
-                Some(q)
+            Ok(sol) => {
+                self.last_ik = Some(report(
+                    &self.chain,
+                    &sol.q,
+                    &self.target_pose,
+                    true,
+                    sol.iterations,
+                ));
+                Some(sol.q)
             }
-            Err((err, best)) => {
-                let iterations = err.best().map_or(0, |b| b.iterations);
+            Err(err) => {
+                let best = err.best().cloned();
                 self.last_ik = best
                     .as_ref()
-                    .map(|q| report(&self.chain, q, &self.target_pose, false, iterations));
+                    .map(|b| report(&self.chain, &b.q, &self.target_pose, false, b.iterations));
                 match self.config.on_ik_failure {
                     IkFailurePolicy::HoldCurrent => None,
-                    IkFailurePolicy::UseBest => best,
+                    IkFailurePolicy::UseBest => best.map(|b| b.q),
                 }
             }
         };
@@ -485,7 +472,7 @@ impl PartController for EePoseController {
         }
         if self.config.use_target {
             let q = nalgebra::Quaternion::new(state[3], state[4], state[5], state[6]);
-            if !(q.norm() > 0.0) || state.iter().any(|v| !v.is_finite()) {
+            if q.norm() <= 0.0 || q.norm().is_nan() || state.iter().any(|v| !v.is_finite()) {
                 return Err(format!(
                     "{}: target pose state {state:?} is not a valid pose",
                     self.config.name

@@ -1,7 +1,9 @@
 //! PD joint position control: `pd_joint_pos`, `pd_joint_delta_pos`, `pd_joint_target_delta_pos`,
 //! `pd_joint_pos_vel`, `pd_joint_delta_pos_vel` and the mimic gripper.
 
-use super::{gather, per_joint, BuildContext, BuildError, PartController, PartConversion};
+use super::{
+    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+};
 use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
 
@@ -103,17 +105,7 @@ impl JointPositionController {
             low.extend(std::iter::repeat_n(vlo, n));
             high.extend(std::iter::repeat_n(vhi, n));
         }
-        if let Some(i) = (0..low.len())
-            .find(|&i| !(low[i] < high[i]) || !low[i].is_finite() || !high[i].is_finite())
-        {
-            return Err(BuildError::BadConfig {
-                controller: name.into(),
-                message: format!(
-                    "action bound {i} is [{}, {}]; bounds must be finite with low < high",
-                    low[i], high[i]
-                ),
-            });
-        }
+        check_bounds(name, &low, &high)?;
         let scaling = if config.normalize_action {
             ActionScaling::Normalized
         } else {

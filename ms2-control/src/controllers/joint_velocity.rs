@@ -1,6 +1,8 @@
 //! PD joint velocity control: `pd_joint_vel` (stiffness 0, velocity targets).
 
-use super::{gather, per_joint, BuildContext, BuildError, PartController, PartConversion};
+use super::{
+    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+};
 use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
 
@@ -40,6 +42,7 @@ impl JointVelocityController {
         let n = joint_indices.len();
         let low = per_joint(&config.name, "lower", &config.lower, n)?;
         let high = per_joint(&config.name, "upper", &config.upper, n)?;
+        check_bounds(&config.name, &low, &high)?;
         let scaling = if config.normalize_action {
             ActionScaling::Normalized
         } else {

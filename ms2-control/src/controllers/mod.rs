@@ -244,3 +244,18 @@ pub(crate) fn per_joint(
         }),
     }
 }
+
+/// Checks that every action bound is finite with `low < high`.
+pub(crate) fn check_bounds(controller: &str, low: &[f64], high: &[f64]) -> Result<(), BuildError> {
+    for (i, (&lo, &hi)) in low.iter().zip(high).enumerate() {
+        if !lo.is_finite() || !hi.is_finite() || lo >= hi {
+            return Err(BuildError::BadConfig {
+                controller: controller.to_string(),
+                message: format!(
+                    "action bound {i} is [{lo}, {hi}]; bounds must be finite with low < high"
+                ),
+            });
+        }
+    }
+    Ok(())
+}

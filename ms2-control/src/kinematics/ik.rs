@@ -107,8 +107,8 @@ pub enum IkError {
         limits_active: bool,
     },
     /// The QP solver reported a failure.
-    #[error("QP solver failed: {0}")]
-    QpSolver(String),
+    #[error("linear or QP solver failed: {0}")]
+    SolverFailed(String),
 }
 
 impl IkError {
@@ -177,6 +177,11 @@ fn attempt(
     rule: &mut dyn StepRule,
 ) -> Result<(IkSolution, bool, bool), IkError> {
     const MAX_DAMPING: f64 = 1e3;
+    /// An accepted step reducing `‖Δp‖ + ‖Δθ‖` by less than this (m + rad) makes no progress.
+    const STALL_GAIN: f64 = 1e-9;
+    /// Consecutive accepted steps without progress that end an attempt.
+    const STALL_STEPS: usize = 5;
+    let mut stalled_steps = 0;
     let n = chain.dof();
     let mut q = start.to_vec();
     let mut jac_full = Matrix6xX::zeros(n);
@@ -225,10 +230,21 @@ fn attempt(
         let candidate_pose = chain.pose_and_jacobian_into(&candidate, &mut candidate_jac);
         let candidate_e = pose_error(&candidate_pose, target);
         if moved && score(&candidate_e) < score(&e) {
+            // Accepted steps that no longer reduce the error (an unreachable target's closest
+            // point) end the attempt early.
+            let gain = score(&e) - score(&candidate_e);
+            stalled_steps = if gain < STALL_GAIN {
+                stalled_steps + 1
+            } else {
+                0
+            };
             q = candidate;
             e = candidate_e;
             std::mem::swap(&mut jac_full, &mut candidate_jac);
             damping = (damping * 0.5).max(opts.damping);
+            if stalled_steps >= STALL_STEPS {
+                break;
+            }
         } else {
             damping *= 4.0;
             if damping > MAX_DAMPING {
@@ -383,9 +399,9 @@ impl StepRule for DlsRule {
                 jjt[(i, j)] + if i == j { lambda2 } else { 0.0 }
             });
             let mut rhs = Mat::<f64>::from_fn(6, 1, |i, _| err[i]);
-            let llt = a
-                .llt(Side::Lower)
-                .map_err(|e| IkError::QpSolver(format!("Cholesky of J·Jᵀ + λ²I failed: {e:?}")))?;
+            let llt = a.llt(Side::Lower).map_err(|e| {
+                IkError::SolverFailed(format!("Cholesky of J·Jᵀ + λ²I failed: {e:?}"))
+            })?;
             llt.solve_in_place(rhs.as_mut());
             let y = Vector6::from_fn(|i, _| rhs[(i, 0)]);
             let mut blocked = false;
@@ -520,13 +536,13 @@ impl StepRule for QpRule {
             .verbose(false)
             .presolve_enable(false)
             .build()
-            .map_err(|e| IkError::QpSolver(e.to_string()))?;
+            .map_err(|e| IkError::SolverFailed(e.to_string()))?;
         let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
-            .map_err(|e| IkError::QpSolver(e.to_string()))?;
+            .map_err(|e| IkError::SolverFailed(e.to_string()))?;
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {}
-            other => return Err(IkError::QpSolver(format!("clarabel status {other:?}"))),
+            other => return Err(IkError::SolverFailed(format!("clarabel status {other:?}"))),
         }
         // The interior-point solution can sit a hair outside the box: project it back.
         Ok(solver

@@ -4,9 +4,9 @@
 //!   [`ms2_control::Articulation`] (controllers drive the simulated robot through it).
 //! - [`render_scene`]: an ms2-physics world's visual shapes as an [`ms2_render::Scene`], with
 //!   the process-wide [`RenderContext`] (one renderer, shared meshes).
-//!
-//! A later phase adds the rigid-backend adapter for the soft-body solver (ms2-mpm) next to them.
+//! - [`mpm_rigid`]: the ms2-physics world as ms2-mpm's rigid backend (two-way coupling).
 
+pub mod mpm_rigid;
 pub mod physics_articulation;
 pub mod render_scene;
 
