@@ -139,6 +139,22 @@ impl World {
                 return Ok(());
             }
         }
+        self.write_state_onto_cold_template(state)
+    }
+
+    /// Drops the solver's history (warm-start impulses, contact manifolds) while keeping every
+    /// pose, velocity, joint position/velocity and drive target: the simulation continues as if
+    /// the world had just been built in this state.
+    ///
+    /// Environments call this at the end of a reset, so that an episode depends only on its
+    /// seed and not on the episode that ran before it.
+    pub fn forget_solver_history(&mut self) -> Result<()> {
+        let state = self.get_state();
+        self.write_state_onto_cold_template(&state)
+    }
+
+    /// Writes a (length- and finiteness-checked) state onto the configuration's cold template.
+    fn write_state_onto_cold_template(&mut self, state: &[f32]) -> Result<()> {
         // Validate quaternions before writing anything (below).
         let mut offset = 0;
         let mut poses = Vec::new();

@@ -186,6 +186,12 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
         let TaskScene { world, agent } = &mut self.scene;
         agent.initialize(world, rng)?;
         self.task.initialize_task(&self.scene, rng);
+        // The previous episode's contact caches must not leak into this one: an episode is
+        // determined by its seed alone.
+        self.scene
+            .world
+            .forget_solver_history()
+            .map_err(physics_err)?;
         Ok(())
     }
 
