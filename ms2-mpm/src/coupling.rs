@@ -297,9 +297,9 @@ impl Coupling {
     pub fn sync_bodies(&mut self, backend: &dyn RigidBackend) -> Result<(), MpmError> {
         let n = backend.body_count();
         if n != self.impulses.len() {
-            return Err(MpmError::UnknownBody {
-                body: n,
-                count: self.impulses.len(),
+            return Err(MpmError::BodyCountChanged {
+                expected: self.impulses.len(),
+                got: n,
             });
         }
         self.bodies.clear();
@@ -367,6 +367,27 @@ impl Coupling {
             self.last_wrenches[body] = w;
             backend.apply_coupling_wrench(body, w.force, w.torque);
         }
+    }
+
+    /// Signed distance (m; negative inside) from world point `p` to the closest shape of
+    /// `body`, at the pose of the last sync; `f32::INFINITY` if the body has no shapes. For
+    /// task checks such as "how much clay is inside the beaker".
+    pub fn distance_to_body(&self, body: usize, p: Vec3) -> Result<f32, MpmError> {
+        if body >= self.bodies.len() {
+            return Err(MpmError::UnknownBody {
+                body,
+                count: self.bodies.len(),
+            });
+        }
+        Ok(self
+            .shapes
+            .iter()
+            .filter(|sh| sh.body == body)
+            .map(|sh| {
+                let local = sh.inverse_rotation * (p - sh.world_position);
+                sh.sdf.distance_and_normal(local).0
+            })
+            .fold(f32::INFINITY, f32::min))
     }
 
     /// The wrench each body received at the last [`Self::apply_wrenches`].

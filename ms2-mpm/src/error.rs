@@ -81,12 +81,20 @@ pub enum MpmError {
         /// What is wrong.
         reason: String,
     },
-    /// A body index refers to no body of the rigid backend.
-    #[error("unknown rigid body {body}: the backend has {count} bodies")]
+    /// A body index refers to no body of the coupling.
+    #[error("unknown rigid body {body}: the coupling has {count} bodies")]
     UnknownBody {
         /// The index given.
         body: usize,
         /// Number of bodies.
         count: usize,
+    },
+    /// The rigid backend's body count changed since the coupling copied its shapes.
+    #[error("the rigid backend now has {got} bodies, but the coupling was built for {expected}; build a new Coupling after adding or removing bodies")]
+    BodyCountChanged {
+        /// Bodies when the coupling was built.
+        expected: usize,
+        /// Bodies now.
+        got: usize,
     },
 }

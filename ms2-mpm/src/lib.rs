@@ -23,6 +23,8 @@
 //! Threads: the solver uses the current rayon pool; run it inside
 //! `rayon::ThreadPoolBuilder::new().num_threads(n).build()?.install(..)` to choose the count.
 
+#![warn(missing_docs)]
+
 pub mod coupling;
 pub mod error;
 pub mod grid;

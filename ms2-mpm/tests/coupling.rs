@@ -175,3 +175,114 @@ fn mesh_collider_pushes_like_the_equivalent_box() {
         forces[1]
     );
 }
+
+#[test]
+fn coupled_runs_are_deterministic_for_any_thread_count() {
+    let sim = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut s = solver(Boundary::default());
+            clay_bed(&mut s, 0.05);
+            let mut world = SimpleRigidWorld::new(s.config().gravity);
+            let body = world.add_box(
+                Vec3::new(0.02, 0.03, 0.01),
+                800.0,
+                Vec3::new(0.15, 0.17, 0.07),
+                Motion::Dynamic,
+            );
+            // Off-centre and spinning, so that torques matter too.
+            world.bodies[body].angular_velocity = Vec3::new(1.0, -2.0, 3.0);
+            let mut coupling =
+                Coupling::new(&world, CouplingParams::for_substep(s.config().substep_dt)).unwrap();
+            for _ in 0..60 {
+                world.step(0.002);
+                coupling.advance(&mut s, &mut world, SUBSTEPS).unwrap();
+            }
+            (world.bodies[body].clone(), s.state())
+        })
+    };
+    let (body_a, soft_a) = sim(1);
+    let (body_b, soft_b) = sim(2);
+    assert!(
+        body_a == body_b,
+        "rigid body differs: {body_a:?} vs {body_b:?}"
+    );
+    assert!(
+        soft_a == soft_b,
+        "soft state differs between 1 and 2 threads"
+    );
+    assert!(
+        body_a.coupling_force.length() > 0.0,
+        "the box never touched the clay"
+    );
+}
+
+#[test]
+fn bad_coupling_input_is_refused() {
+    let mut world = SimpleRigidWorld::new(Vec3::new(0.0, 0.0, -9.81));
+    world.add_box(
+        Vec3::splat(0.02),
+        500.0,
+        Vec3::new(0.1, 0.1, 0.1),
+        Motion::Dynamic,
+    );
+    let mut params = CouplingParams::for_substep(5e-4);
+    params.friction = f32::NAN;
+    let err = Coupling::new(&world, params)
+        .err()
+        .expect("NaN friction must be refused");
+    assert!(err.to_string().contains("friction"), "{err}");
+    let mut coupling = Coupling::new(&world, CouplingParams::for_substep(5e-4)).unwrap();
+    world.add_box(
+        Vec3::splat(0.02),
+        500.0,
+        Vec3::new(0.2, 0.1, 0.1),
+        Motion::Dynamic,
+    );
+    assert!(matches!(
+        coupling.sync_bodies(&world),
+        Err(ms2_mpm::MpmError::BodyCountChanged {
+            expected: 1,
+            got: 2
+        })
+    ));
+    world.bodies[0].position.x = f32::INFINITY;
+    world.bodies.pop();
+    assert!(matches!(
+        coupling.sync_bodies(&world),
+        Err(ms2_mpm::MpmError::NonFiniteInput { .. })
+    ));
+}
+
+#[test]
+fn distance_to_body_follows_the_synced_pose() {
+    let mut world = SimpleRigidWorld::new(Vec3::ZERO);
+    let b = world.add_box(
+        Vec3::new(0.02, 0.03, 0.04),
+        500.0,
+        Vec3::new(0.1, 0.1, 0.1),
+        Motion::Kinematic,
+    );
+    let mut coupling = Coupling::new(&world, CouplingParams::for_substep(5e-4)).unwrap();
+    let d = coupling
+        .distance_to_body(b, Vec3::new(0.1, 0.1, 0.2))
+        .unwrap();
+    assert!((d - 0.06).abs() < 1e-6, "{d}");
+    // Turn the box 90° about x: its z half extent becomes 3 cm.
+    world.bodies[b].rotation = glam::Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    coupling.sync_bodies(&world).unwrap();
+    let d = coupling
+        .distance_to_body(b, Vec3::new(0.1, 0.1, 0.2))
+        .unwrap();
+    assert!((d - 0.07).abs() < 1e-5, "{d}");
+    assert!(
+        coupling
+            .distance_to_body(b, Vec3::new(0.1, 0.1, 0.1))
+            .unwrap()
+            < 0.0
+    );
+    assert!(coupling.distance_to_body(7, Vec3::ZERO).is_err());
+}

@@ -1,4 +1,4 @@
-//! Articulation descriptions (from URDF or by hand) and their construction as rapier
+//! Articulations built from an [`ArticulationDesc`] as rapier
 //! reduced-coordinate multibodies.
 //!
 //! Links joined by fixed joints are merged into one rigid body (as PhysX does): the body frame is
@@ -16,7 +16,9 @@ use rapier3d::dynamics::{
 };
 use rapier3d::math::{Pose, Rotation};
 
-use crate::error::{PhysicsError, Result, UrdfError};
+use crate::description::{invalid, validate_tree};
+pub use crate::description::{ArticulationDesc, Inertial, JointDesc, JointType, LinkDesc, Mimic};
+use crate::error::{PhysicsError, Result};
 use crate::math::{pose_from_na, vec_from_na, Pose3};
 use crate::shape::{MassSpec, Material, ShapeSpec, VisualShape};
 use crate::world::{BodyEntry, BodyId, BodyKind, ExcludedPairs, World};
@@ -30,101 +32,6 @@ impl ArticulationId {
     pub fn index(self) -> usize {
         self.0 as usize
     }
-}
-
-/// Type of a joint.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum JointType {
-    /// Rotation about the axis (rad), within limits.
-    Revolute,
-    /// Rotation about the axis (rad), unlimited.
-    Continuous,
-    /// Translation along the axis (m), within limits.
-    Prismatic,
-    /// No motion: the child is welded to the parent.
-    Fixed,
-}
-
-impl JointType {
-    /// True for joints with one degree of freedom.
-    pub fn is_movable(self) -> bool {
-        !matches!(self, JointType::Fixed)
-    }
-}
-
-/// Mass properties of a link.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Inertial {
-    /// Mass (kg).
-    pub mass: f32,
-    /// Pose of the inertial frame (origin at the centre of mass) in the link frame.
-    pub pose_link_from_inertial: Pose3,
-    /// Inertia tensor about the centre of mass, in the inertial frame (kg·m²).
-    pub inertia: Matrix3<f32>,
-}
-
-/// One link of an articulation description.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LinkDesc {
-    /// Unique link name.
-    pub name: String,
-    /// Mass properties; `None` for a massless frame (e.g. a tool-centre point).
-    pub inertial: Option<Inertial>,
-    /// Collision shapes in the link frame (their `mass` is ignored: mass comes from `inertial`).
-    pub collisions: Vec<ShapeSpec>,
-    /// Visual shapes in the link frame.
-    pub visuals: Vec<VisualShape>,
-}
-
-/// A mimic relation `q = multiplier * q_joint + offset`, kept as data for controllers.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Mimic {
-    /// The joint mimicked.
-    pub joint: String,
-    /// Multiplier.
-    pub multiplier: f32,
-    /// Offset (rad or m).
-    pub offset: f32,
-}
-
-/// One joint of an articulation description.
-#[derive(Clone, Debug, PartialEq)]
-pub struct JointDesc {
-    /// Unique joint name.
-    pub name: String,
-    /// Joint type.
-    pub joint_type: JointType,
-    /// Parent link name.
-    pub parent: String,
-    /// Child link name.
-    pub child: String,
-    /// Pose of the joint frame (= child link frame at zero position) in the parent link frame.
-    pub pose_parent_from_joint: Pose3,
-    /// Joint axis in the joint frame (any non-zero length; normalised on use).
-    pub axis: Vector3<f32>,
-    /// Position limits `[lower, upper]` (rad or m); `None` for unlimited.
-    pub limits: Option<[f32; 2]>,
-    /// Effort limit from the description (N·m or N), as data.
-    pub effort_limit: f32,
-    /// Velocity limit from the description (rad/s or m/s), as data.
-    pub velocity_limit: f32,
-    /// Viscous joint damping (N·m·s/rad or N·s/m).
-    pub damping: f32,
-    /// Dry joint friction (N·m or N).
-    pub friction: f32,
-    /// Mimic relation, as data.
-    pub mimic: Option<Mimic>,
-}
-
-/// A complete articulation description (what a URDF file holds).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ArticulationDesc {
-    /// Robot name.
-    pub name: String,
-    /// Links.
-    pub links: Vec<LinkDesc>,
-    /// Joints.
-    pub joints: Vec<JointDesc>,
 }
 
 /// How an articulation's links collide with each other.
@@ -261,153 +168,6 @@ pub(crate) struct Articulation {
     pub(crate) multibody: MultibodyIndex,
 }
 
-fn invalid(file: &str, element: String, reason: String) -> PhysicsError {
-    PhysicsError::Urdf(UrdfError::Invalid {
-        file: file.to_string(),
-        element,
-        reason,
-    })
-}
-
-/// The validated tree: link order (depth first) and each link's parent joint.
-pub(crate) struct Tree {
-    pub(crate) order: Vec<usize>,
-    pub(crate) parent_joint: Vec<Option<usize>>,
-}
-
-/// Checks names, references and tree shape; returns the depth-first order.
-pub(crate) fn validate_tree(desc: &ArticulationDesc, file: &str) -> Result<Tree> {
-    let mut link_index = HashMap::new();
-    for (i, l) in desc.links.iter().enumerate() {
-        if link_index.insert(l.name.as_str(), i).is_some() {
-            return Err(invalid(
-                file,
-                format!("<link name=\"{}\">", l.name),
-                "duplicate link name".into(),
-            ));
-        }
-    }
-    if desc.links.is_empty() {
-        return Err(invalid(
-            file,
-            "<robot>".into(),
-            "no <link>: expected at least one".into(),
-        ));
-    }
-    let mut parent_joint = vec![None; desc.links.len()];
-    let mut children: Vec<Vec<usize>> = vec![Vec::new(); desc.links.len()];
-    let mut joint_names = HashMap::new();
-    for (j, joint) in desc.joints.iter().enumerate() {
-        let el = || format!("<joint name=\"{}\">", joint.name);
-        if joint_names.insert(joint.name.as_str(), j).is_some() {
-            return Err(invalid(file, el(), "duplicate joint name".into()));
-        }
-        let p = *link_index.get(joint.parent.as_str()).ok_or_else(|| {
-            invalid(
-                file,
-                el(),
-                format!("parent link \"{}\" does not exist", joint.parent),
-            )
-        })?;
-        let c = *link_index.get(joint.child.as_str()).ok_or_else(|| {
-            invalid(
-                file,
-                el(),
-                format!("child link \"{}\" does not exist", joint.child),
-            )
-        })?;
-        if parent_joint[c].is_some() {
-            return Err(invalid(
-                file,
-                el(),
-                format!("link \"{}\" is the child of two joints", joint.child),
-            ));
-        }
-        parent_joint[c] = Some(j);
-        children[p].push(c);
-        if joint.joint_type.is_movable() && joint.axis.norm() < 1e-9 {
-            return Err(invalid(
-                file,
-                el(),
-                "zero <axis>: expected a non-zero axis".into(),
-            ));
-        }
-        if let Some([lo, hi]) = joint.limits {
-            if lo.is_nan() || hi.is_nan() || lo > hi {
-                return Err(invalid(
-                    file,
-                    el(),
-                    format!("<limit lower={lo} upper={hi}>: expected lower <= upper"),
-                ));
-            }
-        }
-        if !(joint.damping >= 0.0 && joint.friction >= 0.0) {
-            return Err(invalid(
-                file,
-                el(),
-                format!(
-                    "<dynamics damping={} friction={}>: expected values >= 0",
-                    joint.damping, joint.friction
-                ),
-            ));
-        }
-    }
-    for joint in &desc.joints {
-        if let Some(m) = &joint.mimic {
-            if !joint_names.contains_key(m.joint.as_str()) {
-                return Err(invalid(
-                    file,
-                    format!("<joint name=\"{}\"> <mimic>", joint.name),
-                    format!("mimicked joint \"{}\" does not exist", m.joint),
-                ));
-            }
-        }
-    }
-    for l in &desc.links {
-        if let Some(i) = &l.inertial {
-            if !(i.mass.is_finite() && i.mass >= 0.0) {
-                return Err(invalid(
-                    file,
-                    format!("<link name=\"{}\"> <inertial>", l.name),
-                    format!("mass {}: expected a finite mass >= 0 kg", i.mass),
-                ));
-            }
-        }
-    }
-    let roots: Vec<usize> = (0..desc.links.len())
-        .filter(|&i| parent_joint[i].is_none())
-        .collect();
-    if roots.len() != 1 {
-        let names: Vec<&str> = roots.iter().map(|&i| desc.links[i].name.as_str()).collect();
-        return Err(invalid(
-            file,
-            "<robot>".into(),
-            format!(
-                "expected exactly one root link (a link that is no joint's child), found {names:?}"
-            ),
-        ));
-    }
-    let mut order = Vec::with_capacity(desc.links.len());
-    let mut stack = vec![roots[0]];
-    while let Some(l) = stack.pop() {
-        order.push(l);
-        for &c in children[l].iter().rev() {
-            stack.push(c);
-        }
-    }
-    if order.len() != desc.links.len() {
-        return Err(invalid(
-            file,
-            "<robot>".into(),
-            "the joints form a loop: expected a tree".into(),
-        ));
-    }
-    Ok(Tree {
-        order,
-        parent_joint,
-    })
-}
-
 fn mat3_from_na(m: &Matrix3<f32>) -> rapier3d::math::Matrix {
     rapier3d::math::Matrix::from_cols_slice(m.as_slice())
 }
@@ -432,6 +192,13 @@ impl World {
         file: &str,
     ) -> Result<ArticulationId> {
         let tree = validate_tree(desc, file)?;
+        if !crate::math::pose_is_finite(&options.root_pose) {
+            return Err(PhysicsError::InvalidParameter {
+                name: "root_pose",
+                value: format!("{:?}", options.root_pose),
+                expected: "a finite pose",
+            });
+        }
         options.default_material.validate()?;
         for (name, m) in &options.link_materials {
             m.validate()?;

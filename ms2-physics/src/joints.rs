@@ -299,7 +299,8 @@ impl World {
         Ok(())
     }
 
-    /// Sets the PD drive of one degree of freedom (keeps its targets).
+    /// Sets the PD drive of one degree of freedom (keeps its targets). Changing gains is a
+    /// configuration change for [`World::set_state`]; writing the same gains is a no-op.
     pub fn set_drive(&mut self, art: ArticulationId, dof: usize, drive: DriveParams) -> Result<()> {
         drive.validate()?;
         let a = self.articulation_ref(art)?;
@@ -315,6 +316,16 @@ impl World {
             .get_multibody_mut(mbi)
             .expect("multibody");
         let data = &mut mb.link_mut(d.mb_link).expect("link").joint.data;
+        if let Some(m) = data.motor(d.axis) {
+            if m.stiffness == drive.stiffness
+                && m.damping == drive.damping
+                && m.max_force == drive.force_limit
+                && m.model == MotorModel::ForceBased
+            {
+                // Unchanged: not a configuration change, exact snapshots stay valid.
+                return Ok(());
+            }
+        }
         let (pos, vel) = data
             .motor(d.axis)
             .map(|m| (m.target_pos, m.target_vel))
@@ -358,27 +369,47 @@ impl World {
             }))
     }
 
+    /// Writes position or velocity targets of `dofs` (all dofs in order when `None`).
     fn write_targets(
         &mut self,
         art: ArticulationId,
+        dofs: Option<&[usize]>,
         values: &[f32],
         what: &str,
         velocity: bool,
     ) -> Result<()> {
         let a = self.articulation_ref(art)?;
+        let n = a.dofs.len();
+        let expected = dofs.map_or(n, <[usize]>::len);
         check_len(
             || format!("{what} of \"{}\"", a.name),
-            a.dofs.len(),
+            expected,
             values.len(),
         )?;
         check_finite(|| format!("{what} of \"{}\"", a.name), values)?;
-        let (dofs, mbi) = (a.dofs.clone(), a.multibody);
+        if let Some(bad) = dofs.and_then(|d| d.iter().find(|&&i| i >= n)) {
+            return Err(PhysicsError::InvalidParameter {
+                name: "dof",
+                value: bad.to_string(),
+                expected: "an index below the articulation's dof count",
+            });
+        }
+        let all: Vec<usize>;
+        let indices = match dofs {
+            Some(d) => d,
+            None => {
+                all = (0..n).collect();
+                &all
+            }
+        };
+        let (art_dofs, mbi) = (a.dofs.clone(), a.multibody);
         let mb = self
             .sim
             .multibody_joints
             .get_multibody_mut(mbi)
             .expect("multibody");
-        for (d, &v) in dofs.iter().zip(values) {
+        for (&i, &v) in indices.iter().zip(values) {
+            let d = art_dofs[i];
             let data = &mut mb.link_mut(d.mb_link).expect("link").joint.data;
             let m = data.motor(d.axis).copied().unwrap_or_default();
             let (pos, vel) = if velocity {
@@ -391,9 +422,35 @@ impl World {
         Ok(())
     }
 
+    /// Sets the position targets (rad or m) of the listed degrees of freedom only.
+    pub fn set_drive_targets_of(
+        &mut self,
+        art: ArticulationId,
+        dofs: &[usize],
+        qpos_target: &[f32],
+    ) -> Result<()> {
+        self.write_targets(
+            art,
+            Some(dofs),
+            qpos_target,
+            "drive position targets",
+            false,
+        )
+    }
+
+    /// Sets the velocity targets (rad/s or m/s) of the listed degrees of freedom only.
+    pub fn set_drive_velocity_targets_of(
+        &mut self,
+        art: ArticulationId,
+        dofs: &[usize],
+        qvel_target: &[f32],
+    ) -> Result<()> {
+        self.write_targets(art, Some(dofs), qvel_target, "drive velocity targets", true)
+    }
+
     /// Sets the drives' position targets (rad or m, dof order).
     pub fn set_drive_targets(&mut self, art: ArticulationId, qpos_target: &[f32]) -> Result<()> {
-        self.write_targets(art, qpos_target, "drive position targets", false)
+        self.write_targets(art, None, qpos_target, "drive position targets", false)
     }
 
     /// Sets the drives' velocity targets (rad/s or m/s, dof order).
@@ -402,7 +459,7 @@ impl World {
         art: ArticulationId,
         qvel_target: &[f32],
     ) -> Result<()> {
-        self.write_targets(art, qvel_target, "drive velocity targets", true)
+        self.write_targets(art, None, qvel_target, "drive velocity targets", true)
     }
 
     fn read_targets(&self, art: ArticulationId, velocity: bool) -> Result<Vec<f32>> {

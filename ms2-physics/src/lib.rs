@@ -31,8 +31,10 @@
 //! ```
 
 pub mod articulation;
+mod bodies;
 pub mod config;
 pub mod contact;
+pub mod description;
 pub mod error;
 mod joints;
 pub mod math;

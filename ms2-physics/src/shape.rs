@@ -306,6 +306,12 @@ impl ShapeSpec {
     /// Builds the rapier collider (without parent).
     pub(crate) fn to_collider(&self) -> Result<ColliderBuilder> {
         self.material.validate()?;
+        if !crate::math::pose_is_finite(&self.pose_body_from_shape) {
+            return Err(PhysicsError::InvalidShape(format!(
+                "shape pose {:?} is not finite",
+                self.pose_body_from_shape
+            )));
+        }
         let (shape, pose) = match &self.shape {
             ShapeDesc::Cylinder {
                 radius,

@@ -34,6 +34,8 @@ struct Snapshot {
     bits: Vec<u32>,
     generation: u64,
     sim: Box<Sim>,
+    /// Bodies carrying forces applied for the next step when the snapshot was taken.
+    forced: Vec<rapier3d::prelude::RigidBodyHandle>,
 }
 
 /// Recent snapshots taken by `get_state`.
@@ -110,6 +112,7 @@ impl World {
                 bits,
                 generation: self.generation,
                 sim: Box::new(self.sim.clone()),
+                forced: self.forced.clone(),
             });
         }
         out
@@ -130,8 +133,8 @@ impl World {
                 .find(|s| s.generation == self.generation && s.bits == bits)
             {
                 self.sim = (*s.sim).clone();
+                self.forced = s.forced.clone();
                 drop(cache);
-                self.forced.clear();
                 self.pipeline = rapier3d::prelude::PhysicsPipeline::new();
                 return Ok(());
             }
@@ -167,6 +170,13 @@ impl World {
         let template = self.cold_template.as_ref().expect("just ensured");
         self.sim = (*template.1).clone();
         self.pipeline = rapier3d::prelude::PhysicsPipeline::new();
+        // The template may hold forces applied for the step it was taken before: drop them.
+        for e in &self.table {
+            if let Some(rb) = self.sim.bodies.get_mut(e.handle) {
+                rb.reset_forces(false);
+                rb.reset_torques(false);
+            }
+        }
         let mut o = 0;
         let handles: Vec<_> = self
             .table

@@ -325,3 +325,108 @@ fn stl_mesh_and_convex_decomposition_load() {
     ));
     assert!(Path::new(&dir.path().join("l.stl")).exists());
 }
+
+#[test]
+fn targets_of_a_subset_of_dofs_leave_the_others_alone() {
+    let (mut world, panda, _) = panda_scene(WorldConfig::default(), None);
+    let before = world.drive_targets(panda).unwrap();
+    world
+        .set_drive_targets_of(panda, &[7, 8], &[0.01, 0.02])
+        .unwrap();
+    world
+        .set_drive_velocity_targets_of(panda, &[2], &[0.3])
+        .unwrap();
+    let after = world.drive_targets(panda).unwrap();
+    assert_eq!(&after[..7], &before[..7]);
+    assert_eq!(&after[7..], &[0.01, 0.02]);
+    assert_eq!(world.drive_velocity_targets(panda).unwrap()[2], 0.3);
+    assert!(world.set_drive_targets_of(panda, &[9], &[0.0]).is_err());
+    assert!(world.set_drive_targets_of(panda, &[0, 1], &[0.0]).is_err());
+}
+
+/// A base block and a two-link planar arm whose second link, folded back, sweeps through the
+/// base: it must stop on the base (non-adjacent links collide) unless self-collision is off.
+fn folding_arm_final_angle(self_collision: ms2_physics::SelfCollision) -> f32 {
+    use ms2_physics::{ArticulationDesc, Inertial, JointDesc, JointType, LinkDesc};
+    let inertial = Some(Inertial {
+        mass: 1.0,
+        pose_link_from_inertial: Pose3::identity(),
+        inertia: nalgebra::Matrix3::identity() * 0.01,
+    });
+    let bar = |length: f32| {
+        ShapeSpec::new(ShapeDesc::cuboid(length, 0.04, 0.04))
+            .with_pose(Pose3::translation(length / 2.0, 0.0, 0.0))
+            .with_mass(MassSpec::Massless)
+    };
+    let link = |name: &str, collisions: Vec<ShapeSpec>, inertial: Option<Inertial>| LinkDesc {
+        name: name.into(),
+        inertial,
+        collisions,
+        visuals: vec![],
+    };
+    let joint = |name: &str, parent: &str, child: &str, x: f32| JointDesc {
+        name: name.into(),
+        joint_type: JointType::Revolute,
+        parent: parent.into(),
+        child: child.into(),
+        pose_parent_from_joint: Pose3::translation(x, 0.0, 0.0),
+        axis: Vector3::z(),
+        limits: Some([-3.2, 3.2]),
+        effort_limit: 100.0,
+        velocity_limit: 10.0,
+        damping: 0.0,
+        friction: 0.0,
+        mimic: None,
+    };
+    let desc = ArticulationDesc {
+        name: "folding".into(),
+        links: vec![
+            link(
+                "base",
+                vec![ShapeSpec::new(ShapeDesc::cuboid(0.1, 0.1, 0.1))],
+                None,
+            ),
+            link(
+                "a",
+                vec![bar(0.4).with_pose(Pose3::translation(0.3, 0.0, 0.0))],
+                inertial.clone(),
+            ),
+            link("b", vec![bar(0.6)], inertial),
+        ],
+        joints: vec![joint("j1", "base", "a", 0.0), joint("j2", "a", "b", 0.5)],
+    };
+    let mut world = World::new(WorldConfig::default()).unwrap();
+    let options = ArticulationOptions {
+        root_pose: Pose3::translation(0.0, 0.0, 0.5),
+        self_collision,
+        ..ArticulationOptions::default()
+    };
+    let art = world.add_articulation(&desc, &options).unwrap();
+    world
+        .set_drives(
+            art,
+            DriveParams {
+                stiffness: 50.0,
+                damping: 10.0,
+                force_limit: 20.0,
+            },
+        )
+        .unwrap();
+    world.set_drive_targets(art, &[0.0, 3.1]).unwrap();
+    world.step_n(1500);
+    world.qpos(art).unwrap()[1]
+}
+
+#[test]
+fn non_adjacent_links_collide_unless_self_collision_is_disabled() {
+    let blocked = folding_arm_final_angle(ms2_physics::SelfCollision::NonAdjacent);
+    let free = folding_arm_final_angle(ms2_physics::SelfCollision::Disabled);
+    assert!(
+        (free - 3.1).abs() < 0.05,
+        "without self-collision the arm folds fully: {free}"
+    );
+    assert!(
+        blocked < 3.0,
+        "the folded link passed through the base: {blocked}"
+    );
+}

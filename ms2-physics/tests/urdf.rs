@@ -148,3 +148,23 @@ fn obj_mesh_collision_loads_as_convex_hull() {
     assert_eq!(w.body_visuals(body).unwrap().len(), 1);
     assert_eq!(w.dof(art).unwrap(), 1);
 }
+
+#[test]
+fn negative_inertia_is_an_invalid_element_error() {
+    let text = TWO_LINKS
+        .replace("TYPE", "revolute")
+        .replace("GEOMETRY", "")
+        .replace("izz=\"0.01\"", "izz=\"-0.5\"");
+    let err = world()
+        .load_urdf_str(&text, Path::new("."), &ArticulationOptions::default())
+        .unwrap_err();
+    match &err {
+        PhysicsError::Urdf(UrdfError::Invalid { element, .. }) => {
+            assert!(
+                element.contains("arm") && element.contains("inertia"),
+                "{element}"
+            )
+        }
+        other => panic!("expected an invalid-element error, got {other:?}"),
+    }
+}

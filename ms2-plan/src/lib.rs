@@ -13,11 +13,33 @@
 //! Frames and units: all poses are in the robot's **base frame** unless a name says otherwise
 //! (`pose_a_from_b` maps coordinates in frame `b` to frame `a`); lengths in metres, angles in
 //! radians, times in seconds. Joint values are radians (revolute) or metres (prismatic).
+//!
+//! ms2's Panda is available as [`KinematicRobot::panda`] (feature `control`, on by default: an
+//! adapter over ms2-control's kinematic model and the URDF's collision primitives):
+//!
+//! ```
+//! use ms2_plan::{CollisionScene, KinematicRobot, MotionPlanner, PlannerConfig};
+//! let panda = KinematicRobot::panda().unwrap();
+//! let mut scene = CollisionScene::new();
+//! scene.add_ground("ground", 0.0).unwrap();
+//! scene.allow_collision("panda_link0", "ground");
+//! let start = ms2_assets::PANDA_REST_QPOS[..7].to_vec();
+//! let mut goal = start.clone();
+//! goal[0] = 1.0; // swing joint 1 by 1 rad
+//! let mut planner = MotionPlanner::new(&panda, PlannerConfig::default()).unwrap();
+//! let motion = planner.plan_to_configuration(&scene, &start, &goal).unwrap();
+//! // Joint targets at 20 Hz, ending exactly at the goal.
+//! assert_eq!(motion.trajectory.positions.last().unwrap(), &goal);
+//! ```
+
+#![warn(missing_docs)]
 
 mod checker;
 mod convert;
 mod error;
 mod grasp;
+#[cfg(feature = "control")]
+mod kinematic_robot;
 mod planner;
 mod robot;
 mod rrt;
@@ -34,6 +56,8 @@ pub use error::PlanError;
 pub use grasp::{
     box_grasp_poses, find_grasps, GraspCandidate, GraspKind, GraspPose, GripperSpec, OrientedBox,
 };
+#[cfg(feature = "control")]
+pub use kinematic_robot::{KinematicRobot, PANDA_MAX_ACCELERATIONS};
 pub use planner::{MotionPlanner, PlannedMotion, PlannerConfig};
 pub use robot::{CollisionLink, JointLimits, LinkShape, PlanningRobot};
 pub use rrt::{plan_rrt_connect, RrtConfig};

@@ -91,7 +91,7 @@ pub trait PlanningRobot {
 
     /// Index (into [`PlanningRobot::collision_links`]) of the link that carries grasped objects
     /// (for the Panda, the hand).
-    fn tcp_link(&self) -> usize;
+    fn grasp_link(&self) -> usize;
 
     /// Inverse kinematics hook: a configuration whose TCP pose equals `pose_base_from_tcp`,
     /// searched from `seed` (a valid configuration), within joint limits.

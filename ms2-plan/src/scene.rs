@@ -260,3 +260,67 @@ impl CollisionScene {
             .ok_or_else(|| PlanError::UnknownObject(name.to_owned()))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn world_objects_are_expressed_in_the_base_frame() {
+        let pose_world_from_base = Isometry3::translation(-0.615, 0.0, 0.0);
+        let scene = CollisionScene::from_world_objects(
+            &pose_world_from_base,
+            [(
+                "cube".to_owned(),
+                SharedShape::ball(0.02),
+                Isometry3::translation(0.1, 0.2, 0.02),
+            )],
+        )
+        .unwrap();
+        let cube = scene.object("cube").unwrap();
+        assert_relative_eq!(
+            cube.pose_base_from_object.translation.vector,
+            Vector3::new(0.715, 0.2, 0.02),
+            epsilon = 1e-12
+        );
+    }
+
+    #[test]
+    fn names_are_unique_and_attaching_keeps_the_object_where_it_is() {
+        let mut scene = CollisionScene::new();
+        scene.add_ground("ground", 0.0).unwrap();
+        let err = scene.add_ground("ground", 1.0).unwrap_err();
+        assert_eq!(err, PlanError::DuplicateName("ground".into()));
+        assert!(matches!(
+            scene.add_box("b", Vector3::new(0.1, -0.1, 0.1), Isometry3::identity()),
+            Err(PlanError::InvalidParameter {
+                name: "box size",
+                ..
+            })
+        ));
+        let box_pose = Isometry3::translation(0.5, 0.0, 0.3);
+        scene
+            .add_box("box", Vector3::new(0.04, 0.04, 0.04), box_pose)
+            .unwrap();
+        let pose_base_from_hand =
+            Isometry3::new(Vector3::new(0.5, 0.0, 0.4), Vector3::new(3.1, 0.0, 0.0));
+        scene
+            .attach_existing_object("box", "hand", &pose_base_from_hand, vec!["finger".into()])
+            .unwrap();
+        assert!(scene.object("box").is_err());
+        let attached = &scene.attached_objects()[0];
+        let back = pose_base_from_hand * attached.pose_link_from_object;
+        assert_relative_eq!(
+            back.translation.vector,
+            box_pose.translation.vector,
+            epsilon = 1e-12
+        );
+        let detached = scene.detach_object("box").unwrap();
+        assert_eq!(detached.touch_links, vec!["finger".to_owned()]);
+        assert_eq!(
+            scene.detach_object("box").unwrap_err(),
+            PlanError::UnknownObject("box".into())
+        );
+    }
+}

@@ -287,6 +287,16 @@ pub fn compute_profile(
 /// The last sample is the path's end; it is reached at the first multiple of `timestep` at or
 /// after the optimal duration.
 ///
+/// ```
+/// use ms2_plan::{parameterize, CubicSplinePath, JointLimits};
+/// let path = CubicSplinePath::new(&[vec![0.0], vec![1.0]]).unwrap();
+/// let limits = [JointLimits { lower: -2.0, upper: 2.0, max_velocity: 1.0, max_acceleration: 2.0 }];
+/// let trajectory = parameterize(&path, &limits, 0.05, 0.005).unwrap();
+/// // Trapezoid: 1 rad at up to 1 rad/s with 2 rad/s² ramps takes 1.5 s.
+/// assert!((trajectory.duration() - 1.5).abs() <= 0.05);
+/// assert_eq!(trajectory.positions.last().unwrap(), &vec![1.0]);
+/// ```
+///
 /// # Errors
 /// As [`compute_profile`]; [`PlanError::InvalidParameter`] for a non-positive `timestep` or
 /// `grid_resolution`.

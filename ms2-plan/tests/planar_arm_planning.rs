@@ -324,3 +324,31 @@ fn plan_to_pose_reaches_the_pose_around_the_wall() {
     let checker = CollisionChecker::new(&arm, &scene, CheckerOptions::default()).unwrap();
     assert!(checker.is_path_valid(&motion.trajectory.positions, 0.001));
 }
+
+#[test]
+fn shortcutting_straightens_a_zigzag_in_free_space_and_keeps_a_blocked_detour_valid() {
+    use rand::SeedableRng;
+    let arm = PlanarArm::new();
+    let empty = CollisionScene::new();
+    let checker = CollisionChecker::new(&arm, &empty, CheckerOptions::default()).unwrap();
+    let zigzag = vec![
+        vec![0.0, 0.3, 0.0],
+        vec![0.3, 0.9, 0.4],
+        vec![0.6, 0.3, 0.0],
+        vec![0.9, 0.9, 0.4],
+        vec![1.2, 0.3, 0.0],
+    ];
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
+    let short = ms2_plan::shortcut_path(&checker, &zigzag, 50, 0.01, &mut rng);
+    assert_eq!(short, vec![zigzag[0].clone(), zigzag[4].clone()]);
+
+    let scene = wall_scene();
+    let checker = CollisionChecker::new(&arm, &scene, CheckerOptions::default()).unwrap();
+    let config = ms2_plan::RrtConfig::default();
+    let raw = ms2_plan::plan_rrt_connect(&checker, &START, &GOAL, &config, &mut rng).unwrap();
+    let short = ms2_plan::shortcut_path(&checker, &raw, 200, 0.01, &mut rng);
+    assert!(ms2_plan::path_length(&short) <= ms2_plan::path_length(&raw));
+    assert!(checker.is_path_valid(&short, 0.001));
+    assert_eq!(short.first(), raw.first());
+    assert_eq!(short.last(), raw.last());
+}

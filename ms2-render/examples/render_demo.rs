@@ -36,6 +36,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     })?;
 
     let mut scene = Scene::new();
+    // The sun casts shadows over the 1 m around the origin.
+    scene.lighting.shadow = Some(Shadow::default());
     let ids = |k| SegmentationIds { actor: k, link: k };
     scene.add_instance(Instance::new(
         ground,

@@ -9,6 +9,7 @@
 
 use crate::renderer::{Renderer, ResourceStore, CAMERA_BLOCK_BYTES, INSTANCE_BYTES};
 use crate::scene::MAX_DIRECTIONAL_LIGHTS;
+use crate::shadow::light_clip_from_world;
 use crate::targets::{linear_to_srgb8, CameraTargets, FrameResources};
 use crate::{Camera, CameraOutput, RenderError, Scene};
 use std::sync::{Arc, Mutex};
@@ -42,10 +43,29 @@ fn instance_record(instance: &crate::Instance) -> [u32; 32] {
     words
 }
 
+/// Words in a uniform block (`CAMERA_BLOCK_BYTES` / 4).
+const BLOCK_WORDS: usize = CAMERA_BLOCK_BYTES as usize / 4;
+
+/// The first light's shadow projection for a scene, if it has shadows.
+fn scene_light_clip_from_world(scene: &Scene) -> Option<nalgebra::Matrix4<f32>> {
+    let shadow = scene.lighting.shadow.as_ref()?;
+    let light = scene.lighting.directional.first()?;
+    Some(light_clip_from_world(shadow, light.direction_world))
+}
+
+/// Packs the uniform block of a scene's shadow pass: only `clip_from_world` is used.
+fn light_block(light_clip_from_world: &nalgebra::Matrix4<f32>) -> [u32; BLOCK_WORDS] {
+    let mut words = [0u32; BLOCK_WORDS];
+    for (k, v) in light_clip_from_world.as_slice().iter().enumerate() {
+        words[k] = v.to_bits();
+    }
+    words
+}
+
 /// Packs a camera's uniform block (see `CameraBlock` in `shader.wgsl`).
-fn camera_block(camera: &Camera, scene: &Scene) -> [u32; 64] {
-    let mut words = [0u32; 64];
-    let put = |words: &mut [u32; 64], at: usize, values: &[f32]| {
+fn camera_block(camera: &Camera, scene: &Scene) -> [u32; BLOCK_WORDS] {
+    let mut words = [0u32; BLOCK_WORDS];
+    let put = |words: &mut [u32; BLOCK_WORDS], at: usize, values: &[f32]| {
         for (k, v) in values.iter().enumerate() {
             words[at + k] = v.to_bits();
         }
@@ -77,6 +97,10 @@ fn camera_block(camera: &Camera, scene: &Scene) -> [u32; 64] {
         );
     }
     words[60] = l.directional.len().min(MAX_DIRECTIONAL_LIGHTS) as u32;
+    if let Some(light) = scene_light_clip_from_world(scene) {
+        words[61] = 1;
+        put(&mut words, 64, light.as_slice());
+    }
     words
 }
 
@@ -150,6 +174,31 @@ impl Renderer {
             None => FrameResources::new(self, &sizes)?,
         };
         let gpu = &self.inner.gpu;
+        // Uniform blocks: one per camera, then one per shadowed scene (its light's projection).
+        let mut blocks: Vec<[u32; BLOCK_WORDS]> = cameras
+            .iter()
+            .zip(&camera_scene)
+            .map(|(c, &k)| camera_block(c, views[k].0))
+            .collect();
+        let mut shadow_passes = Vec::new(); // (scene index, uniform block index)
+        for (k, (scene, _)) in views.iter().enumerate() {
+            if let (Some(light), Some(shadow)) =
+                (scene_light_clip_from_world(scene), &scene.lighting.shadow)
+            {
+                resources.ensure_shadow_map(self, k, shadow.resolution);
+                shadow_passes.push((k, blocks.len()));
+                blocks.push(light_block(&light));
+            }
+        }
+        resources.ensure_uniform_capacity(self, blocks.len() as u64);
+        let mut uniform_bytes = vec![0u8; gpu.uniform_stride as usize * blocks.len()];
+        for (b, block) in blocks.iter().enumerate() {
+            let at = b * gpu.uniform_stride as usize;
+            uniform_bytes[at..at + CAMERA_BLOCK_BYTES as usize]
+                .copy_from_slice(bytemuck::cast_slice(block));
+        }
+        gpu.queue
+            .write_buffer(&resources.uniforms, 0, &uniform_bytes);
         resources.ensure_instance_capacity(&gpu.device, records.len() as u64);
         let instances = resources
             .instances
@@ -159,15 +208,6 @@ impl Renderer {
             gpu.queue
                 .write_buffer(instances, 0, bytemuck::cast_slice(&records));
         }
-        let mut uniform_bytes = vec![0u8; (gpu.uniform_stride as usize) * cameras.len()];
-        for (c, camera) in cameras.iter().enumerate() {
-            let block = camera_block(camera, views[camera_scene[c]].0);
-            let at = c * gpu.uniform_stride as usize;
-            uniform_bytes[at..at + CAMERA_BLOCK_BYTES as usize]
-                .copy_from_slice(bytemuck::cast_slice(&block));
-        }
-        gpu.queue
-            .write_buffer(&resources.uniforms, 0, &uniform_bytes);
 
         let error_scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut encoder = gpu
@@ -175,11 +215,54 @@ impl Renderer {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("ms2-render batch"),
             });
+        for &(k, block) in &shadow_passes {
+            let map = resources.shadow_maps[k]
+                .as_ref()
+                .expect("shadow map created above");
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("ms2-render shadow"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &map.view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&gpu.shadow.pipeline);
+            let offset = (block as u64 * gpu.uniform_stride) as u32;
+            pass.set_bind_group(0, &resources.camera_bind_group, &[offset]);
+            for draw in &draws[k] {
+                let mesh = &store.meshes[draw.mesh];
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                let start = draw.record * INSTANCE_BYTES;
+                pass.set_vertex_buffer(1, instances.slice(start..start + INSTANCE_BYTES));
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+            }
+        }
         for (c, targets) in resources.targets.iter().enumerate() {
             let mut pass = begin_pass(&mut encoder, targets);
             pass.set_pipeline(&gpu.pipeline);
             let offset = (c as u64 * gpu.uniform_stride) as u32;
             pass.set_bind_group(0, &resources.camera_bind_group, &[offset]);
+            let shadow_map = match &views[camera_scene[c]].0.lighting.shadow {
+                Some(_) => resources
+                    .shadow_maps
+                    .get(camera_scene[c])
+                    .and_then(|m| m.as_ref()),
+                None => None,
+            };
+            pass.set_bind_group(
+                2,
+                shadow_map.map_or(&gpu.shadow.disabled, |m| &m.bind_group),
+                &[],
+            );
             for draw in &draws[camera_scene[c]] {
                 let mesh = &store.meshes[draw.mesh];
                 let texture = draw

@@ -48,6 +48,7 @@ pub mod mesh;
 mod output;
 mod renderer;
 pub mod scene;
+mod shadow;
 mod targets;
 
 pub use camera::Camera;
@@ -60,7 +61,7 @@ pub use renderer::{
     TextureHandle, BACKEND_ENV_VAR,
 };
 pub use scene::{
-    DirectionalLight, Instance, InstanceId, Lighting, Material, Scene, SegmentationIds,
+    DirectionalLight, Instance, InstanceId, Lighting, Material, Scene, SegmentationIds, Shadow,
 };
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! The renderer: adapter selection, the shared mesh/texture store and the render pipeline.
 
 use crate::error::INSTALL_ADVICE;
+use crate::shadow::{shadow_bind_group_layout, ShadowGpu};
 use crate::targets::FramePool;
 use crate::{MeshData, RenderError};
 use std::sync::{Arc, Mutex, RwLock};
@@ -104,6 +105,7 @@ pub(crate) struct Gpu {
     pub(crate) texture_layout: wgpu::BindGroupLayout,
     pub(crate) sampler: wgpu::Sampler,
     pub(crate) white_texture: wgpu::BindGroup,
+    pub(crate) shadow: ShadowGpu,
     /// Stride between per-camera uniform blocks, bytes.
     pub(crate) uniform_stride: u64,
 }
@@ -130,7 +132,33 @@ pub(crate) const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba
 /// Depth-test format (never read back: GL cannot copy depth textures).
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Size of the per-camera uniform block (see `shader.wgsl`).
-pub(crate) const CAMERA_BLOCK_BYTES: u64 = 256;
+pub(crate) const CAMERA_BLOCK_BYTES: u64 = 320;
+/// Per-vertex attributes: position, normal, uv.
+const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+/// Per-instance attributes (see `VertexIn` in `shader.wgsl`).
+const INSTANCE_ATTRIBUTES: [wgpu::VertexAttribute; 8] = wgpu::vertex_attr_array![
+    3 => Float32x4, 4 => Float32x4, 5 => Float32x4,
+    6 => Float32x4, 7 => Float32x4, 8 => Float32x4,
+    9 => Float32x4, 10 => Uint32x4
+];
+
+/// Vertex buffer 0: mesh vertices; buffer 1: one instance record.
+pub(crate) fn vertex_buffer_layouts() -> [Option<wgpu::VertexBufferLayout<'static>>; 2] {
+    [
+        Some(wgpu::VertexBufferLayout {
+            array_stride: VERTEX_BYTES,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &VERTEX_ATTRIBUTES,
+        }),
+        Some(wgpu::VertexBufferLayout {
+            array_stride: INSTANCE_BYTES,
+            step_mode: wgpu::VertexStepMode::Instance,
+            attributes: &INSTANCE_ATTRIBUTES,
+        }),
+    ]
+}
+
 /// Bytes per vertex: position (3 f32), normal (3 f32), uv (2 f32).
 const VERTEX_BYTES: u64 = 32;
 /// Bytes per instance record: model rows (3 vec4), normal rows (3 vec4), colour, ids.
@@ -339,19 +367,16 @@ impl Gpu {
                 },
             ],
         });
+        let shadow_layout = shadow_bind_group_layout(&device);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("ms2-render pipeline layout"),
-            bind_group_layouts: &[Some(&camera_layout), Some(&texture_layout)],
+            bind_group_layouts: &[
+                Some(&camera_layout),
+                Some(&texture_layout),
+                Some(&shadow_layout),
+            ],
             immediate_size: 0,
         });
-        let vertex_attributes = wgpu::vertex_attr_array![
-            0 => Float32x3, 1 => Float32x3, 2 => Float32x2
-        ];
-        let instance_attributes = wgpu::vertex_attr_array![
-            3 => Float32x4, 4 => Float32x4, 5 => Float32x4,
-            6 => Float32x4, 7 => Float32x4, 8 => Float32x4,
-            9 => Float32x4, 10 => Uint32x4
-        ];
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("ms2-render pipeline"),
             layout: Some(&layout),
@@ -359,18 +384,7 @@ impl Gpu {
                 module: &shader,
                 entry_point: Some("vs_main"),
                 compilation_options: Default::default(),
-                buffers: &[
-                    Some(wgpu::VertexBufferLayout {
-                        array_stride: VERTEX_BYTES,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &vertex_attributes,
-                    }),
-                    Some(wgpu::VertexBufferLayout {
-                        array_stride: INSTANCE_BYTES,
-                        step_mode: wgpu::VertexStepMode::Instance,
-                        attributes: &instance_attributes,
-                    }),
-                ],
+                buffers: &vertex_buffer_layouts(),
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
@@ -422,7 +436,9 @@ impl Gpu {
             (1, 1),
             &[255, 255, 255, 255],
         );
+        let shadow = ShadowGpu::new(&device, shadow_layout, &camera_layout, &shader);
         Gpu {
+            shadow,
             device,
             queue,
             pipeline,

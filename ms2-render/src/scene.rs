@@ -95,6 +95,29 @@ pub struct DirectionalLight {
 /// Maximum number of directional lights per scene.
 pub const MAX_DIRECTIONAL_LIGHTS: usize = 4;
 
+/// Shadows cast by a scene's first directional light, computed over a sphere around the
+/// workspace (objects outside it neither cast nor receive shadows).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shadow {
+    /// Centre of the shadowed region, world frame, metres.
+    pub center_world: Vector3<f32>,
+    /// Radius of the shadowed region, metres (> 0).
+    pub radius_m: f32,
+    /// Shadow-map size in texels per side (16 to 4096); ~2 r / resolution metres per texel.
+    pub resolution: u32,
+}
+
+impl Default for Shadow {
+    /// A 1 m sphere around the origin (a tabletop workspace), 1024² texels.
+    fn default() -> Shadow {
+        Shadow {
+            center_world: Vector3::zeros(),
+            radius_m: 1.0,
+            resolution: 1024,
+        }
+    }
+}
+
 /// Lights and background of a scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Lighting {
@@ -104,6 +127,9 @@ pub struct Lighting {
     pub directional: Vec<DirectionalLight>,
     /// Linear RGB colour of background pixels.
     pub background: [f32; 3],
+    /// Shadows of the first directional light, if any (off by default: each shadowed scene
+    /// costs one extra depth pass per frame).
+    pub shadow: Option<Shadow>,
 }
 
 impl Default for Lighting {
@@ -123,6 +149,7 @@ impl Default for Lighting {
                 },
             ],
             background: [0.0, 0.0, 0.0],
+            shadow: None,
         }
     }
 }
@@ -200,6 +227,22 @@ impl Scene {
                 return Err(RenderError::InvalidScene(format!(
                     "light direction {d:?} must be finite and non-zero"
                 )));
+            }
+        }
+        if let Some(shadow) = &l.shadow {
+            let ok = shadow.center_world.iter().all(|v| v.is_finite())
+                && shadow.radius_m.is_finite()
+                && shadow.radius_m > 0.0
+                && (16..=4096).contains(&shadow.resolution);
+            if !ok {
+                return Err(RenderError::InvalidScene(format!(
+                    "shadow {shadow:?}: expected a finite centre, radius > 0 and 16..=4096 texels"
+                )));
+            }
+            if l.directional.is_empty() {
+                return Err(RenderError::InvalidScene(
+                    "shadows need at least one directional light".into(),
+                ));
             }
         }
         for (k, inst) in self.instances.iter().enumerate() {

@@ -10,13 +10,17 @@ struct CameraBlock {
     // xyz: direction the light travels (normalised), w unused.
     light_direction: array<vec4<f32>, 4>,
     light_color: array<vec4<f32>, 4>,
-    // x: number of lights.
+    // x: number of lights; y: 1 if the first light casts shadows.
     counts: vec4<u32>,
+    // Orthographic light projection of the first light (see `frame.rs`), depth in [0, 1].
+    light_clip_from_world: mat4x4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> camera: CameraBlock;
 @group(1) @binding(0) var base_texture: texture_2d<f32>;
 @group(1) @binding(1) var base_sampler: sampler;
+@group(2) @binding(0) var shadow_map: texture_depth_2d;
+@group(2) @binding(1) var shadow_sampler: sampler_comparison;
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -66,6 +70,27 @@ fn vs_main(v: VertexIn) -> VertexOut {
     return out;
 }
 
+// Depth-only pass from the first light (its block's clip_from_world is the light projection).
+@vertex
+fn vs_shadow(v: VertexIn) -> @builtin(position) vec4<f32> {
+    let p = vec4<f32>(v.position, 1.0);
+    let world = vec3<f32>(dot(v.model_row0, p), dot(v.model_row1, p), dot(v.model_row2, p));
+    return camera.clip_from_world * vec4<f32>(world, 1.0);
+}
+
+// 1 where the first light reaches `world`, 0 in its shadow (filtered at shadow-map texels).
+fn sun_visibility(world: vec3<f32>) -> f32 {
+    if (camera.counts.y == 0u) {
+        return 1.0;
+    }
+    let p = camera.light_clip_from_world * vec4<f32>(world, 1.0);
+    let uv = vec2<f32>(0.5 + 0.5 * p.x, 0.5 - 0.5 * p.y);
+    if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || p.z > 1.0) {
+        return 1.0;
+    }
+    return textureSampleCompareLevel(shadow_map, shadow_sampler, uv, p.z - 0.002);
+}
+
 struct FragmentOut {
     @location(0) color: vec4<f32>,
     @location(1) gbuffer: vec4<u32>,
@@ -80,12 +105,14 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     let albedo = in.base_color.rgb * textureSample(base_texture, base_sampler, in.uv).rgb;
     let to_eye = normalize(camera.eye_world.xyz - in.world_position);
     var light = camera.ambient.rgb * albedo;
+    let sun = sun_visibility(in.world_position);
     for (var i = 0u; i < camera.counts.x; i = i + 1u) {
         let l = -camera.light_direction[i].xyz;
         let lambert = max(dot(n, l), 0.0);
         let h = normalize(l + to_eye);
         let specular = select(0.0, pow(max(dot(n, h), 0.0), 32.0), lambert > 0.0);
-        light = light + camera.light_color[i].rgb * (albedo * lambert + vec3<f32>(0.15 * specular));
+        let visible = select(1.0, sun, i == 0u);
+        light = light + visible * camera.light_color[i].rgb * (albedo * lambert + vec3<f32>(0.15 * specular));
     }
     var out: FragmentOut;
     out.color = vec4<f32>(light, 1.0);

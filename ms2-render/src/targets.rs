@@ -4,6 +4,7 @@
 use crate::renderer::{
     Renderer, CAMERA_BLOCK_BYTES, COLOR_FORMAT, DEPTH_FORMAT, GBUFFER_FORMAT, INSTANCE_BYTES,
 };
+use crate::shadow::ShadowMap;
 use crate::{Camera, CameraOutput, RenderError};
 
 /// How many idle batches the pool keeps.
@@ -31,8 +32,12 @@ pub(crate) struct FrameResources {
     pub(crate) readback: wgpu::Buffer,
     pub(crate) uniforms: wgpu::Buffer,
     pub(crate) camera_bind_group: wgpu::BindGroup,
+    /// Uniform blocks the buffer holds.
+    uniform_capacity: u64,
     pub(crate) instances: Option<wgpu::Buffer>,
     instance_capacity: u64,
+    /// Shadow map per scene index of the batch (created when a scene first needs one).
+    pub(crate) shadow_maps: Vec<Option<ShadowMap>>,
 }
 
 /// Idle [`FrameResources`], reused by batches of the same shape.
@@ -120,33 +125,43 @@ impl FrameResources {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ms2-render camera uniforms"),
-            size: gpu.uniform_stride * sizes.len() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let camera_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ms2-render camera"),
-            layout: &gpu.camera_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &uniforms,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(CAMERA_BLOCK_BYTES),
-                }),
-            }],
-        });
+        let (uniforms, camera_bind_group) = uniform_buffer(renderer, sizes.len() as u64);
         Ok(FrameResources {
             sizes: sizes.to_vec(),
             targets,
             readback,
             uniforms,
             camera_bind_group,
+            uniform_capacity: sizes.len() as u64,
             instances: None,
             instance_capacity: 0,
+            shadow_maps: Vec::new(),
         })
+    }
+
+    /// Makes sure the uniform buffer holds at least `blocks` camera/light blocks.
+    pub(crate) fn ensure_uniform_capacity(&mut self, renderer: &Renderer, blocks: u64) {
+        if self.uniform_capacity < blocks {
+            (self.uniforms, self.camera_bind_group) = uniform_buffer(renderer, blocks);
+            self.uniform_capacity = blocks;
+        }
+    }
+
+    /// Makes sure scene `scene_index` has a shadow map of `resolution`² texels.
+    pub(crate) fn ensure_shadow_map(
+        &mut self,
+        renderer: &Renderer,
+        scene_index: usize,
+        resolution: u32,
+    ) {
+        if self.shadow_maps.len() <= scene_index {
+            self.shadow_maps.resize_with(scene_index + 1, || None);
+        }
+        let slot = &mut self.shadow_maps[scene_index];
+        if slot.as_ref().is_none_or(|m| m.resolution != resolution) {
+            let gpu = &renderer.inner.gpu;
+            *slot = Some(gpu.shadow.create_map(&gpu.device, resolution));
+        }
     }
 
     /// Makes sure the instance buffer holds at least `records` instance records.
@@ -239,6 +254,30 @@ impl CameraTargets {
             segmentation_link,
         }
     }
+}
+
+/// A uniform buffer of `blocks` camera/light blocks and its bind group (dynamic offsets).
+fn uniform_buffer(renderer: &Renderer, blocks: u64) -> (wgpu::Buffer, wgpu::BindGroup) {
+    let gpu = &renderer.inner.gpu;
+    let uniforms = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("ms2-render camera uniforms"),
+        size: gpu.uniform_stride * blocks.max(1),
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("ms2-render camera"),
+        layout: &gpu.camera_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &uniforms,
+                offset: 0,
+                size: wgpu::BufferSize::new(CAMERA_BLOCK_BYTES),
+            }),
+        }],
+    });
+    (uniforms, bind_group)
 }
 
 /// Encodes a linear colour channel in `[0, 1]` as 8-bit sRGB.

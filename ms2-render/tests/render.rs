@@ -283,6 +283,7 @@ fn textures_are_sampled_with_uvs_left_to_right() {
         ambient: [1.0; 3],
         directional: vec![],
         background: [0.0; 3],
+        shadow: None,
     };
     scene.add_instance(Instance::new(
         plane,
@@ -411,4 +412,76 @@ fn environments_in_threads_share_one_renderer() {
     for r in &results {
         assert!(r == &alone, "a render from another thread differs");
     }
+}
+
+#[test]
+fn directional_light_casts_shadows_when_enabled() {
+    let r = renderer();
+    let ground = r.add_mesh(&MeshData::plane(1.0, 1.0)).unwrap();
+    let plate = r.add_mesh(&MeshData::cuboid([0.1, 0.1, 0.005])).unwrap();
+    let mut scene = Scene::new();
+    scene.lighting = Lighting {
+        ambient: [0.2; 3],
+        directional: vec![DirectionalLight {
+            direction_world: Vector3::new(0.0, 0.0, -1.0),
+            color: [0.8; 3],
+        }],
+        background: [0.0; 3],
+        shadow: None,
+    };
+    let white = Material::color(1.0, 1.0, 1.0);
+    scene.add_instance(Instance::new(
+        ground,
+        white,
+        Isometry3::identity(),
+        ids(1, 1),
+    ));
+    // A plate floating 0.3 m above the ground at x = −0.2.
+    scene.add_instance(Instance::new(
+        plate,
+        white,
+        Isometry3::translation(-0.2, 0.0, 0.3),
+        ids(2, 2),
+    ));
+    // Looking at the ground from the side, below the plate's height.
+    let camera = Camera::new(96, 96, 1.2, 0.01, 10.0).looking_at(
+        Point3::new(0.6, 0.0, 0.25),
+        Point3::new(-0.1, 0.0, 0.0),
+        Vector3::z(),
+    );
+    let brightness = |out: &CameraOutput, world: Point3<f32>| {
+        let uv = out.intrinsic_cv() * (out.extrinsic_cv() * world.to_homogeneous());
+        let i = (uv.y / uv.z).round() as usize * 96 + (uv.x / uv.z).round() as usize;
+        assert_eq!(out.segmentation_link[i], 1, "expected ground at {world:?}");
+        out.rgb[3 * i] as i32
+    };
+    let under = Point3::new(-0.2, 0.0, 0.0);
+    let beside = Point3::new(0.1, 0.0, 0.0);
+    let lit = &r.render(&[(&scene, &[camera][..])]).unwrap()[0];
+    assert!((brightness(lit, under) - brightness(lit, beside)).abs() <= 2);
+    scene.lighting.shadow = Some(Shadow {
+        center_world: Vector3::zeros(),
+        radius_m: 0.6,
+        resolution: 256,
+    });
+    let shadowed = &r.render(&[(&scene, &[camera][..])]).unwrap()[0];
+    let (dark, bright) = (brightness(shadowed, under), brightness(shadowed, beside));
+    assert!(
+        dark + 60 < bright,
+        "shadowed ground {dark}, lit ground {bright}"
+    );
+    assert!(
+        (bright - brightness(lit, beside)).abs() <= 2,
+        "no self-shadowing on lit ground"
+    );
+    // Bad shadow settings are rejected.
+    scene.lighting.shadow = Some(Shadow {
+        center_world: Vector3::zeros(),
+        radius_m: -1.0,
+        resolution: 256,
+    });
+    assert!(matches!(
+        r.render(&[(&scene, &[camera][..])]),
+        Err(RenderError::InvalidScene(_))
+    ));
 }

@@ -23,6 +23,7 @@
 
 #![warn(missing_docs)]
 
+pub mod adapters;
 mod backend;
 pub mod config;
 mod env;

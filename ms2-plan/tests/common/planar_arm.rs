@@ -98,7 +98,7 @@ impl PlanningRobot for PlanarArm {
         self.link_poses(q, &mut poses);
         poses[2] * Isometry3::translation(LENGTHS[2], 0.0, 0.0)
     }
-    fn tcp_link(&self) -> usize {
+    fn grasp_link(&self) -> usize {
         2
     }
     fn inverse_kinematics(

@@ -1,3 +1,4 @@
 //! The registered tasks.
 
 pub mod dummy;
+pub mod soft;

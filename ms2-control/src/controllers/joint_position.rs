@@ -1,0 +1,256 @@
+//! PD joint position control: `pd_joint_pos`, `pd_joint_delta_pos`, `pd_joint_target_delta_pos`,
+//! `pd_joint_pos_vel`, `pd_joint_delta_pos_vel` and the mimic gripper.
+
+use super::{
+    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+};
+use crate::action::{ActionBounds, ActionScaling};
+use crate::articulation::{Articulation, DriveGains};
+
+/// Configuration of a [`JointPositionController`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointPositionConfig {
+    /// Controller name, e.g. `arm_pd_joint_delta_pos`.
+    pub name: String,
+    /// Driven joints.
+    pub joint_names: Vec<String>,
+    /// Lower bound of the (physical) position action, one value or one per action entry; `None`
+    /// takes the joints' lower position limits from the kinematic model.
+    pub lower: Option<Vec<f64>>,
+    /// Upper bound, as `lower`.
+    pub upper: Option<Vec<f64>>,
+    /// The action is a change of joint position (`true`) or an absolute position (`false`).
+    pub use_delta: bool,
+    /// With `use_delta`: accumulate on the previous target (`true`) or on the current `qpos`.
+    pub use_target: bool,
+    /// Map `[-1, 1]` onto the bounds (`true`) or take physical values (`false`).
+    pub normalize_action: bool,
+    /// Ramp the drive target linearly from the current `qpos` to the new target over the
+    /// control step's substeps instead of setting it at once.
+    pub interpolate: bool,
+    /// All joints share one action entry and one target (a mimic pair such as the gripper).
+    pub mimic: bool,
+    /// Append a velocity-target half with these bounds (rad/s or m/s) to the action:
+    /// `pd_joint_pos_vel` / `pd_joint_delta_pos_vel`.
+    pub velocity_bounds: Option<(f64, f64)>,
+    /// PD gains of every driven joint.
+    pub gains: DriveGains,
+}
+
+/// PD joint position controller (see the crate docs for each mode's formula).
+#[derive(Debug, Clone)]
+pub struct JointPositionController {
+    config: JointPositionConfig,
+    joint_indices: Vec<usize>,
+    bounds: ActionBounds,
+    /// Number of position entries in the action (1 for mimic).
+    position_dim: usize,
+    substeps: usize,
+    target_qpos: Vec<f64>,
+    target_qvel: Vec<f64>,
+    start_qpos: Vec<f64>,
+    substep: usize,
+}
+
+impl JointPositionController {
+    /// Builds the controller for the articulation layout in `ctx`.
+    pub fn new(config: &JointPositionConfig, ctx: &BuildContext<'_>) -> Result<Self, BuildError> {
+        let name = config.name.as_str();
+        let joint_indices = ctx.indices(name, &config.joint_names)?;
+        let n = joint_indices.len();
+        if n == 0 {
+            return Err(BuildError::BadConfig {
+                controller: name.into(),
+                message: "no joints".into(),
+            });
+        }
+        let position_dim = if config.mimic { 1 } else { n };
+        let model_limits = |upper: bool| -> Result<Vec<f64>, BuildError> {
+            config
+                .joint_names
+                .iter()
+                .take(position_dim)
+                .map(|j| {
+                    let i = ctx
+                        .model
+                        .dof_index(j)
+                        .ok_or_else(|| BuildError::BadConfig {
+                            controller: name.into(),
+                            message: format!(
+                                "joint `{j}` is not a movable joint of the kinematic model"
+                            ),
+                        })?;
+                    let l = ctx.model.dof_limits()[i];
+                    Ok(if upper { l.upper } else { l.lower })
+                })
+                .collect()
+        };
+        let lower = match &config.lower {
+            Some(v) => per_joint(name, "lower", v, position_dim)?,
+            None => model_limits(false)?,
+        };
+        let upper = match &config.upper {
+            Some(v) => per_joint(name, "upper", v, position_dim)?,
+            None => model_limits(true)?,
+        };
+        let mut low = lower;
+        let mut high = upper;
+        if let Some((vlo, vhi)) = config.velocity_bounds {
+            if config.mimic {
+                return Err(BuildError::BadConfig {
+                    controller: name.into(),
+                    message: "a mimic controller cannot take velocity targets".into(),
+                });
+            }
+            low.extend(std::iter::repeat_n(vlo, n));
+            high.extend(std::iter::repeat_n(vhi, n));
+        }
+        check_bounds(name, &low, &high)?;
+        let scaling = if config.normalize_action {
+            ActionScaling::Normalized
+        } else {
+            ActionScaling::Physical
+        };
+        Ok(Self {
+            config: config.clone(),
+            joint_indices,
+            bounds: ActionBounds { low, high, scaling },
+            position_dim,
+            substeps: ctx.timing.substeps(),
+            target_qpos: vec![0.0; n],
+            target_qvel: vec![0.0; n],
+            start_qpos: vec![0.0; n],
+            substep: 0,
+        })
+    }
+
+    fn physical(&self, action: &[f64]) -> Vec<f64> {
+        action
+            .iter()
+            .enumerate()
+            .map(|(i, &a)| self.bounds.to_physical(i, a))
+            .collect()
+    }
+}
+
+impl PartController for JointPositionController {
+    fn name(&self) -> &str {
+        &self.config.name
+    }
+
+    fn joint_indices(&self) -> &[usize] {
+        &self.joint_indices
+    }
+
+    fn bounds(&self) -> &ActionBounds {
+        &self.bounds
+    }
+
+    fn drive_gains(&self) -> Vec<DriveGains> {
+        vec![self.config.gains; self.joint_indices.len()]
+    }
+
+    fn reset(&mut self, articulation: &mut dyn Articulation) {
+        let q = gather(&articulation.qpos(), &self.joint_indices);
+        self.start_qpos = q.clone();
+        self.target_qpos = q;
+        self.target_qvel = vec![0.0; self.joint_indices.len()];
+        self.substep = 0;
+        articulation.set_drive_position_targets(&self.joint_indices, &self.target_qpos);
+        articulation.set_drive_velocity_targets(&self.joint_indices, &self.target_qvel);
+    }
+
+    fn set_action(&mut self, articulation: &mut dyn Articulation, action: &[f64]) {
+        let x = self.physical(action);
+        let n = self.joint_indices.len();
+        self.substep = 0;
+        self.start_qpos = gather(&articulation.qpos(), &self.joint_indices);
+        let position = &x[..self.position_dim];
+        for j in 0..n {
+            let a = if self.config.mimic {
+                position[0]
+            } else {
+                position[j]
+            };
+            self.target_qpos[j] = match (self.config.use_delta, self.config.use_target) {
+                (false, _) => a,
+                (true, false) => self.start_qpos[j] + a,
+                (true, true) => self.target_qpos[j] + a,
+            };
+        }
+        if !self.config.interpolate {
+            articulation.set_drive_position_targets(&self.joint_indices, &self.target_qpos);
+        }
+        if self.config.velocity_bounds.is_some() {
+            self.target_qvel = x[self.position_dim..].to_vec();
+            articulation.set_drive_velocity_targets(&self.joint_indices, &self.target_qvel);
+        }
+    }
+
+    fn before_substep(&mut self, articulation: &mut dyn Articulation) {
+        if self.config.interpolate {
+            self.substep = (self.substep + 1).min(self.substeps);
+            let s = self.substep as f64 / self.substeps as f64;
+            let ramp: Vec<f64> = (0..self.joint_indices.len())
+                .map(|j| self.start_qpos[j] + (self.target_qpos[j] - self.start_qpos[j]) * s)
+                .collect();
+            articulation.set_drive_position_targets(&self.joint_indices, &ramp);
+        }
+    }
+
+    fn position_targets(&self) -> Option<Vec<f64>> {
+        Some(self.target_qpos.clone())
+    }
+
+    fn action_for_joint_targets(
+        &self,
+        articulation: &dyn Articulation,
+        joint_targets: &[f64],
+    ) -> PartConversion {
+        let q = gather(&articulation.qpos(), &self.joint_indices);
+        let mut physical: Vec<f64> = (0..self.position_dim)
+            .map(|j| match (self.config.use_delta, self.config.use_target) {
+                (false, _) => joint_targets[j],
+                (true, false) => joint_targets[j] - q[j],
+                (true, true) => joint_targets[j] - self.target_qpos[j],
+            })
+            .collect();
+        if self.config.velocity_bounds.is_some() {
+            physical.extend(std::iter::repeat_n(0.0, self.joint_indices.len()));
+        }
+        let mut saturated = false;
+        let action = physical
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| {
+                let (a, s) = self.bounds.to_user(i, x);
+                saturated |= s;
+                a
+            })
+            .collect();
+        PartConversion { action, saturated }
+    }
+
+    fn state(&self) -> Vec<f64> {
+        if self.config.use_target {
+            self.target_qpos.clone()
+        } else {
+            Vec::new()
+        }
+    }
+
+    fn set_state(&mut self, state: &[f64]) -> Result<(), String> {
+        let expected = self.state().len();
+        if state.len() != expected {
+            return Err(format!(
+                "{}: state has {} values, expected {expected}",
+                self.config.name,
+                state.len()
+            ));
+        }
+        if self.config.use_target {
+            self.target_qpos = state.to_vec();
+        }
+        Ok(())
+    }
+}

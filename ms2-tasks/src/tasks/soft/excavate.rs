@@ -1,0 +1,428 @@
+//! The Excavate scene: scoop a target amount of clay with a bucket and lift it.
+//!
+//! A clay bed with a seeded height map lies on the floor; a bucket (an open-front scoop of five
+//! boxes: bottom plate, back wall, two side walls) is moved as a kinematic body of the rigid
+//! world and pushes the clay through the two-way coupling. The bucket is commanded once per
+//! control step (20 Hz) with a [`BucketPose`]; the scene interpolates it linearly over the
+//! control step's rigid steps (500 Hz).
+//!
+//! Success (the paper's terms): the number of clay particles in the bucket is within ±25 % of
+//! the episode's target; every particle in the bucket is higher than
+//! [`ExcavateScene::target_height`]; fewer than 20 particles are spilled (outside the bucket
+//! and either outside the bed's footprint by more than 2 cm, or more than 4 cm above the bed's
+//! highest initial point); mean soft-body speed below 0.05 m/s.
+//!
+//! Not yet the `Excavate-v0` environment: the Panda arm carrying the bucket and the task
+//! runtime's hooks are not wired (see `docs/tasks.md`).
+
+use glam::{Vec2, Vec3};
+use ms2_mpm::sampling::{self, HeightMap};
+use ms2_mpm::MpmState;
+use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig};
+use nalgebra::{Translation3, UnitQuaternion, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::{SoftConfig, SoftSceneError, SoftWorld};
+use crate::adapters::mpm_rigid::pose_to_glam;
+
+/// Control frequency (Hz), as ManiSkill2.
+pub const CONTROL_FREQ_HZ: u32 = 20;
+/// Episode limit in control steps, as ManiSkill2's Excavate.
+pub const MAX_EPISODE_STEPS: u32 = 250;
+/// Largest number of spilled particles of a successful episode.
+pub const MAX_SPILLED: usize = 20;
+/// Largest mean soft-body speed (m/s) of a successful episode.
+pub const MAX_SOFT_SPEED: f32 = 0.05;
+/// Relative tolerance on the scooped amount.
+pub const AMOUNT_TOLERANCE: f32 = 0.25;
+
+/// Interior half extents of the bucket (m, bucket frame): x towards the opening, z up.
+pub const BUCKET_INNER_HALF: [f32; 3] = [0.04, 0.035, 0.03];
+/// Wall and plate half thickness (m).
+pub const BUCKET_WALL_HALF: f32 = 0.005;
+
+/// Bed footprint (m, world x and y).
+const BED_MIN: [f32; 2] = [0.12, 0.10];
+const BED_MAX: [f32; 2] = [0.24, 0.22];
+/// Mean bed thickness (m) and the seeded height map's amplitude (m).
+const BED_THICKNESS: f32 = 0.035;
+const BED_AMPLITUDE: f32 = 0.006;
+/// Range of the episode's target amount (particles).
+const TARGET_RANGE: (usize, usize) = (300, 700);
+
+/// Commanded bucket pose: position of the bottom plate's centre (m, world) and pitch (rad,
+/// about world −y: positive raises the opening).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BucketPose {
+    /// Plate centre (m, world).
+    pub position: Vec3,
+    /// Opening raised by this angle (rad).
+    pub pitch: f32,
+}
+
+impl BucketPose {
+    /// The rigid-world pose.
+    pub fn to_pose(&self) -> Pose3 {
+        Pose3::from_parts(
+            Translation3::new(self.position.x, self.position.y, self.position.z),
+            UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -self.pitch),
+        )
+    }
+
+    fn lerp(&self, other: &BucketPose, t: f32) -> BucketPose {
+        BucketPose {
+            position: self.position.lerp(other.position, t),
+            pitch: self.pitch + (other.pitch - self.pitch) * t,
+        }
+    }
+}
+
+/// Evaluation of the current state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExcavateEvaluation {
+    /// Clay particles in the bucket.
+    pub particles_in_bucket: usize,
+    /// Episode target (particles).
+    pub target_particles: usize,
+    /// Lowest clay particle in the bucket (m, world z; −∞ if none).
+    pub lowest_in_bucket: f32,
+    /// Spilled particles.
+    pub spilled: usize,
+    /// Mean soft-body speed (m/s).
+    pub mean_soft_speed: f32,
+    /// All success terms hold.
+    pub success: bool,
+}
+
+/// Full scene state (ManiSkill2's `env_init_state` style: rigid state, soft state, task data).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExcavateState {
+    /// Rigid world state.
+    pub world: Vec<f32>,
+    /// Soft state.
+    pub soft: MpmState,
+    /// Last commanded bucket pose.
+    pub bucket_command: BucketPose,
+    /// Episode target (particles).
+    pub target_particles: usize,
+    /// Highest and mean initial bed surface (m, world z).
+    pub bed_top_and_mean_z: [f32; 2],
+}
+
+/// The Excavate scene (see the [module docs](self)).
+pub struct ExcavateScene {
+    world: World,
+    soft: SoftWorld,
+    bucket: BodyId,
+    command: BucketPose,
+    target_particles: usize,
+    floor_z: f32,
+    bed_top_z: f32,
+    mean_bed_z: f32,
+    rigid_steps_per_control: usize,
+}
+
+impl std::fmt::Debug for ExcavateScene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ExcavateScene")
+            .field("soft", &self.soft)
+            .field("target_particles", &self.target_particles)
+            .finish_non_exhaustive()
+    }
+}
+
+impl ExcavateScene {
+    /// Builds an episode from `seed`: the bed's height map (5 × 5 samples, ±6 mm about a
+    /// 3.5 cm thick bed), the bucket's start y (±1 cm) and the target amount.
+    pub fn new(seed: u64) -> Result<Self, SoftSceneError> {
+        let config = SoftConfig::default();
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let (mut solver, clay) = SoftWorld::solver_for(&config)?;
+        let floor_z = solver.usable_domain().0.z;
+        let (nx, ny) = (5, 5);
+        let cell = (BED_MAX[0] - BED_MIN[0]) / (nx - 1) as f32;
+        let heights: Vec<f32> = (0..nx * ny)
+            .map(|_| floor_z + BED_THICKNESS + rng.random_range(-BED_AMPLITUDE..BED_AMPLITUDE))
+            .collect();
+        let bed_top_z = heights.iter().copied().fold(f32::MIN, f32::max);
+        let mean_bed_z = heights.iter().sum::<f32>() / heights.len() as f32;
+        let map = HeightMap {
+            origin: Vec2::from(BED_MIN),
+            cell_size: cell,
+            nx,
+            ny,
+            heights,
+        };
+        let spacing = config.particle_spacing;
+        let mut points = sampling::sample_heightmap(&map, floor_z, spacing)?;
+        sampling::jitter(&mut points, 0.1 * spacing, seed);
+        solver.add_particles(&points, clay, spacing.powi(3), Vec3::ZERO)?;
+        let target_particles = rng.random_range(TARGET_RANGE.0..=TARGET_RANGE.1);
+        let start_y = 0.16 + rng.random_range(-0.01..0.01);
+
+        let mut world = World::new(WorldConfig::default())
+            .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
+        let command = BucketPose {
+            position: Vec3::new(
+                BED_MIN[0] - BUCKET_INNER_HALF[0] - 0.01,
+                start_y,
+                bed_top_z + 0.03,
+            ),
+            pitch: 0.0,
+        };
+        let bucket = world
+            .add_actor(
+                ActorDesc::new("bucket", ActorKind::Kinematic)
+                    .with_pose(command.to_pose())
+                    .with_shape(ShapeSpec::new(bucket_shape())),
+            )
+            .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
+        let soft = SoftWorld::new(solver, &mut world, vec![bucket])?;
+        let rigid_steps_per_control =
+            (1.0 / (CONTROL_FREQ_HZ as f32 * world.timestep())).round() as usize;
+        Ok(Self {
+            world,
+            soft,
+            bucket,
+            command,
+            target_particles,
+            floor_z,
+            bed_top_z,
+            mean_bed_z,
+            rigid_steps_per_control,
+        })
+    }
+
+    /// One control step: moves the bucket linearly from the last command to `target` over the
+    /// control period, stepping the coupled rigid and soft simulation.
+    pub fn step(&mut self, target: BucketPose) -> Result<(), SoftSceneError> {
+        if !(target.position.is_finite() && target.pitch.is_finite()) {
+            return Err(SoftSceneError::Physics(format!(
+                "bucket target {target:?} is not finite"
+            )));
+        }
+        let start = self.command;
+        let n = self.rigid_steps_per_control;
+        for k in 1..=n {
+            let pose = start.lerp(&target, k as f32 / n as f32).to_pose();
+            self.world
+                .set_kinematic_target(self.bucket, &pose)
+                .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
+            self.soft.step(&mut self.world)?;
+        }
+        self.command = target;
+        Ok(())
+    }
+
+    /// Last commanded bucket pose.
+    pub fn bucket_command(&self) -> BucketPose {
+        self.command
+    }
+
+    /// Episode target (particles).
+    pub fn target_particles(&self) -> usize {
+        self.target_particles
+    }
+
+    /// Mean initial bed surface height (m, world z).
+    pub fn mean_bed_z(&self) -> f32 {
+        self.mean_bed_z
+    }
+
+    /// MPM floor height (m, world z).
+    pub fn floor_z(&self) -> f32 {
+        self.floor_z
+    }
+
+    /// Height (m, world z) the scooped clay must be above: 5 cm over the bed's highest point.
+    pub fn target_height(&self) -> f32 {
+        self.bed_top_z + 0.05
+    }
+
+    /// The coupled soft world.
+    pub fn soft(&self) -> &SoftWorld {
+        &self.soft
+    }
+
+    /// The rigid world.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// Particle positions (m, world), the `particles` observation.
+    pub fn particle_positions(&self) -> &[Vec3] {
+        self.soft.solver().positions()
+    }
+
+    /// Whether world point `p` (m) is inside the bucket (interior, up to 1 cm above the walls).
+    pub fn in_bucket(&self, p: Vec3) -> bool {
+        let (pos, rot) = pose_to_glam(
+            &self
+                .world
+                .body_pose(self.bucket)
+                .unwrap_or_else(|_| self.command.to_pose()),
+        );
+        let local = rot.inverse() * (p - pos);
+        let [hx, hy, hz] = BUCKET_INNER_HALF;
+        local.x.abs() <= hx + 0.005
+            && local.y.abs() <= hy
+            && local.z >= 0.0
+            && local.z <= 2.0 * hz + 0.02
+    }
+
+    /// Success terms of the current state (see the [module docs](self)).
+    pub fn evaluate(&self) -> ExcavateEvaluation {
+        let mut in_bucket = 0;
+        let mut lowest = f32::INFINITY;
+        let mut spilled = 0;
+        for &p in self.particle_positions() {
+            if self.in_bucket(p) {
+                in_bucket += 1;
+                lowest = lowest.min(p.z);
+            } else {
+                let outside = p.x < BED_MIN[0] - 0.02
+                    || p.x > BED_MAX[0] + 0.02
+                    || p.y < BED_MIN[1] - 0.02
+                    || p.y > BED_MAX[1] + 0.02;
+                if outside || p.z > self.bed_top_z + 0.04 {
+                    spilled += 1;
+                }
+            }
+        }
+        if in_bucket == 0 {
+            lowest = f32::NEG_INFINITY;
+        }
+        let mean_soft_speed = self.soft.mean_speed();
+        let target = self.target_particles as f32;
+        let amount_ok = (in_bucket as f32 - target).abs() <= AMOUNT_TOLERANCE * target;
+        ExcavateEvaluation {
+            particles_in_bucket: in_bucket,
+            target_particles: self.target_particles,
+            lowest_in_bucket: lowest,
+            spilled,
+            mean_soft_speed,
+            success: amount_ok
+                && lowest > self.target_height()
+                && spilled < MAX_SPILLED
+                && mean_soft_speed < MAX_SOFT_SPEED,
+        }
+    }
+
+    /// Dense reward in [0, 1] of an evaluation: approach the amount, then the height, then
+    /// come to rest; 1 on success.
+    pub fn dense_reward(&self, eval: &ExcavateEvaluation) -> f64 {
+        if eval.success {
+            return 1.0;
+        }
+        let target = eval.target_particles as f64;
+        let amount = 1.0 - ((eval.particles_in_bucket as f64 - target).abs() / target).min(1.0);
+        let height = if eval.particles_in_bucket == 0 {
+            0.0
+        } else {
+            let gap = f64::from(self.target_height() - eval.lowest_in_bucket).max(0.0);
+            1.0 - (10.0 * gap).tanh()
+        };
+        let rest = 1.0 - f64::from(10.0 * eval.mean_soft_speed).tanh();
+        0.9 * (0.4 * amount + 0.4 * height + 0.2 * rest)
+    }
+
+    /// The full state.
+    pub fn get_state(&mut self) -> ExcavateState {
+        ExcavateState {
+            world: self.world.get_state(),
+            soft: self.soft.state(),
+            bucket_command: self.command,
+            target_particles: self.target_particles,
+            bed_top_and_mean_z: [self.bed_top_z, self.mean_bed_z],
+        }
+    }
+
+    /// Restores a state from [`ExcavateScene::get_state`] of a scene built the same way.
+    pub fn set_state(&mut self, state: &ExcavateState) -> Result<(), SoftSceneError> {
+        self.world
+            .set_state(&state.world)
+            .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
+        self.soft.set_state(&state.soft)?;
+        self.command = state.bucket_command;
+        self.target_particles = state.target_particles;
+        [self.bed_top_z, self.mean_bed_z] = state.bed_top_and_mean_z;
+        Ok(())
+    }
+}
+
+/// The bucket: bottom plate centred on the body origin, back wall at −x, side walls at ±y,
+/// open towards +x and up.
+fn bucket_shape() -> ShapeDesc {
+    let [hx, hy, hz] = BUCKET_INNER_HALF;
+    let w = BUCKET_WALL_HALF;
+    let part = |x: f32, y: f32, z: f32, half: [f32; 3]| {
+        (
+            Pose3::translation(x, y, z),
+            ShapeDesc::Box {
+                half_extents: Vector3::from(half),
+            },
+        )
+    };
+    ShapeDesc::Compound {
+        parts: vec![
+            part(-w, 0.0, 0.0, [hx + w, hy + 2.0 * w, w]),
+            part(-hx - w, 0.0, hz + w, [w, hy + 2.0 * w, hz + w]),
+            part(0.0, hy + w, hz + w, [hx, w, hz + w]),
+            part(0.0, -hy - w, hz + w, [hx, w, hz + w]),
+        ],
+    }
+}
+
+/// Scripted scoop: the bucket's command for each control step of an episode.
+///
+/// Lowers the plate onto the floor beside the bed, slides it into the bed by the length that
+/// holds the target amount (bucket width × mean bed height × length), raises the opening 20°,
+/// lifts above the target height, and holds still.
+#[derive(Clone, Debug)]
+pub struct ScriptedScoop {
+    waypoints: Vec<(u32, BucketPose)>,
+}
+
+impl ScriptedScoop {
+    /// Plans the scoop for `scene`'s episode.
+    pub fn plan(scene: &ExcavateScene) -> Self {
+        let start = scene.bucket_command();
+        let [_, hy, _] = BUCKET_INNER_HALF;
+        let particle_volume = SoftConfig::default().particle_spacing.powi(3);
+        let bed_height = scene.mean_bed_z() - scene.floor_z();
+        // Clay entering the bucket per metre of sweep into the bed.
+        let per_metre = 2.0 * hy * bed_height / particle_volume;
+        let gap_to_bed = BED_MIN[0] - (start.position.x + BUCKET_INNER_HALF[0]);
+        let sweep = gap_to_bed + scene.target_particles() as f32 / per_metre;
+        let plate_z = scene.floor_z() + BUCKET_WALL_HALF + 0.002;
+        let at = |dx: f32, z: f32, pitch: f32| BucketPose {
+            position: Vec3::new(start.position.x + dx, start.position.y, z),
+            pitch,
+        };
+        let lift_z = scene.target_height() + 0.03;
+        let tilt = 20f32.to_radians();
+        Self {
+            waypoints: vec![
+                (0, start),
+                (4, at(0.0, plate_z, 0.0)),
+                (14, at(sweep, plate_z, 0.0)),
+                (18, at(sweep, plate_z + 0.01, tilt)),
+                (30, at(sweep, lift_z, tilt)),
+                (MAX_EPISODE_STEPS, at(sweep, lift_z, tilt)),
+            ],
+        }
+    }
+
+    /// The command for control step `step` (0-based: the pose to reach at its end).
+    pub fn command(&self, step: u32) -> BucketPose {
+        let s = step + 1;
+        for pair in self.waypoints.windows(2) {
+            let ((s0, p0), (s1, p1)) = (pair[0], pair[1]);
+            if s <= s1 {
+                return p0.lerp(&p1, (s.saturating_sub(s0)) as f32 / (s1 - s0) as f32);
+            }
+        }
+        self.waypoints[self.waypoints.len() - 1].1
+    }
+}
