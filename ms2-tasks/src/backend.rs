@@ -5,11 +5,14 @@
 //! task runtime ([`crate::task_env::TaskEnv`] over a [`crate::Task`]) or the physics-free test
 //! env `Dummy-v0`.
 
+use std::any::Any;
+
 use crate::error::EnvError;
 use crate::info::Evaluation;
 use crate::obs::ObsValue;
 use crate::seeding::EpisodeRng;
 use crate::spaces::BoxSpace;
+use crate::task::TaskScene;
 
 /// A simulation the [`crate::Env`] runtime drives.
 pub(crate) trait EnvBackend: Send {
@@ -41,4 +44,12 @@ pub(crate) trait EnvBackend: Send {
     fn get_state(&self) -> Vec<f32>;
     /// Restores a state (length and finiteness already checked).
     fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError>;
+    /// The robot scene, for robot tasks (scripted policies and tests read it).
+    fn task_scene(&self) -> Option<&TaskScene> {
+        None
+    }
+    /// The task, for robot tasks (scripted policies downcast it).
+    fn task_any(&self) -> Option<&dyn Any> {
+        None
+    }
 }

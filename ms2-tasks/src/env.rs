@@ -105,8 +105,8 @@ impl Env {
             elapsed_steps: 0,
             observation_space: Space::Dict(Vec::new()),
         };
+        // The backend built its scene when it was made; sample a first episode.
         let mut rng = episode_rng(CONSTRUCTION_SEED);
-        env.backend.reconfigure(&mut rng)?;
         env.backend.initialize_episode(&mut rng)?;
         env.observation_space = Space::unbounded_like(&env.observe());
         Ok(env)
@@ -284,6 +284,16 @@ impl Env {
             .iter()
             .map(|m| m.as_str().to_owned())
             .collect()
+    }
+
+    /// The robot scene (world and robot) of a robot task; `None` for `Dummy-v0`.
+    pub fn task_scene(&self) -> Option<&crate::task::TaskScene> {
+        self.backend.task_scene()
+    }
+
+    /// The task object of a robot task (downcast with `Any::downcast_ref`).
+    pub fn task_any(&self) -> Option<&dyn std::any::Any> {
+        self.backend.task_any()
     }
 
     /// Largest dense reward of the task.

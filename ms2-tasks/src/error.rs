@@ -83,9 +83,6 @@ pub enum EnvError {
         /// Its value.
         value: f32,
     },
-    /// `step` was called before the first `reset`.
-    #[error("step() called before reset(): reset the environment first")]
-    NotReset,
     /// `VecEnv::reset` got a seed list of the wrong length.
     #[error("expected one seed entry per env ({expected}), got {got}")]
     SeedCount {

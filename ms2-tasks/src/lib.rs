@@ -24,16 +24,20 @@
 #![warn(missing_docs)]
 
 pub mod adapters;
+pub mod agent;
 mod backend;
 pub mod config;
 mod env;
 pub mod error;
+pub mod geometry;
 pub mod info;
 pub mod obs;
 mod registry;
-mod scripted;
+pub mod scripted;
 pub mod seeding;
 pub mod spaces;
+pub mod task;
+mod task_env;
 pub mod tasks;
 mod vec_env;
 
@@ -46,4 +50,5 @@ pub use registry::env_ids;
 pub use scripted::{make_scripted_policy, ScriptedPolicy};
 pub use seeding::EpisodeRng;
 pub use spaces::{BoxSpace, Space};
+pub use task::{Task, TaskScene};
 pub use vec_env::VecEnv;

@@ -3,18 +3,37 @@
 use crate::backend::EnvBackend;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
+use crate::task_env::TaskEnv;
 use crate::tasks::dummy::DummyEnv;
+use crate::tasks::{LiftCube, PickCube, StackCube};
+
+/// Builds a backend from a config and the number of physics substeps per env step.
+type MakeBackend = fn(&EnvConfig, u32) -> Result<Box<dyn EnvBackend>, EnvError>;
 
 /// A registered environment id and how to build its backend.
 struct Registration {
     id: &'static str,
-    make: fn(&EnvConfig, u32) -> Result<Box<dyn EnvBackend>, EnvError>,
+    make: MakeBackend,
 }
 
-const REGISTRY: &[Registration] = &[Registration {
-    id: "Dummy-v0",
-    make: |cfg, substeps| Ok(Box::new(DummyEnv::new(cfg, substeps)?)),
-}];
+const REGISTRY: &[Registration] = &[
+    Registration {
+        id: "PickCube-v0",
+        make: |cfg, substeps| Ok(Box::new(TaskEnv::new(cfg, substeps, PickCube::default())?)),
+    },
+    Registration {
+        id: "LiftCube-v0",
+        make: |cfg, substeps| Ok(Box::new(TaskEnv::new(cfg, substeps, LiftCube::default())?)),
+    },
+    Registration {
+        id: "StackCube-v0",
+        make: |cfg, substeps| Ok(Box::new(TaskEnv::new(cfg, substeps, StackCube::default())?)),
+    },
+    Registration {
+        id: "Dummy-v0",
+        make: |cfg, substeps| Ok(Box::new(DummyEnv::new(cfg, substeps)?)),
+    },
+];
 
 /// Registered environment ids.
 ///

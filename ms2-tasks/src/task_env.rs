@@ -1,0 +1,249 @@
+//! [`TaskEnv`]: the shared runtime of the robot tasks (world + robot + controller + step loop),
+//! driving a [`Task`]'s hooks.
+
+use std::any::Any;
+
+use ms2_control::{ControlMode, ControlTiming, RobotConfig};
+use ms2_physics::{World, WorldConfig};
+
+use crate::agent::{physics_err, PandaAgent};
+use crate::backend::EnvBackend;
+use crate::config::EnvConfig;
+use crate::error::EnvError;
+use crate::geometry::vectorize_pose;
+use crate::info::Evaluation;
+use crate::obs::{DictBuilder, ObsValue};
+use crate::seeding::{episode_rng, EpisodeRng};
+use crate::spaces::BoxSpace;
+use crate::task::{Task, TaskScene};
+
+/// Seed of the scene built when an env is made.
+const BUILD_SEED: u64 = 2022;
+
+/// The robot-task runtime over task `T`.
+pub(crate) struct TaskEnv<T: Task> {
+    task: T,
+    scene: TaskScene,
+    robot: RobotConfig,
+    world_config: WorldConfig,
+    timing: ControlTiming,
+    substeps: u32,
+    control_modes: Vec<String>,
+    action_space: BoxSpace,
+}
+
+impl<T: Task> TaskEnv<T> {
+    /// Builds the runtime for `cfg` (control mode resolved here) around `task`.
+    pub(crate) fn new(cfg: &EnvConfig, substeps: u32, mut task: T) -> Result<Self, EnvError> {
+        let robot = RobotConfig::panda(ms2_assets::PANDA_URDF)
+            .map_err(|e| EnvError::Controller(e.to_string()))?;
+        let control_modes: Vec<String> = robot
+            .supported_modes
+            .iter()
+            .map(|m| m.name().to_owned())
+            .collect();
+        let mode_name = cfg
+            .control_mode
+            .as_deref()
+            .unwrap_or(ControlMode::DEFAULT.name());
+        let mode = robot
+            .supported_modes
+            .iter()
+            .copied()
+            .find(|m| m.name() == mode_name)
+            .ok_or_else(|| EnvError::UnknownControlMode {
+                got: mode_name.to_owned(),
+                valid: control_modes.clone(),
+            })?;
+        let timing = ControlTiming {
+            control_freq_hz: cfg.control_freq,
+            sim_freq_hz: cfg.sim_freq,
+        };
+        let world_config = WorldConfig {
+            timestep: (1.0 / cfg.sim_freq) as f32,
+            ..WorldConfig::default()
+        };
+        let mut rng = episode_rng(BUILD_SEED);
+        let scene = build_scene(&world_config, &robot, mode, timing, &mut task, &mut rng)?;
+        let ctrl = &scene.agent.controller;
+        let action_space = BoxSpace::vector(
+            ctrl.action_low().iter().map(|&v| v as f32).collect(),
+            ctrl.action_high().iter().map(|&v| v as f32).collect(),
+        );
+        Ok(Self {
+            task,
+            scene,
+            robot,
+            world_config,
+            timing,
+            substeps,
+            control_modes,
+            action_space,
+        })
+    }
+
+    fn controller_state(&self) -> Vec<f32> {
+        self.scene
+            .agent
+            .controller
+            .state()
+            .iter()
+            .flat_map(|(_, v)| v.iter().map(|&x| x as f32))
+            .collect()
+    }
+}
+
+/// A fresh world with the ground, the robot and the task's actors.
+fn build_scene<T: Task>(
+    world_config: &WorldConfig,
+    robot: &RobotConfig,
+    mode: ControlMode,
+    timing: ControlTiming,
+    task: &mut T,
+    rng: &mut EpisodeRng,
+) -> Result<TaskScene, EnvError> {
+    let mut world = World::new(world_config.clone()).map_err(physics_err)?;
+    let agent = PandaAgent::build(&mut world, robot, mode, timing)?;
+    task.build_scene(&mut world, rng)?;
+    Ok(TaskScene { world, agent })
+}
+
+impl<T: Task> EnvBackend for TaskEnv<T> {
+    fn default_max_episode_steps(&self) -> u32 {
+        self.task.max_episode_steps()
+    }
+
+    fn control_modes(&self) -> Vec<String> {
+        self.control_modes.clone()
+    }
+
+    fn control_mode(&self) -> &str {
+        self.scene.agent.control_mode.name()
+    }
+
+    fn action_space(&self) -> &BoxSpace {
+        &self.action_space
+    }
+
+    fn max_dense_reward(&self) -> f64 {
+        self.task.max_dense_reward()
+    }
+
+    fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
+        let mode = self.scene.agent.control_mode;
+        self.scene = build_scene(
+            &self.world_config,
+            &self.robot,
+            mode,
+            self.timing,
+            &mut self.task,
+            rng,
+        )?;
+        Ok(())
+    }
+
+    fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
+        self.task.initialize_actors(&mut self.scene, rng)?;
+        let TaskScene { world, agent } = &mut self.scene;
+        agent.initialize(world, rng)?;
+        self.task.initialize_task(&self.scene, rng);
+        Ok(())
+    }
+
+    fn apply_action(&mut self, action: &[f32]) -> Result<(), EnvError> {
+        let TaskScene { world, agent } = &mut self.scene;
+        agent.set_action(world, action)?;
+        for _ in 0..self.substeps {
+            agent.before_substep(world);
+            world.step();
+        }
+        Ok(())
+    }
+
+    fn observe_state_dict(&self) -> ObsValue {
+        let TaskScene { world, agent } = &self.scene;
+        let mut agent_obs = DictBuilder::new();
+        agent_obs.push_vector("qpos", &agent.qpos(world));
+        agent_obs.push_vector("qvel", &agent.qvel(world));
+        // Target-accumulating modes also report their targets, as ManiSkill2 does.
+        let ctrl_state = agent.controller.state();
+        if !ctrl_state.is_empty() {
+            let mut ctrl = DictBuilder::new();
+            for (part, values) in ctrl_state {
+                let key = if agent.control_mode.name().starts_with("pd_ee") && part == "arm" {
+                    "target_pose"
+                } else {
+                    "target_qpos"
+                };
+                let values: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+                ctrl.push(&part, DictBuilder::new().vector(key, &values).build());
+            }
+            agent_obs.push("controller", ctrl.build());
+        }
+        agent_obs.push_vector("base_pose", &vectorize_pose(&agent.base_pose()));
+        let mut extra = DictBuilder::new();
+        self.task.extra_obs(&self.scene, &mut extra);
+        let mut root = DictBuilder::new();
+        root.push("agent", agent_obs.build());
+        root.push("extra", extra.build());
+        root.build()
+    }
+
+    fn evaluate(&self) -> Evaluation {
+        self.task.evaluate(&self.scene)
+    }
+
+    fn dense_reward(&self, eval: &Evaluation, _action: &[f32]) -> f64 {
+        self.task.dense_reward(&self.scene, eval)
+    }
+
+    fn state_len(&self) -> usize {
+        self.scene.world.state_len() + self.controller_state().len() + self.task.task_state_len()
+    }
+
+    fn get_state(&self) -> Vec<f32> {
+        let mut state = self.scene.world.get_state();
+        state.extend(self.controller_state());
+        state.extend(self.task.task_state());
+        state
+    }
+
+    fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError> {
+        let world_len = self.scene.world.state_len();
+        let parts = self.scene.agent.controller.state();
+        let ctrl_len: usize = parts.iter().map(|(_, v)| v.len()).sum();
+        let (world_state, rest) = state.split_at(world_len);
+        let (ctrl_state, task_state) = rest.split_at(ctrl_len);
+        self.scene
+            .world
+            .set_state(world_state)
+            .map_err(physics_err)?;
+        let mut offset = 0;
+        let restored: Vec<(String, Vec<f64>)> = parts
+            .into_iter()
+            .map(|(name, v)| {
+                let values = ctrl_state[offset..offset + v.len()]
+                    .iter()
+                    .map(|&x| f64::from(x))
+                    .collect();
+                offset += v.len();
+                (name, values)
+            })
+            .collect();
+        self.scene
+            .agent
+            .controller
+            .set_state(&restored)
+            .map_err(EnvError::Controller)?;
+        self.task.set_task_state(task_state);
+        Ok(())
+    }
+
+    fn task_scene(&self) -> Option<&TaskScene> {
+        Some(&self.scene)
+    }
+
+    fn task_any(&self) -> Option<&dyn Any> {
+        Some(self.task.as_any())
+    }
+}
