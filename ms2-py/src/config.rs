@@ -23,6 +23,7 @@ pub fn make_config(
         control_mode,
         reward_mode,
         render_mode,
+        camera_cfgs: None,
         sim_freq,
         control_freq,
         max_episode_steps,

@@ -169,4 +169,15 @@ impl NativeEnv {
     fn reward_modes(&self) -> PyResult<Vec<String>> {
         self.read(|env| env.reward_modes())
     }
+
+    /// The human view: uint8 [512, 512, 3], goal markers shown (rendered with the GIL released).
+    fn render<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let frame = self.with_env(py, |env| Ok(env.render()?))?;
+        obs_to_py(py, ms2_tasks::ObsValue::Array(frame))
+    }
+
+    /// Triangles drawn per observation camera in the last render (0 before any render).
+    fn triangles_per_camera(&self) -> PyResult<usize> {
+        self.read(|env| env.triangles_per_camera())
+    }
 }

@@ -80,6 +80,7 @@ fn is_input_error(err: &EnvError) -> bool {
             | EnvError::SeedCount { .. }
             | EnvError::InvalidConfig(_)
             | EnvError::NoScriptedPolicy { .. }
+            | EnvError::NotRenderable { .. }
     )
 }
 

@@ -44,6 +44,25 @@ pub(crate) trait EnvBackend: Send {
     fn get_state(&self) -> Vec<f32>;
     /// Restores a state (length and finiteness already checked).
     fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError>;
+    /// Renders the observation cameras (robot tasks only).
+    fn capture_cameras(&self) -> Result<crate::sensors::CameraFrame, EnvError> {
+        Err(self.not_renderable())
+    }
+    /// Renders the human view, goal marker shown (robot tasks only).
+    fn render_human(&self) -> Result<ms2_render::CameraOutput, EnvError> {
+        Err(self.not_renderable())
+    }
+    /// Triangles drawn per observation camera (0 before the first render).
+    fn triangles_per_camera(&self) -> usize {
+        0
+    }
+    /// The error of the render calls of a backend without a scene.
+    fn not_renderable(&self) -> EnvError {
+        EnvError::NotRenderable {
+            env_id: "Dummy-v0".to_owned(),
+            reason: "it has no 3D scene; use obs_mode state or state_dict".to_owned(),
+        }
+    }
     /// The robot scene, for robot tasks (scripted policies and tests read it).
     fn task_scene(&self) -> Option<&TaskScene> {
         None

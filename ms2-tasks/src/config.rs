@@ -1,6 +1,7 @@
 //! Environment configuration and the observation / reward mode enums.
 
 use crate::error::EnvError;
+use crate::sensors::{CameraConfig, VisualLayout};
 
 /// How an environment is made: which task, which observation, control and reward modes, and the
 /// simulation / control frequencies.
@@ -11,14 +12,18 @@ use crate::error::EnvError;
 pub struct EnvConfig {
     /// Registered environment id, e.g. `"PickCube-v0"` (see [`crate::env_ids`]).
     pub env_id: String,
-    /// Observation mode: `"state_dict"` or `"state"` (visual modes come with the renderer).
+    /// Observation mode: `"state_dict"`, `"state"`, `"rgbd"`, `"pointcloud"`,
+    /// `"rgbd_robot_seg"` or `"pointcloud_robot_seg"`.
     pub obs_mode: String,
     /// Control mode of the robot; `None` = the task's default (`"pd_joint_delta_pos"`).
     pub control_mode: Option<String>,
     /// Reward mode: `"sparse"`, `"dense"` or `"normalized_dense"`; `None` = `"normalized_dense"`.
     pub reward_mode: Option<String>,
-    /// Render mode: `None` or `"rgb_array"` (renderer integration comes later).
+    /// Render mode: `None` or `"rgb_array"` ([`crate::Env::render`]: a 512×512 view for people).
     pub render_mode: Option<String>,
+    /// Observation cameras of the visual obs modes; `None` = the task's defaults
+    /// (`base_camera` and `hand_camera`, see [`CameraConfig::panda_defaults`]).
+    pub camera_cfgs: Option<Vec<CameraConfig>>,
     /// Physics frequency in Hz (default 500). Must be a whole multiple of `control_freq`.
     pub sim_freq: f64,
     /// Control (env step) frequency in Hz (default 20).
@@ -35,6 +40,7 @@ impl Default for EnvConfig {
             control_mode: None,
             reward_mode: None,
             render_mode: None,
+            camera_cfgs: None,
             sim_freq: 500.0,
             control_freq: 20.0,
             max_episode_steps: None,
@@ -88,17 +94,47 @@ pub enum ObsMode {
     StateDict,
     /// The `state_dict` flattened into one float32 vector, in the dict's key order.
     State,
+    /// Per-camera RGB and depth images plus camera parameters (see [`crate::sensors::visual_obs`]).
+    Rgbd,
+    /// A world-frame point cloud fused over the cameras.
+    PointCloud,
+    /// `rgbd` plus a boolean robot mask per camera.
+    RgbdRobotSeg,
+    /// `pointcloud` plus a boolean robot mask per point.
+    PointCloudRobotSeg,
 }
 
 impl ObsMode {
     /// All supported modes.
-    pub const ALL: [ObsMode; 2] = [ObsMode::StateDict, ObsMode::State];
+    pub const ALL: [ObsMode; 6] = [
+        ObsMode::StateDict,
+        ObsMode::State,
+        ObsMode::Rgbd,
+        ObsMode::PointCloud,
+        ObsMode::RgbdRobotSeg,
+        ObsMode::PointCloudRobotSeg,
+    ];
 
-    /// The mode's name as used in configs (`"state_dict"`, `"state"`).
+    /// The mode's name as used in configs (`"state_dict"`, `"state"`, `"rgbd"`, …).
     pub fn as_str(self) -> &'static str {
         match self {
             ObsMode::StateDict => "state_dict",
             ObsMode::State => "state",
+            ObsMode::Rgbd => "rgbd",
+            ObsMode::PointCloud => "pointcloud",
+            ObsMode::RgbdRobotSeg => "rgbd_robot_seg",
+            ObsMode::PointCloudRobotSeg => "pointcloud_robot_seg",
+        }
+    }
+
+    /// The visual layout and whether a robot mask is added; `None` for the state modes.
+    pub fn visual(self) -> Option<(VisualLayout, bool)> {
+        match self {
+            ObsMode::StateDict | ObsMode::State => None,
+            ObsMode::Rgbd => Some((VisualLayout::Rgbd, false)),
+            ObsMode::PointCloud => Some((VisualLayout::PointCloud, false)),
+            ObsMode::RgbdRobotSeg => Some((VisualLayout::Rgbd, true)),
+            ObsMode::PointCloudRobotSeg => Some((VisualLayout::PointCloud, true)),
         }
     }
 

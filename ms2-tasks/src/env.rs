@@ -108,7 +108,7 @@ impl Env {
         // The backend built its scene when it was made; sample a first episode.
         let mut rng = episode_rng(CONSTRUCTION_SEED);
         env.backend.initialize_episode(&mut rng)?;
-        env.observation_space = Space::unbounded_like(&env.observe());
+        env.observation_space = Space::unbounded_like(&env.try_observe()?);
         Ok(env)
     }
 
@@ -128,7 +128,7 @@ impl Env {
         self.backend.initialize_episode(&mut rng)?;
         self.elapsed_steps = 0;
         let eval = self.backend.evaluate();
-        Ok((self.observe(), self.make_info(eval)))
+        Ok((self.try_observe()?, self.make_info(eval)))
     }
 
     /// Applies `action` (length = `action_space().size()`, finite) for one control period of
@@ -147,7 +147,7 @@ impl Env {
         };
         let terminated = eval.success;
         Ok(StepOutput {
-            obs: self.observe(),
+            obs: self.try_observe()?,
             reward,
             terminated,
             truncated: self.elapsed_steps >= self.max_episode_steps,
@@ -185,10 +185,34 @@ impl Env {
         info
     }
 
-    /// The current observation in the env's obs mode.
+    /// The current observation in the env's obs mode, rendering the cameras in visual modes.
+    pub fn try_observe(&self) -> Result<ObsValue, EnvError> {
+        match self.obs_mode.visual() {
+            Some((layout, robot_seg)) => {
+                let frame = self.backend.capture_cameras()?;
+                Ok(crate::sensors::visual_obs::assemble(
+                    self.backend.observe_state_dict(),
+                    &frame,
+                    layout,
+                    robot_seg,
+                ))
+            }
+            None => Ok(self.observe()),
+        }
+    }
+
+    /// The current observation in the env's obs mode without rendering: in the state modes the
+    /// full observation; in visual modes only its non-image part (`agent` and the
+    /// non-privileged `extra`; [`Env::try_observe`] adds the images).
     pub fn observe(&self) -> ObsValue {
         let dict = self.backend.observe_state_dict();
         match self.obs_mode {
+            ObsMode::Rgbd
+            | ObsMode::PointCloud
+            | ObsMode::RgbdRobotSeg
+            | ObsMode::PointCloudRobotSeg => {
+                ObsValue::Dict(crate::sensors::visual_obs::non_privileged_state(dict))
+            }
             ObsMode::StateDict => dict,
             ObsMode::State => {
                 let mut flat = Vec::with_capacity(64);
@@ -294,6 +318,21 @@ impl Env {
     /// The task object of a robot task (downcast with `Any::downcast_ref`).
     pub fn task_any(&self) -> Option<&dyn std::any::Any> {
         self.backend.task_any()
+    }
+
+    /// The human view for `render_mode = "rgb_array"`: uint8 [512, 512, 3] from the render
+    /// camera, goal markers shown (they never appear in observation images).
+    pub fn render(&self) -> Result<Array, EnvError> {
+        let out = self.backend.render_human()?;
+        Ok(Array {
+            shape: vec![out.height() as usize, out.width() as usize, 3],
+            data: ArrayData::U8(out.rgb),
+        })
+    }
+
+    /// Triangles drawn per observation camera in the last render (0 before any render).
+    pub fn triangles_per_camera(&self) -> usize {
+        self.backend.triangles_per_camera()
     }
 
     /// Largest dense reward of the task.

@@ -100,6 +100,18 @@ pub enum EnvError {
     /// The controller failed (message from the control crate).
     #[error("controller error: {0}")]
     Controller(String),
+    /// Rendering failed (message from the render crate), or the scene holds something that
+    /// cannot be drawn.
+    #[error("render error: {0}")]
+    Render(String),
+    /// The obs mode or render call needs cameras, but this env has no renderable scene.
+    #[error("env {env_id:?} cannot render ({reason})")]
+    NotRenderable {
+        /// The env id.
+        env_id: String,
+        /// Why not.
+        reason: String,
+    },
     /// No scripted policy exists for this env / control mode.
     #[error("no scripted policy for env {env_id:?} with control_mode {control_mode:?}: {reason}")]
     NoScriptedPolicy {

@@ -2,7 +2,8 @@
 //!
 //! Gymnasium-style environments of the ManiSkill2 benchmark: [`Env`] (reset / step / state),
 //! [`VecEnv`] (parallel envs on rayon), seeding as in ManiSkill2, reward modes (`sparse`,
-//! `dense`, `normalized_dense`), observation modes (`state_dict`, `state`), and scripted oracle
+//! `dense`, `normalized_dense`), observation modes (`state_dict`, `state`, and the visual `rgbd`, `pointcloud`,
+//! `*_robot_seg` rendered with ms2-render, see [`sensors`]), and scripted oracle
 //! policies ([`make_scripted_policy`]).
 //!
 //! Ids: see [`env_ids`]. `Dummy-v0` is a documented physics-free test env.
@@ -35,6 +36,7 @@ pub mod obs;
 mod registry;
 pub mod scripted;
 pub mod seeding;
+pub mod sensors;
 pub mod spaces;
 pub mod task;
 mod task_env;

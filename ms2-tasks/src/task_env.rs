@@ -2,10 +2,12 @@
 //! driving a [`Task`]'s hooks.
 
 use std::any::Any;
+use std::sync::Mutex;
 
 use ms2_control::{ControlMode, ControlTiming, RobotConfig};
 use ms2_physics::{World, WorldConfig};
 
+use crate::adapters::RenderContext;
 use crate::agent::{physics_err, PandaAgent};
 use crate::backend::EnvBackend;
 use crate::config::EnvConfig;
@@ -14,6 +16,7 @@ use crate::geometry::vectorize_pose;
 use crate::info::Evaluation;
 use crate::obs::{DictBuilder, ObsValue};
 use crate::seeding::{episode_rng, EpisodeRng};
+use crate::sensors::{CameraConfig, CameraFrame, Sensors};
 use crate::spaces::BoxSpace;
 use crate::task::{Task, TaskScene};
 
@@ -30,6 +33,9 @@ pub(crate) struct TaskEnv<T: Task> {
     substeps: u32,
     control_modes: Vec<String>,
     action_space: BoxSpace,
+    camera_cfgs: Vec<CameraConfig>,
+    /// Cameras and render scene, built on the first render (state-only envs never render).
+    sensors: Mutex<Option<Sensors>>,
 }
 
 impl<T: Task> TaskEnv<T> {
@@ -70,6 +76,13 @@ impl<T: Task> TaskEnv<T> {
             ctrl.action_low().iter().map(|&v| v as f32).collect(),
             ctrl.action_high().iter().map(|&v| v as f32).collect(),
         );
+        let camera_cfgs = cfg
+            .camera_cfgs
+            .clone()
+            .unwrap_or_else(CameraConfig::panda_defaults);
+        for cam in &camera_cfgs {
+            cam.validate()?;
+        }
         Ok(Self {
             task,
             scene,
@@ -79,7 +92,31 @@ impl<T: Task> TaskEnv<T> {
             substeps,
             control_modes,
             action_space,
+            camera_cfgs,
+            sensors: Mutex::new(None),
         })
+    }
+
+    /// Runs `f` on the env's sensors (built on first use) and world.
+    fn with_sensors<R>(
+        &self,
+        f: impl FnOnce(&mut Sensors, &ms2_physics::World) -> Result<R, EnvError>,
+    ) -> Result<R, EnvError> {
+        let mut guard = self
+            .sensors
+            .lock()
+            .map_err(|_| EnvError::Render("sensor lock poisoned by an earlier panic".to_owned()))?;
+        let sensors = match &mut *guard {
+            Some(sensors) => sensors,
+            slot @ None => slot.insert(Sensors::new(
+                RenderContext::shared()?,
+                &self.scene.world,
+                Some(self.scene.agent.articulation),
+                self.camera_cfgs.clone(),
+                CameraConfig::render_camera(),
+            )?),
+        };
+        f(sensors, &self.scene.world)
     }
 
     fn controller_state(&self) -> Vec<f32> {
@@ -139,6 +176,8 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
             &mut self.task,
             rng,
         )?;
+        // The new world has new bodies: the render scene is rebuilt on the next render.
+        *self.sensors.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
         Ok(())
     }
 
@@ -237,6 +276,26 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
             .map_err(EnvError::Controller)?;
         self.task.set_task_state(task_state);
         Ok(())
+    }
+
+    fn capture_cameras(&self) -> Result<CameraFrame, EnvError> {
+        self.with_sensors(|sensors, world| sensors.capture(world))
+    }
+
+    fn render_human(&self) -> Result<ms2_render::CameraOutput, EnvError> {
+        let goal = self
+            .observe_state_dict()
+            .get("extra/goal_pos")
+            .and_then(|g| g.as_f32().map(|v| nalgebra::Vector3::new(v[0], v[1], v[2])));
+        self.with_sensors(|sensors, world| sensors.render_human(world, goal))
+    }
+
+    fn triangles_per_camera(&self) -> usize {
+        self.sensors
+            .lock()
+            .ok()
+            .and_then(|g| g.as_ref().map(Sensors::triangles_per_camera))
+            .unwrap_or(0)
     }
 
     fn task_scene(&self) -> Option<&TaskScene> {

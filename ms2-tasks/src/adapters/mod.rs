@@ -2,11 +2,13 @@
 //!
 //! - [`physics_articulation`]: an ms2-physics articulation as ms2-control's
 //!   [`ms2_control::Articulation`] (controllers drive the simulated robot through it).
+//! - [`render_scene`]: an ms2-physics world's visual shapes as an [`ms2_render::Scene`], with
+//!   the process-wide [`RenderContext`] (one renderer, shared meshes).
 //! - [`mpm_rigid`]: the ms2-physics world as ms2-mpm's rigid backend (two-way coupling).
-//!
-//! A later phase adds the renderer-scene adapter (ms2-render) next to them.
 
 pub mod mpm_rigid;
 pub mod physics_articulation;
+pub mod render_scene;
 
 pub use physics_articulation::{snapshot_articulation, PhysicsArticulation};
+pub use render_scene::{RenderContext, SegmentedObject, WorldRenderScene};

@@ -1,0 +1,107 @@
+"""Visual observation modes, human renders and MP4 recording from Python."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import ms2
+import numpy as np
+import pytest
+
+ROBOT_TASKS = [i for i in ("PickCube-v0", "LiftCube-v0", "StackCube-v0") if i in ms2.env_ids()]
+VISUAL_MODES = ["rgbd", "pointcloud", "rgbd_robot_seg", "pointcloud_robot_seg"]
+CAMERAS = ["base_camera", "hand_camera"]
+N_POINTS = len(CAMERAS) * 128 * 128
+
+
+def check_visual_obs(obs, obs_mode: str, batch: tuple[int, ...] = ()) -> None:
+    """ManiSkill2's keys, shapes and dtypes of a visual observation (with a leading batch)."""
+    assert set(obs["extra"]) <= {"tcp_pose", "goal_pos"} and "tcp_pose" in obs["extra"]
+    assert obs["agent"]["qpos"].shape == (*batch, 9)
+    seg = obs_mode.endswith("robot_seg")
+    if obs_mode.startswith("rgbd"):
+        assert list(obs["image"]) == CAMERAS and list(obs["camera_param"]) == CAMERAS
+        for cam in CAMERAS:
+            image = obs["image"][cam]
+            assert image["rgb"].shape == (*batch, 128, 128, 3) and image["rgb"].dtype == np.uint8
+            assert image["depth"].shape == (*batch, 128, 128, 1)
+            assert image["depth"].dtype == np.float32
+            assert ("robot_seg" in image) == seg
+            if seg:
+                assert image["robot_seg"].dtype == np.bool_
+                assert image["robot_seg"].shape == (*batch, 128, 128, 1)
+            param = obs["camera_param"][cam]
+            assert param["extrinsic_cv"].shape == (*batch, 3, 4)
+            assert param["cam2world_gl"].shape == (*batch, 4, 4)
+            assert param["intrinsic_cv"].shape == (*batch, 3, 3)
+    else:
+        cloud = obs["pointcloud"]
+        assert cloud["xyzw"].shape == (*batch, N_POINTS, 4) and cloud["xyzw"].dtype == np.float32
+        assert cloud["rgb"].shape == (*batch, N_POINTS, 3) and cloud["rgb"].dtype == np.uint8
+        assert cloud["Segmentation"].shape == (*batch, N_POINTS, 4)
+        assert cloud["Segmentation"].dtype == np.uint32
+        assert ("robot_seg" in cloud) == seg
+        if seg:
+            assert cloud["robot_seg"].shape == (*batch, N_POINTS, 1)
+            assert cloud["robot_seg"].any() and not cloud["robot_seg"].all()
+        valid = cloud["xyzw"][..., 3] == 1
+        assert valid.any()
+        assert np.all(cloud["xyzw"][~valid] == 0)
+
+
+@pytest.mark.parametrize("env_id", ROBOT_TASKS)
+@pytest.mark.parametrize("obs_mode", VISUAL_MODES)
+def test_every_task_steps_in_every_visual_mode(env_id, obs_mode):
+    env = gym.make(env_id, obs_mode=obs_mode)
+    obs, _ = env.reset(seed=0)
+    check_visual_obs(obs, obs_mode)
+    assert obs in env.observation_space
+    obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+    check_visual_obs(obs, obs_mode)
+    assert obs in env.observation_space
+    env.close()
+
+
+def test_vector_env_stacks_visual_obs():
+    venv = gym.make_vec("PickCube-v0", num_envs=2, obs_mode="rgbd_robot_seg")
+    obs, _ = venv.reset(seed=0)
+    check_visual_obs(obs, "rgbd_robot_seg", batch=(2,))
+    obs, *_ = venv.step(venv.action_space.sample())
+    check_visual_obs(obs, "rgbd_robot_seg", batch=(2,))
+    venv.close()
+
+
+def test_render_rgb_array_is_a_512_view():
+    env = gym.make("PickCube-v0", render_mode="rgb_array")
+    env.reset(seed=0)
+    frame = env.render()
+    assert frame.shape == (512, 512, 3) and frame.dtype == np.uint8
+    assert frame.std() > 10, "not a blank image"
+    env.close()
+
+
+def test_state_only_env_rejects_visual_modes():
+    with pytest.raises(ValueError, match="render"):
+        ms2.Ms2Env("Dummy-v0", obs_mode="rgbd")
+
+
+def test_record_episode_writes_a_readable_mp4(tmp_path):
+    imageio = pytest.importorskip("imageio.v2")
+    from ms2.recording import RecordEpisode
+
+    env = RecordEpisode(gym.make("PickCube-v0", render_mode="rgb_array"), tmp_path, fps=20)
+    env.reset(seed=0)
+    for _ in range(5):
+        env.step(env.action_space.sample())
+    env.close()
+    assert env.video_paths == [tmp_path / "episode_0.mp4"]
+    frames = list(imageio.get_reader(env.video_paths[0]))
+    assert len(frames) == 6  # reset + 5 steps
+    assert frames[0].shape == (512, 512, 3)
+    assert not list(tmp_path.glob(".*tmp*")), "no temporary files left"
+
+
+def test_record_episode_needs_rgb_array():
+    from ms2.recording import RecordEpisode
+
+    with pytest.raises(ValueError, match="rgb_array"):
+        RecordEpisode(gym.make("PickCube-v0"), "unused")

@@ -1,0 +1,160 @@
+//! Cameras and visual observations of the robot tasks.
+//!
+//! - [`camera`]: [`CameraConfig`] (ManiSkill2's `base_camera`, `hand_camera`, render camera).
+//! - [`visual_obs`]: the `rgbd` / `pointcloud` (+ `robot_seg`) observation layouts.
+//! - [`Sensors`]: one env's render scene (an [`WorldRenderScene`] of its world), its cameras
+//!   and the goal marker drawn only in human renders; it renders through the process-wide
+//!   [`RenderContext`].
+
+pub mod camera;
+pub mod visual_obs;
+
+use std::sync::Arc;
+
+use ms2_physics::{ArticulationId, World};
+use ms2_render::{CameraOutput, Instance, InstanceId, Material, SegmentationIds};
+use nalgebra::{Isometry3, Vector3};
+
+pub use camera::{look_at_robotics, CameraConfig, CameraMount};
+pub use visual_obs::{CameraFrame, VisualLayout, NON_PRIVILEGED_EXTRA_KEYS};
+
+use crate::adapters::render_scene::render_err;
+use crate::adapters::{RenderContext, WorldRenderScene};
+use crate::error::EnvError;
+
+/// Radius (m) of the goal marker sphere of human renders (ManiSkill2: the goal threshold).
+pub const GOAL_MARKER_RADIUS_M: f32 = 0.025;
+
+/// One env's cameras and render scene.
+#[derive(Debug)]
+pub struct Sensors {
+    ctx: Arc<RenderContext>,
+    scene: WorldRenderScene,
+    cameras: Vec<CameraConfig>,
+    render_camera: CameraConfig,
+    robot: Option<ArticulationId>,
+    robot_ids: Vec<u32>,
+    goal_marker: InstanceId,
+}
+
+impl Sensors {
+    /// Builds the render scene of `world` with observation `cameras` (uids must be unique) and
+    /// the human `render_camera`; `robot` carries link-mounted cameras and defines the robot
+    /// mask.
+    pub fn new(
+        ctx: Arc<RenderContext>,
+        world: &World,
+        robot: Option<ArticulationId>,
+        cameras: Vec<CameraConfig>,
+        render_camera: CameraConfig,
+    ) -> Result<Sensors, EnvError> {
+        for (i, cam) in cameras.iter().enumerate() {
+            cam.validate()?;
+            if cameras[..i].iter().any(|c| c.uid == cam.uid) {
+                return Err(EnvError::InvalidConfig(format!(
+                    "camera uid {:?} appears twice",
+                    cam.uid
+                )));
+            }
+            cam.camera_at(world, robot)?;
+        }
+        render_camera.validate()?;
+        let mut scene = WorldRenderScene::build(&ctx, world)?;
+        let robot_ids = robot
+            .map(|art| scene.articulation_ids(art))
+            .unwrap_or_default();
+        let mut marker = Instance::new(
+            ctx.unit_sphere_mesh()?,
+            Material::color(0.0, 1.0, 0.0),
+            Isometry3::identity(),
+            SegmentationIds::default(),
+        )
+        .with_scale(Vector3::repeat(GOAL_MARKER_RADIUS_M));
+        marker.visible = false;
+        let goal_marker = scene.scene_mut().add_instance(marker);
+        Ok(Sensors {
+            ctx,
+            scene,
+            cameras,
+            render_camera,
+            robot,
+            robot_ids,
+            goal_marker,
+        })
+    }
+
+    /// The observation cameras.
+    pub fn cameras(&self) -> &[CameraConfig] {
+        &self.cameras
+    }
+
+    /// The render scene.
+    pub fn render_scene(&self) -> &WorldRenderScene {
+        &self.scene
+    }
+
+    /// Channel-1 ids of the robot's links.
+    pub fn robot_ids(&self) -> &[u32] {
+        &self.robot_ids
+    }
+
+    /// Copies poses from `world` and renders every observation camera in one submission.
+    pub fn capture(&mut self, world: &World) -> Result<CameraFrame, EnvError> {
+        self.scene.sync_poses(world)?;
+        let cams = self
+            .cameras
+            .iter()
+            .map(|c| c.camera_at(world, self.robot))
+            .collect::<Result<Vec<_>, _>>()?;
+        let outputs = self
+            .ctx
+            .renderer()
+            .render(&[(self.scene.scene(), &cams[..])])
+            .map_err(render_err)?;
+        Ok(CameraFrame {
+            uids: self.cameras.iter().map(|c| c.uid.clone()).collect(),
+            outputs,
+            robot_ids: self.robot_ids.clone(),
+        })
+    }
+
+    /// Renders the human view (render camera) with the goal marker at `goal_world` (m) when
+    /// given; the marker is hidden again afterwards, so observation cameras never see it.
+    pub fn render_human(
+        &mut self,
+        world: &World,
+        goal_world: Option<Vector3<f32>>,
+    ) -> Result<CameraOutput, EnvError> {
+        self.scene.sync_poses(world)?;
+        let camera = self.render_camera.camera_at(world, self.robot)?;
+        if let Some(goal) = goal_world {
+            let scene = self.scene.scene_mut();
+            scene
+                .set_pose(
+                    self.goal_marker,
+                    Isometry3::translation(goal.x, goal.y, goal.z),
+                )
+                .map_err(render_err)?;
+            scene
+                .set_visible(self.goal_marker, true)
+                .map_err(render_err)?;
+        }
+        let result = self
+            .ctx
+            .renderer()
+            .render(&[(self.scene.scene(), &[camera][..])]);
+        self.scene
+            .scene_mut()
+            .set_visible(self.goal_marker, false)
+            .map_err(render_err)?;
+        let mut outputs = result.map_err(render_err)?;
+        outputs
+            .pop()
+            .ok_or_else(|| EnvError::Render("the renderer returned no image".to_owned()))
+    }
+
+    /// Triangles drawn per observation camera (the scene's visible triangles).
+    pub fn triangles_per_camera(&self) -> usize {
+        self.scene.scene().triangle_count(self.ctx.renderer())
+    }
+}

@@ -1,0 +1,181 @@
+//! ManiSkill2's visual observation layouts (`rgbd`, `pointcloud`, `*_robot_seg`) assembled from
+//! camera outputs.
+//!
+//! - `rgbd`: `{"agent", "extra", "camera_param": {cam: {"extrinsic_cv" [3,4],
+//!   "cam2world_gl" [4,4], "intrinsic_cv" [3,3]}}, "image": {cam: {"rgb" u8 [H,W,3],
+//!   "depth" f32 [H,W,1] (metres, 0 = nothing seen)}}}`; `rgbd_robot_seg` adds
+//!   `image[cam]["robot_seg"]` bool [H,W,1].
+//! - `pointcloud`: `{"agent", "extra", "pointcloud": {"xyzw" f32 [N,4] (world frame; w = 1 for
+//!   points on a surface, all zeros for background), "rgb" u8 [N,3], "Segmentation" u32 [N,4]}}`,
+//!   N = the sum of H·W over cameras (camera order, then row-major); `pointcloud_robot_seg`
+//!   adds `pointcloud["robot_seg"]` bool [N,1].
+//! - `Segmentation` channels: 0 = visual-shape id, 1 = actor/link id (see
+//!   [`crate::adapters::render_scene`]), 2 and 3 = 0 (as in ManiSkill2).
+//! - `extra` keeps only what a real robot would know: [`NON_PRIVILEGED_EXTRA_KEYS`].
+
+use ms2_render::{CameraOutput, FusedPointCloud};
+
+use crate::obs::{Array, ArrayData, ObsValue};
+
+/// `extra` entries kept in visual modes (robot proprioception and the task's goal).
+pub const NON_PRIVILEGED_EXTRA_KEYS: [&str; 2] = ["tcp_pose", "goal_pos"];
+
+/// A visual observation layout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum VisualLayout {
+    /// Per-camera images and camera parameters.
+    Rgbd,
+    /// One world-frame point cloud fused over the cameras.
+    PointCloud,
+}
+
+/// One frame of an env's observation cameras.
+#[derive(Debug, Clone)]
+pub struct CameraFrame {
+    /// Camera uids, in config order.
+    pub uids: Vec<String>,
+    /// One output per camera, same order.
+    pub outputs: Vec<CameraOutput>,
+    /// Channel-1 (actor/link) ids of the robot's links.
+    pub robot_ids: Vec<u32>,
+}
+
+fn array(shape: Vec<usize>, data: ArrayData) -> ObsValue {
+    ObsValue::Array(Array { shape, data })
+}
+
+fn matrix_rows<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f32, R, C>) -> ObsValue {
+    let data = (0..R)
+        .flat_map(|r| (0..C).map(move |c| m[(r, c)]))
+        .collect();
+    array(vec![R, C], ArrayData::F32(data))
+}
+
+/// `state_dict` reduced to the entries a visual mode keeps: `agent` as is, `extra` filtered to
+/// [`NON_PRIVILEGED_EXTRA_KEYS`].
+pub fn non_privileged_state(state_dict: ObsValue) -> Vec<(String, ObsValue)> {
+    let ObsValue::Dict(entries) = state_dict else {
+        return Vec::new();
+    };
+    entries
+        .into_iter()
+        .map(|(key, value)| match (key.as_str(), value) {
+            ("extra", ObsValue::Dict(extra)) => (
+                key,
+                ObsValue::Dict(
+                    extra
+                        .into_iter()
+                        .filter(|(k, _)| NON_PRIVILEGED_EXTRA_KEYS.contains(&k.as_str()))
+                        .collect(),
+                ),
+            ),
+            (_, value) => (key, value),
+        })
+        .collect()
+}
+
+/// The full visual observation: `state_dict`'s non-privileged part plus the camera data in
+/// `layout`, with a robot mask when `robot_seg`.
+pub fn assemble(
+    state_dict: ObsValue,
+    frame: &CameraFrame,
+    layout: VisualLayout,
+    robot_seg: bool,
+) -> ObsValue {
+    let mut root = non_privileged_state(state_dict);
+    let is_robot = |link_id: &u32| frame.robot_ids.contains(link_id);
+    match layout {
+        VisualLayout::Rgbd => {
+            let mut params = Vec::with_capacity(frame.outputs.len());
+            let mut images = Vec::with_capacity(frame.outputs.len());
+            for (uid, out) in frame.uids.iter().zip(&frame.outputs) {
+                let (h, w) = (out.height() as usize, out.width() as usize);
+                params.push((
+                    uid.clone(),
+                    ObsValue::Dict(vec![
+                        ("extrinsic_cv".to_owned(), matrix_rows(&out.extrinsic_cv())),
+                        ("cam2world_gl".to_owned(), matrix_rows(&out.cam2world_gl())),
+                        ("intrinsic_cv".to_owned(), matrix_rows(&out.intrinsic_cv())),
+                    ]),
+                ));
+                let mut image = vec![
+                    (
+                        "rgb".to_owned(),
+                        array(vec![h, w, 3], ArrayData::U8(out.rgb.clone())),
+                    ),
+                    (
+                        "depth".to_owned(),
+                        array(vec![h, w, 1], ArrayData::F32(out.depth_m.clone())),
+                    ),
+                ];
+                if robot_seg {
+                    let mask = out.segmentation_link.iter().map(is_robot).collect();
+                    image.push((
+                        "robot_seg".to_owned(),
+                        array(vec![h, w, 1], ArrayData::Bool(mask)),
+                    ));
+                }
+                images.push((uid.clone(), ObsValue::Dict(image)));
+            }
+            root.push(("camera_param".to_owned(), ObsValue::Dict(params)));
+            root.push(("image".to_owned(), ObsValue::Dict(images)));
+        }
+        VisualLayout::PointCloud => {
+            let fused = FusedPointCloud::from_cameras(&frame.outputs);
+            let n = fused.len();
+            let xyzw = fused.xyzw.iter().flatten().copied().collect();
+            let rgb = fused.rgb.iter().flatten().copied().collect();
+            let seg = fused
+                .segmentation_actor
+                .iter()
+                .zip(&fused.segmentation_link)
+                .flat_map(|(&visual, &link)| [visual, link, 0, 0])
+                .collect();
+            let mut cloud = vec![
+                ("xyzw".to_owned(), array(vec![n, 4], ArrayData::F32(xyzw))),
+                ("rgb".to_owned(), array(vec![n, 3], ArrayData::U8(rgb))),
+                (
+                    "Segmentation".to_owned(),
+                    array(vec![n, 4], ArrayData::U32(seg)),
+                ),
+            ];
+            if robot_seg {
+                let mask = fused.segmentation_link.iter().map(is_robot).collect();
+                cloud.push((
+                    "robot_seg".to_owned(),
+                    array(vec![n, 1], ArrayData::Bool(mask)),
+                ));
+            }
+            root.push(("pointcloud".to_owned(), ObsValue::Dict(cloud)));
+        }
+    }
+    ObsValue::Dict(root)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::obs::DictBuilder;
+
+    #[test]
+    fn extra_keeps_only_non_privileged_keys() {
+        let state = ObsValue::Dict(vec![
+            (
+                "agent".into(),
+                DictBuilder::new().vector("qpos", &[0.0]).build(),
+            ),
+            (
+                "extra".into(),
+                DictBuilder::new()
+                    .vector("tcp_pose", &[0.0; 7])
+                    .vector("goal_pos", &[0.0; 3])
+                    .vector("obj_pose", &[0.0; 7])
+                    .build(),
+            ),
+        ]);
+        let kept = ObsValue::Dict(non_privileged_state(state));
+        assert!(kept.get("agent/qpos").is_some());
+        assert!(kept.get("extra/tcp_pose").is_some() && kept.get("extra/goal_pos").is_some());
+        assert!(kept.get("extra/obj_pose").is_none());
+    }
+}
