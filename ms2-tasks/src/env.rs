@@ -297,9 +297,14 @@ impl Env {
         self.backend.control_modes()
     }
 
-    /// Supported observation modes.
+    /// Supported observation modes (visual modes only for envs with a 3D scene).
     pub fn obs_modes(&self) -> Vec<String> {
-        ObsMode::ALL.iter().map(|m| m.as_str().to_owned()).collect()
+        let renderable = self.backend.task_scene().is_some();
+        ObsMode::ALL
+            .iter()
+            .filter(|m| renderable || m.visual().is_none())
+            .map(|m| m.as_str().to_owned())
+            .collect()
     }
 
     /// Supported reward modes.
