@@ -25,10 +25,10 @@ def to_gym_space(description: Any) -> spaces.Space:
         # gymnasium has no boolean Box; a 0/1 Box of bool dtype is what MultiBinary would check.
         return spaces.Box(low=0, high=1, shape=tuple(shape), dtype=np.bool_)
     if np.issubdtype(dtype, np.integer):
-        # float32 bounds of wide integer types (e.g. 2**32 for uint32) would wrap when cast.
+        # Bounds travel as float32: u32::MAX arrives rounded up to 2**32, which would wrap to 0.
         info = np.iinfo(dtype)
-        low = np.clip(low.astype(np.float64), info.min, info.max)
-        high = np.clip(high.astype(np.float64), info.min, info.max)
+        low = np.clip(np.asarray(low, np.float64), info.min, info.max)
+        high = np.clip(np.asarray(high, np.float64), info.min, info.max)
     return spaces.Box(
         low=low.astype(dtype), high=high.astype(dtype), shape=tuple(shape), dtype=dtype
     )
