@@ -117,10 +117,7 @@ class Ms2Env(gym.Env):
                 "render() called without render_mode; make the env with render_mode='rgb_array'"
             )
             return None
-        render = getattr(self._native, "render", None)
-        if render is None:
-            raise NotImplementedError("this build of ms2 has no renderer yet")
-        return render()
+        return self._native.render()
 
     def close(self) -> None:
         """Releases the native env."""
