@@ -268,8 +268,7 @@ impl RobotConfig {
     /// ```
     /// use ms2_control::{ControlMode, ControlTiming, PerfectTrackingArticulation, RobotConfig};
     /// let panda = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
-    /// let names = panda.model.dof_names().iter().map(|s| s.to_string()).collect();
-    /// let mut robot = PerfectTrackingArticulation::new(names, ms2_assets::PANDA_REST_QPOS.to_vec());
+    /// let mut robot = PerfectTrackingArticulation::for_model(&panda.model, ms2_assets::PANDA_REST_QPOS.to_vec());
     /// let mut ctrl = panda.build_controller(ControlMode::PdEeDeltaPose, &robot, ControlTiming::MANISKILL2).unwrap();
     /// assert_eq!(ctrl.action_dim(), 7);
     /// assert_eq!(ctrl.slice("gripper"), Some(6..7));
