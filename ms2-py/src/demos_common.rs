@@ -137,10 +137,15 @@ pub fn episode_from_py(env_id: &str, dict: &Bound<'_, PyDict>) -> PyResult<DemoE
 }
 
 /// Runs `f` on a rayon pool of `num_workers` threads (at least 1).
-pub fn in_pool<T: Send>(num_workers: usize, f: impl FnOnce() -> T + Send) -> Result<T, NativeError> {
+pub fn in_pool<T: Send>(
+    num_workers: usize,
+    f: impl FnOnce() -> T + Send,
+) -> Result<T, NativeError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(num_workers.max(1))
         .build()
-        .map_err(|e| NativeError::Input(format!("cannot start {num_workers} worker threads: {e}")))?;
+        .map_err(|e| {
+            NativeError::Input(format!("cannot start {num_workers} worker threads: {e}"))
+        })?;
     Ok(pool.install(f))
 }

@@ -15,26 +15,11 @@
 use std::time::Instant;
 
 use ms2_tasks::demos::solutions::{solution_env_ids, solve_episode};
-use ms2_tasks::demos::{replay_episode, DemoEpisode, DemoError, EpisodeRecorder, ReplayOptions};
-use ms2_tasks::{make_env, make_scripted_policy, EnvConfig};
+use ms2_tasks::demos::{replay_episode, scripted_episode, DemoEpisode, DemoError, ReplayOptions};
+use ms2_tasks::EnvConfig;
 use rayon::prelude::*;
 
 const DEFAULT_TARGETS: &str = "pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos";
-
-/// Records the scripted oracle in `pd_joint_pos` for `seed`.
-fn scripted_episode(cfg: &EnvConfig, seed: u64) -> Result<DemoEpisode, DemoError> {
-    let mut env = make_env(cfg)?;
-    let mut policy = make_scripted_policy(&env)?;
-    let (mut rec, _) = EpisodeRecorder::reset(&mut env, seed)?;
-    policy.reset(&env);
-    for _ in 0..env.max_episode_steps() {
-        let action = policy.act(&env);
-        if rec.step(&mut env, &action)?.terminated {
-            break;
-        }
-    }
-    Ok(rec.finish())
-}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();

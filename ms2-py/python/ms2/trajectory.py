@@ -329,8 +329,7 @@ def open_trajectory(path: str | os.PathLike[str]) -> Trajectory:
         foreign = sorted(n for n in names if not n.startswith("traj_"))
         if foreign:
             raise TrajectoryFileError(
-                f"{path}: not a trajectory file: groups {foreign[:5]} are not 'traj_<id>' "
-                "episodes"
+                f"{path}: not a trajectory file: groups {foreign[:5]} are not 'traj_<id>' episodes"
             )
         absent = [
             f"traj_{ep['episode_id']}"

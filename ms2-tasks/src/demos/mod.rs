@@ -3,16 +3,23 @@
 //!
 //! * [`DemoEpisode`] — one recorded episode (actions, env states, success flags), row-major
 //!   float32 like the `.h5` trajectory files (see `docs/trajectory_format.md`).
-//! * [`solutions`] — sense-plan-act solutions that produce `pd_joint_pos` episodes.
+//! * [`EpisodeRecorder`] — records an episode while an env is stepped.
+//! * [`solutions`] — sense-plan-act solutions that produce `pd_joint_pos` episodes;
+//!   [`scripted_episode`] records the scripted oracle instead.
+//! * [`replay_episode`] — replays an episode from its seed (optionally restoring the recorded
+//!   states, recording observations) or converts its actions closed-loop to another control
+//!   mode.
 //! * [`DemoError`] — everything that can go wrong while making or replaying demonstrations.
 
 mod episode;
 mod replay;
+mod scripted;
 pub mod solutions;
 mod source_targets;
 
 pub use episode::{DemoEpisode, EpisodeRecorder};
 pub use replay::{replay_episode, ReplayOptions, ReplayedEpisode, MAX_EXTRA_STEPS_PER_SOURCE_STEP};
+pub use scripted::scripted_episode;
 
 use crate::error::EnvError;
 
