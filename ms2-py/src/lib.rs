@@ -11,6 +11,7 @@
 //! * [`policy::NativeScriptedPolicy`] — the runtime's scripted (oracle) policy of an env.
 //! * [`errors`] — how runtime errors and panics become Python exceptions.
 
+mod cameras;
 mod config;
 mod convert;
 mod demos_common;
