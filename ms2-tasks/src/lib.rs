@@ -28,6 +28,7 @@ pub mod adapters;
 pub mod agent;
 mod backend;
 pub mod config;
+pub mod demos;
 mod env;
 pub mod error;
 pub mod geometry;
