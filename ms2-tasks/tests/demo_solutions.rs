@@ -65,7 +65,7 @@ fn assert_replays(env_id: &str, episode: &DemoEpisode) {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0f32, f32::max);
         assert!(
-            worst <= 1e-5,
+            worst == 0.0,
             "{env_id} step {t}: replayed state differs by {worst}"
         );
         assert_eq!(out.terminated, episode.success[t], "{env_id} step {t}");

@@ -74,7 +74,7 @@ const SOLUTIONS: [CubeTaskSolution; 3] = [
         goal_world: |s| {
             let b = s.cube("cubeB")?;
             let on_top = s.pose_world_from_base * b.pose_base_from_cube;
-            Ok(on_top.translation.vector + Vector3::new(0.0, 0.0, 4.0 * b.half_size + STACK_GAP))
+            Ok(on_top.translation.vector + Vector3::new(0.0, 0.0, 2.0 * b.half_size + STACK_GAP))
         },
         finish: Finish::PlaceAndRelease,
     },
