@@ -11,8 +11,11 @@
 //! * [`policy::NativeScriptedPolicy`] — the runtime's scripted (oracle) policy of an env.
 //! * [`errors`] — how runtime errors and panics become Python exceptions.
 
+mod cameras;
 mod config;
 mod convert;
+mod demos_common;
+mod demos_solve;
 mod env;
 mod errors;
 mod policy;
@@ -63,5 +66,7 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(default_max_episode_steps, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
+    m.add_function(wrap_pyfunction!(demos_solve::solve_episodes, m)?)?;
+    m.add_function(wrap_pyfunction!(demos_solve::solution_env_ids, m)?)?;
     Ok(())
 }

@@ -1,4 +1,5 @@
-//! [`VecEnv`]: several envs stepped in parallel on rayon's thread pool.
+//! [`VecEnv`]: several envs stepped in parallel on rayon's thread pool, their cameras rendered
+//! in one batch.
 
 use rayon::prelude::*;
 
@@ -7,9 +8,31 @@ use crate::env::{Env, StepOutput};
 use crate::error::EnvError;
 use crate::info::Info;
 use crate::obs::ObsValue;
+use crate::sensors::batch::BatchItem;
+use crate::sensors::{capture_batch, visual_obs, CameraFrame};
+
+/// What one env does during [`VecEnv::run`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EnvCommand<'a> {
+    /// Step with this action (`action_dim` floats).
+    Step(&'a [f32]),
+    /// Start a new episode (`seed = None` draws the next seed from the env's RNG).
+    Reset {
+        /// Episode seed.
+        seed: Option<u64>,
+    },
+    /// Leave the env as it is (it reports nothing).
+    Keep,
+}
 
 /// `num_envs` copies of one env config, reset and stepped in parallel (no autoreset: the Python
 /// layer implements gymnasium's).
+///
+/// In visual obs modes a vector step has three phases: physics (and the poses of every env's
+/// render scene and cameras) of all envs in parallel; one batched render of every camera of
+/// every env (one GPU submission, one readback: [`capture_batch`]); then observation assembly
+/// (point-cloud fusion, robot masks) in parallel. The images equal those of stepping each env
+/// alone.
 ///
 /// ```
 /// use ms2_tasks::{EnvConfig, VecEnv};
@@ -64,11 +87,16 @@ impl VecEnv {
                 got: seeds.len(),
             });
         }
-        self.envs
-            .par_iter_mut()
-            .zip(seeds.par_iter())
-            .map(|(env, seed)| env.reset(*seed, false))
-            .collect()
+        let commands: Vec<EnvCommand<'_>> = seeds
+            .iter()
+            .map(|&seed| EnvCommand::Reset { seed })
+            .collect();
+        Ok(self
+            .run(&commands)?
+            .into_iter()
+            .flatten()
+            .map(|out| (out.obs, out.info))
+            .collect())
     }
 
     /// Steps every env; `actions` holds `num_envs * action_dim` floats, row-major (env-major).
@@ -81,10 +109,89 @@ impl VecEnv {
                 got: actions.len(),
             });
         }
-        self.envs
+        let commands: Vec<EnvCommand<'_>> = if self.action_dim == 0 {
+            vec![EnvCommand::Step(&[]); self.envs.len()]
+        } else {
+            actions
+                .chunks(self.action_dim)
+                .map(EnvCommand::Step)
+                .collect()
+        };
+        Ok(self.run(&commands)?.into_iter().flatten().collect())
+    }
+
+    /// Runs one command per env in parallel and returns, per env, its step output (`None` for
+    /// [`EnvCommand::Keep`]). A reset reports its first observation and info with reward 0
+    /// and both flags false (gymnasium's "next step" autoreset convention).
+    pub fn run(
+        &mut self,
+        commands: &[EnvCommand<'_>],
+    ) -> Result<Vec<Option<StepOutput>>, EnvError> {
+        if commands.len() != self.envs.len() {
+            return Err(EnvError::InvalidConfig(format!(
+                "expected one command per env ({}), got {}",
+                self.envs.len(),
+                commands.len()
+            )));
+        }
+        let visual = self.envs[0].visual_layout();
+        // Phase 1: physics; visual envs also pose their render scenes and cameras.
+        let phase1: Vec<Option<(StepOutput, Vec<ms2_render::Camera>)>> = self
+            .envs
             .par_iter_mut()
-            .zip(actions.par_chunks(self.action_dim))
-            .map(|(env, action)| env.step(action))
-            .collect()
+            .zip(commands.par_iter())
+            .map(|(env, command)| {
+                let out = match *command {
+                    EnvCommand::Keep => return Ok(None),
+                    EnvCommand::Step(action) => env.step_deferred(action)?,
+                    EnvCommand::Reset { seed } => {
+                        let (obs, info) = env.reset_deferred(seed)?;
+                        StepOutput {
+                            obs,
+                            reward: 0.0,
+                            terminated: false,
+                            truncated: false,
+                            info,
+                        }
+                    }
+                };
+                let cameras = match visual {
+                    Some(_) => env.prepare_cameras()?,
+                    None => Vec::new(),
+                };
+                Ok(Some((out, cameras)))
+            })
+            .collect::<Result<_, EnvError>>()?;
+        let Some((layout, robot_seg)) = visual else {
+            return Ok(phase1.into_iter().map(|p| p.map(|(out, _)| out)).collect());
+        };
+        // Phase 2: every camera of every env in one submission.
+        let mut frames = {
+            let items: Vec<BatchItem<'_>> = self
+                .envs
+                .iter_mut()
+                .zip(&phase1)
+                .filter_map(|(env, p)| {
+                    p.as_ref()
+                        .map(|(_, cameras)| env.sensors().map(|s| (s, &cameras[..])))
+                })
+                .collect::<Result<_, EnvError>>()?;
+            capture_batch(&items)?.into_iter()
+        };
+        let frames: Vec<Option<CameraFrame>> = phase1
+            .iter()
+            .map(|p| p.as_ref().and_then(|_| frames.next()))
+            .collect();
+        // Phase 3: observations (copies of images, fused point clouds, masks) in parallel.
+        Ok(phase1
+            .into_par_iter()
+            .zip(frames)
+            .map(|(p, frame)| {
+                let (mut out, _) = p?;
+                let state_dict = std::mem::replace(&mut out.obs, ObsValue::Dict(Vec::new()));
+                out.obs = visual_obs::assemble(state_dict, frame?, layout, robot_seg);
+                Some(out)
+            })
+            .collect())
     }
 }

@@ -148,7 +148,7 @@ impl DemoSolver {
             .find(|s| s.env_id == cfg.env_id)
             .ok_or_else(|| DemoError::NoSolution {
                 env_id: cfg.env_id.clone(),
-                valid: solution_env_ids().join(", "),
+                valid: solution_env_ids().into_iter().map(str::to_owned).collect(),
             })?;
         if let Some(mode) = cfg.control_mode.as_deref() {
             if mode != CONTROL_MODE {
