@@ -8,9 +8,9 @@
 use std::time::Instant;
 
 use ms2_plan::{
-    find_grasps, parry3d::shape::SharedShape, AttachedObject, CheckerOptions, CollisionScene,
-    GraspKind, GripperSpec, KinematicRobot, MotionPlanner, PlanError, PlannedMotion, PlannerConfig,
-    PlanningRobot,
+    box_grasp_poses, parry3d::shape::SharedShape, reachable_grasps, AttachedObject, CheckerOptions,
+    CollisionScene, GraspKind, GraspPose, GripperSpec, KinematicRobot, MotionPlanner, OrientedBox,
+    PlanError, PlannedMotion, PlannerConfig, PlanningRobot,
 };
 use nalgebra::{Isometry3, Translation3, Vector3};
 
@@ -97,39 +97,28 @@ impl CubeTaskSolution {
             ..PlannerConfig::default()
         };
 
-        // Grasp: the top-down grasp whose yaw is closest to the hand's current yaw.
+        // Grasp: top-down, at the cube's yaw symmetry closest to the hand's yaw.
         let scene = sensed.collision_scene().map_err(plan_error("scene"))?;
         let start = recorder.arm_target().to_vec();
+        let cube = sensed.cube(self.cube)?.oriented_box();
         let grasp = timings.time(|| {
-            let candidates = find_grasps(
+            let candidates = top_down_grasps(&cube, &gripper, &panda.tcp_pose(&start));
+            reachable_grasps(
                 panda,
                 &scene,
                 Some(self.cube),
-                &sensed.cube(self.cube)?.oriented_box(),
+                candidates,
                 &gripper,
                 &start,
                 CheckerOptions::default(),
             )
-            .map_err(plan_error("grasp"))?;
-            let tcp_now = panda.tcp_pose(&start);
-            candidates
-                .into_iter()
-                .filter(|c| c.grasp.kind == GraspKind::TopDown)
-                .min_by(|a, b| {
-                    let angle = |p: &Isometry3<f64>| p.rotation.angle_to(&tcp_now.rotation);
-                    angle(&a.grasp.pose_base_from_tcp)
-                        .total_cmp(&angle(&b.grasp.pose_base_from_tcp))
-                })
-                .ok_or_else(|| SolveError::Plan {
-                    phase: "grasp",
-                    source: PlanError::NoGraspFound { candidates: 0 },
-                })
+            .map(|mut found| found.swap_remove(0))
+            .map_err(plan_error("grasp"))
         })?;
         let mut planner = MotionPlanner::new(panda, config(0)).map_err(plan_error("config"))?;
 
         // Reach the pre-grasp pose (screw motion, else RRT-Connect to the pre-grasp IK).
-        let pre_grasp_pose =
-            grasp.grasp.pose_base_from_tcp * Translation3::new(0.0, 0.0, -PRE_GRASP_DISTANCE);
+        let pre_grasp_pose = grasp.grasp.pre_grasp_pose(PRE_GRASP_DISTANCE);
         let reach = timings.time(|| {
             planner
                 .plan_screw(&scene, &start, &pre_grasp_pose)
@@ -255,6 +244,33 @@ impl CubeTaskSolution {
         })?;
         recorder.follow(&motion.trajectory, Gripper::Open)
     }
+}
+
+/// Tilts (rad) of a top-down grasp about its closing axis, tried in order: a cube at the edge of
+/// the workspace is out of reach of a vertical hand but within reach of a tilted one.
+const GRASP_TILTS: [f64; 7] = [0.0, 0.3, -0.3, 0.6, -0.6, 0.9, -0.9];
+
+/// Top-down grasps of `cube`, the ones whose yaw is closest to the hand's (`tcp_now`) first,
+/// then the same tilted by each of [`GRASP_TILTS`].
+fn top_down_grasps(
+    cube: &OrientedBox,
+    gripper: &GripperSpec,
+    tcp_now: &Isometry3<f64>,
+) -> Vec<GraspPose> {
+    let mut upright: Vec<GraspPose> = box_grasp_poses(cube, gripper)
+        .into_iter()
+        .filter(|g| g.kind == GraspKind::TopDown)
+        .collect();
+    let turn = |g: &GraspPose| g.pose_base_from_tcp.rotation.angle_to(&tcp_now.rotation);
+    upright.sort_by(|a, b| turn(a).total_cmp(&turn(b)));
+    GRASP_TILTS
+        .iter()
+        .flat_map(|&tilt| {
+            upright
+                .iter()
+                .map(move |g| g.tilted_about_closing_axis(tilt))
+        })
+        .collect()
 }
 
 /// Screw motion to `pose_base_from_tcp`, else RRT-Connect to a collision-free IK solution.
