@@ -15,6 +15,8 @@ mod cameras;
 mod config;
 mod convert;
 mod demos_common;
+mod demos_replay;
+mod demos_scripted;
 mod demos_solve;
 mod env;
 mod errors;
@@ -67,6 +69,8 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_max_episode_steps, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add_function(wrap_pyfunction!(demos_solve::solve_episodes, m)?)?;
+    m.add_function(wrap_pyfunction!(demos_replay::replay_episodes, m)?)?;
+    m.add_function(wrap_pyfunction!(demos_scripted::scripted_episodes, m)?)?;
     m.add_function(wrap_pyfunction!(demos_solve::solution_env_ids, m)?)?;
     Ok(())
 }
