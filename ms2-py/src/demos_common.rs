@@ -3,7 +3,7 @@
 
 use ms2_tasks::demos::{DemoEpisode, DemoError};
 use ms2_tasks::EnvConfig;
-use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -86,6 +86,16 @@ pub fn rows_to_py<'py>(
     PyArray1::from_vec(py, flat).reshape([rows.len(), width])
 }
 
+/// A float32 `(N, M)` numpy array as rows.
+pub fn rows_from_py(array: &PyReadonlyArray2<'_, f32>) -> Vec<Vec<f32>> {
+    array
+        .as_array()
+        .rows()
+        .into_iter()
+        .map(|r| r.to_vec())
+        .collect()
+}
+
 /// An episode as the dict the Python side writes to trajectory files:
 /// `{"episode_seed", "control_mode", "actions" f32[T,A], "env_states" f32[T+1,S],
 /// "success" bool[T], "elapsed_steps", "info"}`.
@@ -101,6 +111,29 @@ pub fn episode_to_py<'py>(py: Python<'py>, ep: &DemoEpisode) -> PyResult<Bound<'
     dict.set_item("elapsed_steps", ep.elapsed_steps)?;
     dict.set_item("info", info_to_py(py, &ep.info)?)?;
     Ok(dict)
+}
+
+/// An episode from a dict with the keys of [`episode_to_py`] (`info` is ignored: replay
+/// recomputes it). Arrays must be float32 / bool numpy arrays.
+pub fn episode_from_py(env_id: &str, dict: &Bound<'_, PyDict>) -> PyResult<DemoEpisode> {
+    let get = |key: &str| {
+        dict.get_item(key)?
+            .ok_or_else(|| PyValueError::new_err(format!("episode dict has no key {key:?}")))
+    };
+    let actions: PyReadonlyArray2<'_, f32> = get("actions")?.extract()?;
+    let env_states: PyReadonlyArray2<'_, f32> = get("env_states")?.extract()?;
+    let success: PyReadonlyArray1<'_, bool> = get("success")?.extract()?;
+    let actions = rows_from_py(&actions);
+    Ok(DemoEpisode {
+        env_id: env_id.to_owned(),
+        episode_seed: get("episode_seed")?.extract()?,
+        control_mode: get("control_mode")?.extract()?,
+        elapsed_steps: u32::try_from(actions.len()).unwrap_or(u32::MAX),
+        actions,
+        env_states: rows_from_py(&env_states),
+        success: success.as_array().to_vec(),
+        info: Vec::new(),
+    })
 }
 
 /// Runs `f` on a rayon pool of `num_workers` threads (at least 1).

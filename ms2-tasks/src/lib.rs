@@ -54,4 +54,4 @@ pub use scripted::{make_scripted_policy, ScriptedPolicy};
 pub use seeding::EpisodeRng;
 pub use spaces::{BoxSpace, Space};
 pub use task::{Task, TaskScene};
-pub use vec_env::VecEnv;
+pub use vec_env::{EnvCommand, VecEnv};

@@ -3,42 +3,25 @@
 //!
 //! * [`DemoEpisode`] — one recorded episode (actions, env states, success flags), row-major
 //!   float32 like the `.h5` trajectory files (see `docs/trajectory_format.md`).
-//! * [`solutions`] — sense-plan-act solutions that produce `pd_joint_pos` episodes.
+//! * [`EpisodeRecorder`] — records an episode while an env is stepped.
+//! * [`solutions`] — sense-plan-act solutions that produce `pd_joint_pos` episodes;
+//!   [`scripted_episode`] records the scripted oracle instead.
+//! * [`replay_episode`] — replays an episode from its seed (optionally restoring the recorded
+//!   states, recording observations) or converts its actions closed-loop to another control
+//!   mode.
 //! * [`DemoError`] — everything that can go wrong while making or replaying demonstrations.
 
+mod episode;
+mod replay;
+mod scripted;
 pub mod solutions;
+mod source_targets;
+
+pub use episode::{DemoEpisode, EpisodeRecorder};
+pub use replay::{replay_episode, ReplayOptions, ReplayedEpisode, MAX_EXTRA_STEPS_PER_SOURCE_STEP};
+pub use scripted::scripted_episode;
 
 use crate::error::EnvError;
-use crate::info::Info;
-
-/// One episode in ManiSkill2's trajectory layout (row-major, float32 like the `.h5` file).
-#[derive(Debug, Clone, PartialEq)]
-pub struct DemoEpisode {
-    /// Registered env id, e.g. `"PickCube-v0"`.
-    pub env_id: String,
-    /// Seed the episode was reset with (`Env::reset(Some(seed), false)`).
-    pub episode_seed: u64,
-    /// Control mode of `actions`, e.g. `"pd_joint_pos"`.
-    pub control_mode: String,
-    /// Actions `[T][A]`, one per env step, in `control_mode`'s units.
-    pub actions: Vec<Vec<f32>>,
-    /// Env states `[T+1][S]`: [`crate::Env::get_state`] after reset, then after each step.
-    pub env_states: Vec<Vec<f32>>,
-    /// `info["success"]` after each step `[T]`.
-    pub success: Vec<bool>,
-    /// Number of env steps (`== actions.len()`).
-    pub elapsed_steps: u32,
-    /// The info of the last step (of the reset when `T == 0`).
-    pub info: Info,
-}
-
-impl DemoEpisode {
-    /// Whether the episode succeeds at its last step (what demo generation keeps and what
-    /// conversion must preserve).
-    pub fn succeeded(&self) -> bool {
-        self.success.last() == Some(&true)
-    }
-}
 
 /// Everything that can go wrong while making or replaying demonstrations.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -80,4 +63,7 @@ pub enum DemoError {
         /// The supported conversions, in words.
         supported: String,
     },
+    /// The replay options are inconsistent with each other or with the episode.
+    #[error("invalid replay options: {0}")]
+    InvalidOptions(String),
 }
