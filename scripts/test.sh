@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
 # Sets up a fresh machine (scripts/setup.sh) and runs every test: Rust (the workspace, release
-# profile, sharing target/ with the maturin build setup.sh made) and Python (ruff + pytest).
+# profile, sharing target/ with the maturin build setup.sh made) and Python (ruff + pytest), after
+# the style gates CI enforces: rustfmt and clippy with warnings as errors.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 started=$(date +%s)
 bash scripts/setup.sh
 # shellcheck disable=SC1091
 . .venv/bin/activate
+echo "[test] cargo fmt --check and clippy (workspace, all targets, warnings are errors)"
+cargo fmt --all -- --check
+cargo clippy --workspace --all-targets -- -D warnings
 echo "[test] cargo test (workspace, release profile)"
 cargo test --release --workspace --exclude ms2-py
 echo "[test] ruff (ms2-py)"

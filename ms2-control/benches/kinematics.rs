@@ -8,12 +8,16 @@ use std::time::Instant;
 
 use criterion::{criterion_group, Criterion};
 use ms2_control::{
-    ControlMode, ControlTiming, DlsIk, IkOptions, KinematicChain, KinematicModel,
-    PerfectTrackingArticulation, QpIk, QpIkOptions, RobotConfig,
+    ControlMode, DlsIk, IkOptions, KinematicChain, KinematicModel, PerfectTrackingArticulation,
+    QpIk, QpIkOptions,
 };
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-const REST: [f64; 9] = ms2_assets::PANDA_REST_QPOS;
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::REST;
+
 const ENV_STEP_S: f64 = 1.0 / 900.0;
 
 fn chain() -> KinematicChain {
@@ -65,18 +69,7 @@ fn kinematics(c: &mut Criterion) {
 fn controller_setup(
     mode: ControlMode,
 ) -> (PerfectTrackingArticulation, ms2_control::CombinedController) {
-    let panda = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
-    let names = panda
-        .model
-        .dof_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    let mut robot = PerfectTrackingArticulation::new(names, REST.to_vec());
-    let mut ctrl = panda
-        .build_controller(mode, &robot, ControlTiming::MANISKILL2)
-        .unwrap();
-    ctrl.reset(&mut robot);
+    let (_, robot, ctrl) = common::panda_on_mock(mode);
     (robot, ctrl)
 }
 

@@ -5,13 +5,8 @@ use ms2_control::{ControlMode, ControlTiming, PerfectTrackingArticulation, Robot
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let panda = RobotConfig::panda(ms2_assets::PANDA_URDF)?;
-    let names = panda
-        .model
-        .dof_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    let mut robot = PerfectTrackingArticulation::new(names, ms2_assets::PANDA_REST_QPOS.to_vec());
+    let mut robot =
+        PerfectTrackingArticulation::for_model(&panda.model, ms2_assets::PANDA_REST_QPOS.to_vec());
     let mode: ControlMode = "pd_ee_delta_pose_align".parse()?;
     let mut ctrl = panda.build_controller(mode, &robot, ControlTiming::MANISKILL2)?;
     ctrl.reset(&mut robot);

@@ -54,6 +54,16 @@ impl ActionBounds {
         }
     }
 
+    /// Physical values of a whole user-facing action, entry by entry as
+    /// [`ActionBounds::to_physical`].
+    pub(crate) fn to_physical_all(&self, action: &[f64]) -> Vec<f64> {
+        action
+            .iter()
+            .enumerate()
+            .map(|(i, &a)| self.to_physical(i, a))
+            .collect()
+    }
+
     /// User-facing value of physical entry `i`, clipped into the space; the flag tells whether
     /// clipping changed it (more than 1e-9 relative to the range).
     pub fn to_user(&self, i: usize, x: f64) -> (f64, bool) {

@@ -19,8 +19,7 @@
 //! ```
 //! use ms2_control::{ControlMode, ControlTiming, PerfectTrackingArticulation, RobotConfig};
 //! let panda = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
-//! let names = panda.model.dof_names().iter().map(|s| s.to_string()).collect();
-//! let mut robot = PerfectTrackingArticulation::new(names, ms2_assets::PANDA_REST_QPOS.to_vec());
+//! let mut robot = PerfectTrackingArticulation::for_model(&panda.model, ms2_assets::PANDA_REST_QPOS.to_vec());
 //! let mut ctrl = panda.build_controller(ControlMode::PdJointDeltaPos, &robot, ControlTiming::MANISKILL2).unwrap();
 //! ctrl.reset(&mut robot);
 //! // Joint 1 by +0.1 rad (action 1.0 = the +0.1 rad bound), gripper fully open.

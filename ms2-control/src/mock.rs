@@ -1,6 +1,7 @@
 //! A physics-free articulation for tests, examples and offline demonstration conversion.
 
 use crate::articulation::{Articulation, DriveGains};
+use crate::kinematics::KinematicModel;
 
 /// An articulation that tracks its drives perfectly.
 ///
@@ -40,6 +41,16 @@ impl PerfectTrackingArticulation {
             gains: vec![DriveGains::MANISKILL2_DEFAULT; n],
             position_target_calls: 0,
         }
+    }
+
+    /// An articulation with the movable joints of `model` (names in dof order) at `qpos`, as
+    /// [`PerfectTrackingArticulation::new`].
+    ///
+    /// # Panics
+    /// If `qpos` does not have one entry per dof of `model`.
+    pub fn for_model(model: &KinematicModel, qpos: Vec<f64>) -> Self {
+        let names = model.dof_names().iter().map(|s| s.to_string()).collect();
+        Self::new(names, qpos)
     }
 
     /// Advances time by `dt` seconds with perfect tracking (see the type docs).

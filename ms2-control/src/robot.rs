@@ -81,17 +81,6 @@ pub struct RobotConfig {
     pub supported_modes: Vec<ControlMode>,
 }
 
-/// Names of the Panda's arm joints.
-const PANDA_ARM: [&str; 7] = [
-    "panda_joint1",
-    "panda_joint2",
-    "panda_joint3",
-    "panda_joint4",
-    "panda_joint5",
-    "panda_joint6",
-    "panda_joint7",
-];
-
 impl RobotConfig {
     /// ManiSkill2's Panda: 7-joint arm with TCP `panda_hand_tcp`, mimic gripper over
     /// `[-0.01, 0.04]` m, gains 1e3/1e2/100, every [`ControlMode`].
@@ -103,13 +92,13 @@ impl RobotConfig {
     /// ```
     pub fn panda(urdf: &str) -> Result<Self, BuildError> {
         let model = Arc::new(KinematicModel::from_urdf_str(urdf)?);
-        model.link("panda_hand_tcp")?;
+        model.link(ms2_assets::PANDA_TCP_LINK)?;
         Ok(Self {
             name: "panda".into(),
             model,
             arm: ArmSpec {
-                joint_names: PANDA_ARM.iter().map(|s| s.to_string()).collect(),
-                ee_link: "panda_hand_tcp".into(),
+                joint_names: owned(&ms2_assets::PANDA_ARM_JOINTS),
+                ee_link: ms2_assets::PANDA_TCP_LINK.into(),
                 gains: DriveGains::MANISKILL2_DEFAULT,
                 joint_delta: 0.1,
                 joint_delta_pos_vel: 0.05,
@@ -119,7 +108,7 @@ impl RobotConfig {
                 ik: EeIkSolver::default(),
             },
             gripper: Some(GripperSpec {
-                joint_names: vec!["panda_finger_joint1".into(), "panda_finger_joint2".into()],
+                joint_names: owned(&ms2_assets::PANDA_GRIPPER_JOINTS),
                 lower: -0.01,
                 upper: 0.04,
                 gains: DriveGains::MANISKILL2_DEFAULT,
@@ -268,8 +257,7 @@ impl RobotConfig {
     /// ```
     /// use ms2_control::{ControlMode, ControlTiming, PerfectTrackingArticulation, RobotConfig};
     /// let panda = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
-    /// let names = panda.model.dof_names().iter().map(|s| s.to_string()).collect();
-    /// let mut robot = PerfectTrackingArticulation::new(names, ms2_assets::PANDA_REST_QPOS.to_vec());
+    /// let mut robot = PerfectTrackingArticulation::for_model(&panda.model, ms2_assets::PANDA_REST_QPOS.to_vec());
     /// let mut ctrl = panda.build_controller(ControlMode::PdEeDeltaPose, &robot, ControlTiming::MANISKILL2).unwrap();
     /// assert_eq!(ctrl.action_dim(), 7);
     /// assert_eq!(ctrl.slice("gripper"), Some(6..7));
@@ -292,4 +280,9 @@ impl RobotConfig {
             timing,
         )
     }
+}
+
+/// Owned copies of `names`.
+fn owned(names: &[&str]) -> Vec<String> {
+    names.iter().map(|s| s.to_string()).collect()
 }

@@ -3,28 +3,13 @@
 
 use approx::assert_relative_eq;
 use ms2_control::{
-    ActionError, Articulation, CombinedController, ControlMode, ControlTiming,
-    PerfectTrackingArticulation, RobotConfig,
+    ActionError, Articulation, ControlMode, ControlTiming, PerfectTrackingArticulation, RobotConfig,
 };
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
-const REST: [f64; 9] = ms2_assets::PANDA_REST_QPOS;
+mod common;
 
-fn setup(mode: ControlMode) -> (RobotConfig, PerfectTrackingArticulation, CombinedController) {
-    let panda = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
-    let names = panda
-        .model
-        .dof_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    let mut robot = PerfectTrackingArticulation::new(names, REST.to_vec());
-    let mut ctrl = panda
-        .build_controller(mode, &robot, ControlTiming::MANISKILL2)
-        .unwrap();
-    ctrl.reset(&mut robot);
-    (panda, robot, ctrl)
-}
+use common::{panda_dof_names, panda_on_mock as setup, REST};
 
 fn arm(v: &[f64]) -> Vec<f64> {
     v[..7].to_vec()
@@ -366,12 +351,7 @@ fn bad_actions_get_typed_errors() {
 #[test]
 fn builder_rejects_articulations_it_cannot_drive() {
     let panda = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
-    let mut names: Vec<String> = panda
-        .model
-        .dof_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let mut names = panda_dof_names(&panda);
     names.push("extra_joint".into());
     let robot = PerfectTrackingArticulation::new(names, vec![0.0; 10]);
     let err = panda
@@ -388,12 +368,7 @@ fn builder_rejects_articulations_it_cannot_drive() {
 #[test]
 fn articulation_joint_order_may_differ_from_the_urdf() {
     let panda = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
-    let mut names: Vec<String> = panda
-        .model
-        .dof_names()
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let mut names = panda_dof_names(&panda);
     names.reverse();
     let mut q = REST.to_vec();
     q.reverse();

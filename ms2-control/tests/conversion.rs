@@ -10,15 +10,7 @@ const DT: f64 = 0.05;
 const STEPS: usize = 80;
 
 fn robot(panda: &RobotConfig) -> PerfectTrackingArticulation {
-    PerfectTrackingArticulation::new(
-        panda
-            .model
-            .dof_names()
-            .iter()
-            .map(|s| s.to_string())
-            .collect(),
-        REST.to_vec(),
-    )
+    PerfectTrackingArticulation::for_model(&panda.model, REST.to_vec())
 }
 
 /// A smooth source action for step `t`: arm joints swing around the rest pose (at most

@@ -70,8 +70,8 @@ fn base_model() -> Arc<KinematicModel> {
 #[test]
 fn base_velocity_is_ego_centric() {
     let model = base_model();
-    let names: Vec<String> = model.dof_names().iter().map(|s| s.to_string()).collect();
-    let mut robot = PerfectTrackingArticulation::new(names.clone(), vec![1.0, 2.0, FRAC_PI_2]);
+    let mut robot = PerfectTrackingArticulation::for_model(&model, vec![1.0, 2.0, FRAC_PI_2]);
+    let names = robot.names.clone();
     let config = PartControllerConfig::BaseVelocity(BaseVelocityConfig {
         name: "base_pd_joint_vel".into(),
         joint_names: names,
@@ -117,8 +117,8 @@ fn base_velocity_is_ego_centric() {
 #[test]
 fn interpolating_joint_controller_ramps_targets_over_the_substeps() {
     let model = base_model();
-    let names: Vec<String> = model.dof_names().iter().map(|s| s.to_string()).collect();
-    let mut robot = PerfectTrackingArticulation::new(names.clone(), vec![0.0, 0.0, 0.0]);
+    let mut robot = PerfectTrackingArticulation::for_model(&model, vec![0.0, 0.0, 0.0]);
+    let names = robot.names.clone();
     let config = PartControllerConfig::JointPosition(JointPositionConfig {
         name: "pd_joint_delta_pos_interpolated".into(),
         joint_names: names,
@@ -161,8 +161,8 @@ fn interpolating_joint_controller_ramps_targets_over_the_substeps() {
 #[test]
 fn inconsistent_configs_are_rejected() {
     let model = base_model();
-    let names: Vec<String> = model.dof_names().iter().map(|s| s.to_string()).collect();
-    let robot = PerfectTrackingArticulation::new(names.clone(), vec![0.0; 3]);
+    let robot = PerfectTrackingArticulation::for_model(&model, vec![0.0; 3]);
+    let names = robot.names.clone();
     let config = PartControllerConfig::BaseVelocity(BaseVelocityConfig {
         name: "base".into(),
         joint_names: names,

@@ -10,20 +10,12 @@ use ms2_plan::{
     KinematicRobot, MotionPlanner, OrientedBox, PlannerConfig, PlanningRobot,
 };
 use nalgebra::{Isometry3, Vector3};
-use planar_arm::PlanarArm;
+use planar_arm::{wall_scene, PlanarArm, GOAL, START};
 
 fn planar_arm_queries(c: &mut Criterion) {
     let arm = PlanarArm::new();
-    let mut scene = CollisionScene::new();
-    scene
-        .add_box(
-            "wall",
-            Vector3::new(0.1, 0.5, 0.2),
-            Isometry3::translation(0.55, 0.5, 0.0),
-        )
-        .expect("fresh scene");
-    let start = [-0.3, 0.2, 0.1];
-    let goal = [1.6, -0.3, 0.2];
+    let scene = wall_scene();
+    let (start, goal) = (START, GOAL);
     let checker =
         CollisionChecker::new(&arm, &scene, CheckerOptions::default()).expect("valid scene");
     c.bench_function("planar3/collision_check", |b| {

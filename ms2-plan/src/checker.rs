@@ -7,7 +7,7 @@ use parry3d::shape::SharedShape;
 
 use crate::convert::pose_to_parry;
 use crate::error::check_configuration;
-use crate::robot::PlanningRobot;
+use crate::robot::{link_index, PlanningRobot};
 use crate::scene::CollisionScene;
 use crate::PlanError;
 
@@ -123,19 +123,6 @@ impl<'r, R: PlanningRobot + ?Sized> CollisionChecker<'r, R> {
             });
         }
         let links = robot.collision_links();
-        let link_index = |name: &str| -> Result<usize, PlanError> {
-            links
-                .iter()
-                .position(|l| l.name == name)
-                .ok_or_else(|| PlanError::UnknownLink {
-                    name: name.to_owned(),
-                    known: links
-                        .iter()
-                        .map(|l| l.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                })
-        };
         let mut robot_shapes = Vec::new();
         for (link, l) in links.iter().enumerate() {
             for s in &l.shapes {
@@ -161,7 +148,7 @@ impl<'r, R: PlanningRobot + ?Sized> CollisionChecker<'r, R> {
             .collect();
         let mut allowed_link_object = Vec::new();
         for (link, object) in scene.allowed_collisions() {
-            allowed_link_object.push((link_index(link)?, object.as_str()));
+            allowed_link_object.push((link_index(links, link)?, object.as_str()));
         }
         let allowed = |link: usize, object: &str| {
             allowed_link_object
@@ -198,10 +185,10 @@ impl<'r, R: PlanningRobot + ?Sized> CollisionChecker<'r, R> {
         let mut carried_obstacle_pairs = Vec::new();
         let mut carried_robot_pairs = Vec::new();
         for (c, a) in scene.attached_objects().iter().enumerate() {
-            let link = link_index(&a.link)?;
+            let link = link_index(links, &a.link)?;
             let mut touch = vec![link];
             for t in &a.touch_links {
-                touch.push(link_index(t)?);
+                touch.push(link_index(links, t)?);
             }
             for (j, o) in obstacles.iter().enumerate() {
                 if !allowed_link_object

@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::checker::{CheckerOptions, CollisionChecker};
 use crate::convert::pose_to_parry;
-use crate::robot::{CollisionLink, JointLimits, PlanningRobot};
+use crate::robot::{link_index, CollisionLink, JointLimits, PlanningRobot};
 use crate::scene::CollisionScene;
 use crate::urdf_geometry::UrdfCollisionGeometry;
 use crate::PlanError;
@@ -110,19 +110,7 @@ impl KinematicRobot {
         for name in model.link_names() {
             links.push(geometry.link(name)?.clone());
         }
-        let index = |name: &str| -> Result<usize, PlanError> {
-            links
-                .iter()
-                .position(|l| l.name == name)
-                .ok_or_else(|| PlanError::UnknownLink {
-                    name: name.to_owned(),
-                    known: links
-                        .iter()
-                        .map(|l| l.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                })
-        };
+        let index = |name: &str| link_index(&links, name);
         let mut skip = Vec::new();
         for (a, b) in geometry.adjacent_link_pairs() {
             skip.push((index(&a)?, index(&b)?));
@@ -228,18 +216,7 @@ impl KinematicRobot {
     /// # Errors
     /// [`PlanError::UnknownLink`] if there is none.
     pub fn link_index(&self, name: &str) -> Result<usize, PlanError> {
-        self.links
-            .iter()
-            .position(|l| l.name == name)
-            .ok_or_else(|| PlanError::UnknownLink {
-                name: name.to_owned(),
-                known: self
-                    .links
-                    .iter()
-                    .map(|l| l.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
+        link_index(&self.links, name)
     }
 
     /// Link pairs (not yet skipped) whose shapes overlap in all of `samples` random

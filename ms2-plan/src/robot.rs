@@ -58,6 +58,24 @@ pub struct CollisionLink {
     pub shapes: Vec<LinkShape>,
 }
 
+/// Index of the link called `name` in `links`.
+///
+/// # Errors
+/// [`PlanError::UnknownLink`] naming all known links if there is none.
+pub(crate) fn link_index(links: &[CollisionLink], name: &str) -> Result<usize, PlanError> {
+    links
+        .iter()
+        .position(|l| l.name == name)
+        .ok_or_else(|| PlanError::UnknownLink {
+            name: name.to_owned(),
+            known: links
+                .iter()
+                .map(|l| l.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+}
+
 /// What the planner needs to know about a robot.
 ///
 /// A configuration `q` is a slice of [`PlanningRobot::dof`] joint values (rad or m) of the

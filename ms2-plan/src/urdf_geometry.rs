@@ -6,7 +6,7 @@ use std::collections::{HashMap, HashSet, VecDeque};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use parry3d::shape::SharedShape;
 
-use crate::robot::{CollisionLink, LinkShape};
+use crate::robot::{link_index, CollisionLink, LinkShape};
 use crate::PlanError;
 
 /// Per-link collision shapes and link adjacency read from a URDF.
@@ -56,18 +56,7 @@ impl UrdfCollisionGeometry {
     /// # Errors
     /// [`PlanError::UnknownLink`] if there is none.
     pub fn link(&self, name: &str) -> Result<&CollisionLink, PlanError> {
-        self.links
-            .iter()
-            .find(|l| l.name == name)
-            .ok_or_else(|| PlanError::UnknownLink {
-                name: name.to_owned(),
-                known: self
-                    .links
-                    .iter()
-                    .map(|l| l.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
+        Ok(&self.links[link_index(&self.links, name)?])
     }
 
     /// Pairs of links with geometry that are joined by a joint, directly or through a chain of

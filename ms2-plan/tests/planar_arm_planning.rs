@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::planar_arm::{planar_pose, PlanarArm};
+use common::planar_arm::{planar_pose, wall_scene, PlanarArm, GOAL, START};
 use ms2_plan::parry3d::shape::SharedShape;
 use ms2_plan::{
     compute_profile, sample, AttachedObject, Body, CheckerOptions, CollisionChecker,
@@ -10,22 +10,6 @@ use ms2_plan::{
     PlanningRobot,
 };
 use nalgebra::{Isometry3, Vector3};
-
-/// A wall the arm must swing around: a box at x ≈ 0.55 between y = 0.25 and 0.75.
-fn wall_scene() -> CollisionScene {
-    let mut scene = CollisionScene::new();
-    scene
-        .add_box(
-            "wall",
-            Vector3::new(0.1, 0.5, 0.2),
-            Isometry3::translation(0.55, 0.5, 0.0),
-        )
-        .unwrap();
-    scene
-}
-
-const START: [f64; 3] = [-0.3, 0.2, 0.1];
-const GOAL: [f64; 3] = [1.6, -0.3, 0.2];
 
 #[test]
 fn planner_goes_around_the_obstacle_and_the_path_is_collision_free_at_fine_resolution() {

@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use pyo3::IntoPyObjectExt;
 
+use crate::cameras::cameras_from_py;
 use crate::config::{config_to_py, make_config};
 use crate::convert::{box_space_to_py, info_to_py, obs_to_py, space_to_py};
 use crate::errors::{catch_panics, lock, NativeError};
@@ -53,7 +54,8 @@ impl NativeEnv {
     /// Makes an env; `None` arguments take the task's defaults.
     #[new]
     #[pyo3(signature = (env_id, obs_mode="state_dict".to_owned(), control_mode=None, reward_mode=None,
-                        render_mode=None, sim_freq=500.0, control_freq=20.0, max_episode_steps=None))]
+                        render_mode=None, sim_freq=500.0, control_freq=20.0, max_episode_steps=None,
+                        camera_cfgs=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -65,8 +67,9 @@ impl NativeEnv {
         sim_freq: f64,
         control_freq: f64,
         max_episode_steps: Option<u32>,
+        camera_cfgs: Option<Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let cfg = make_config(
+        let mut cfg = make_config(
             env_id,
             obs_mode,
             control_mode,
@@ -76,6 +79,7 @@ impl NativeEnv {
             control_freq,
             max_episode_steps,
         );
+        cfg.camera_cfgs = cameras_from_py(camera_cfgs.as_ref())?;
         let env = py.detach(|| catch_panics(|| Ok(make_env(&cfg)?)))?;
         Ok(NativeEnv {
             inner: Mutex::new(env),

@@ -3,12 +3,12 @@
 
 use std::sync::Mutex;
 
-use ms2_tasks::{Env, EnvError, Info, ObsValue, VecEnv};
+use ms2_tasks::{EnvCommand, Info, ObsValue, VecEnv};
 use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
-use rayon::prelude::*;
 
+use crate::cameras::cameras_from_py;
 use crate::config::{config_to_py, make_config};
 use crate::convert::{box_space_to_py, space_to_py, stack_obs, vec_info_to_py};
 use crate::errors::{catch_panics, lock, NativeError};
@@ -64,24 +64,13 @@ impl NativeVecEnv {
     }
 }
 
-/// Resets `env`, storing its observation.
-fn reset_one(
-    env: &mut Env,
-    seed: Option<u64>,
-    obs: &mut Option<ObsValue>,
-) -> Result<Info, EnvError> {
-    let (o, info) = env.reset(seed, false)?;
-    *obs = Some(o);
-    Ok(info)
-}
-
 #[pymethods]
 impl NativeVecEnv {
     /// Makes `num_envs` envs of one config; `None` arguments take the task's defaults.
     #[new]
     #[pyo3(signature = (env_id, num_envs, obs_mode="state_dict".to_owned(), control_mode=None,
                         reward_mode=None, render_mode=None, sim_freq=500.0, control_freq=20.0,
-                        max_episode_steps=None))]
+                        max_episode_steps=None, camera_cfgs=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -94,11 +83,12 @@ impl NativeVecEnv {
         sim_freq: f64,
         control_freq: f64,
         max_episode_steps: Option<u32>,
+        camera_cfgs: Option<Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         if num_envs == 0 {
             return Err(NativeError::Input("num_envs must be at least 1, got 0".to_owned()).into());
         }
-        let cfg = make_config(
+        let mut cfg = make_config(
             env_id,
             obs_mode,
             control_mode,
@@ -108,6 +98,7 @@ impl NativeVecEnv {
             control_freq,
             max_episode_steps,
         );
+        cfg.camera_cfgs = cameras_from_py(camera_cfgs.as_ref())?;
         let envs = py.detach(|| catch_panics(|| Ok(VecEnv::new(&cfg, num_envs)?)))?;
         let action_dim = envs.envs()[0].action_space().shape.iter().product();
         Ok(NativeVecEnv {
@@ -159,20 +150,25 @@ impl NativeVecEnv {
                 last_obs,
                 needs_reset,
             } = state;
-            let infos: Vec<Option<Info>> = envs
-                .envs_mut()
-                .par_iter_mut()
-                .zip(last_obs.par_iter_mut())
-                .zip(needs_reset.par_iter_mut())
-                .enumerate()
-                .map(|(i, ((env, obs), pending))| {
-                    if !mask[i] {
-                        return Ok(None);
-                    }
-                    *pending = false;
-                    reset_one(env, seeds[i], obs).map(Some)
+            let commands: Vec<EnvCommand<'_>> = (0..n)
+                .map(|i| match mask[i] {
+                    true => EnvCommand::Reset { seed: seeds[i] },
+                    false => EnvCommand::Keep,
                 })
-                .collect::<Result<_, EnvError>>()?;
+                .collect();
+            // One parallel pass (and, in visual modes, one batched render of every camera).
+            let outs = envs.run(&commands)?;
+            let infos: Vec<Option<Info>> = outs
+                .into_iter()
+                .enumerate()
+                .map(|(i, out)| {
+                    out.map(|out| {
+                        needs_reset[i] = false;
+                        last_obs[i] = Some(out.obs);
+                        out.info
+                    })
+                })
+                .collect();
             Ok(infos)
         })?;
         let state = lock(&self.inner, "vector env")?;
@@ -228,26 +224,24 @@ impl NativeVecEnv {
                 last_obs,
                 needs_reset,
             } = state;
-            let outcomes: Vec<EnvOutcome> = envs
-                .envs_mut()
-                .par_iter_mut()
-                .zip(last_obs.par_iter_mut())
-                .zip(needs_reset.par_iter_mut())
-                .zip(actions.par_chunks(width.max(1)))
-                .map(|(((env, obs), pending), action)| {
-                    if *pending {
-                        *pending = false;
-                        let info = reset_one(env, None, obs)?;
-                        return Ok(EnvOutcome {
-                            reward: 0.0,
-                            terminated: false,
-                            truncated: false,
-                            info,
-                        });
-                    }
-                    let out = env.step(if width == 0 { &[] } else { action })?;
-                    *obs = Some(out.obs);
-                    *pending = out.terminated || out.truncated;
+            let commands: Vec<EnvCommand<'_>> = (0..n)
+                .map(|i| match needs_reset[i] {
+                    true => EnvCommand::Reset { seed: None },
+                    false => EnvCommand::Step(&actions[i * width..(i + 1) * width]),
+                })
+                .collect();
+            // Physics of all envs in parallel, then (visual modes) one batched render of every
+            // camera and parallel observation assembly; a reset reports reward 0, no flags.
+            let outs = envs.run(&commands)?;
+            let outcomes: Vec<EnvOutcome> = outs
+                .into_iter()
+                .enumerate()
+                .map(|(i, out)| {
+                    let out = out.ok_or_else(|| {
+                        NativeError::Input(format!("env {i} reported no step output"))
+                    })?;
+                    last_obs[i] = Some(out.obs);
+                    needs_reset[i] = out.terminated || out.truncated;
                     Ok(EnvOutcome {
                         reward: out.reward,
                         terminated: out.terminated,
@@ -255,7 +249,7 @@ impl NativeVecEnv {
                         info: out.info,
                     })
                 })
-                .collect::<Result<_, EnvError>>()?;
+                .collect::<Result<_, NativeError>>()?;
             Ok(outcomes)
         })?;
         let state = lock(&self.inner, "vector env")?;
@@ -305,5 +299,11 @@ impl NativeVecEnv {
             ))
         })?;
         Ok(PyArray1::from_vec(py, env.get_state()))
+    }
+
+    /// Triangles drawn per observation camera in the last render (0 before any render).
+    fn triangles_per_camera(&self) -> PyResult<usize> {
+        let state = lock(&self.inner, "vector env")?;
+        Ok(state.envs.envs()[0].triangles_per_camera())
     }
 }

@@ -67,24 +67,8 @@ def _space_leaves(space):
         yield space
 
 
-#: Known runtime bug (ms2-tasks): a reset keeps the physics solver's warm-start/contact caches of
-#: the previous episode, so StackCube's rewards after `reset(seed=123)` differ slightly between
-#: two runs and gymnasium's determinism check fails. Non-strict so the fix in ms2-tasks (restoring
-#: the world's cold state at reset) turns this into XPASS without breaking CI; only an
-#: AssertionError (the checker's) is tolerated.
-KNOWN_NONDETERMINISTIC_RESET = {"StackCube-v0"}
-
-
 @pytest.mark.parametrize("obs_mode", ["state", "state_dict"])
-def test_env_checker_every_control_mode(env_id, obs_mode, request):
-    if env_id in KNOWN_NONDETERMINISTIC_RESET:
-        request.applymarker(
-            pytest.mark.xfail(
-                reason="ms2-tasks reset leaks solver state (see KNOWN_NONDETERMINISTIC_RESET)",
-                raises=AssertionError,
-                strict=False,
-            )
-        )
+def test_env_checker_every_control_mode(env_id, obs_mode):
     for control_mode in ms2.Ms2Env(env_id).supported_control_modes:
         env = ms2.Ms2Env(env_id, obs_mode=obs_mode, control_mode=control_mode)
         check_env(env, skip_render_check=True)

@@ -105,3 +105,66 @@ def test_record_episode_needs_rgb_array():
 
     with pytest.raises(ValueError, match="rgb_array"):
         RecordEpisode(gym.make("PickCube-v0"), "unused")
+
+
+def test_camera_cfgs_change_shapes_globally_and_per_camera():
+    env = gym.make(
+        "PickCube-v0",
+        obs_mode="rgbd",
+        camera_cfgs={"width": 32, "height": 24, "hand_camera": {"width": 16, "fov": 1.0}},
+    )
+    obs, _ = env.reset(seed=0)
+    assert obs["image"]["base_camera"]["rgb"].shape == (24, 32, 3)
+    assert obs["image"]["base_camera"]["depth"].shape == (24, 32, 1)
+    assert obs["image"]["hand_camera"]["rgb"].shape == (24, 16, 3)
+    # fx = (H/2) / tan(fov/2): the hand camera's fov came from its own entry.
+    fy = obs["camera_param"]["hand_camera"]["intrinsic_cv"][1, 1]
+    assert np.isclose(fy, 12.0 / np.tan(0.5), rtol=1e-4)
+    assert obs in env.observation_space
+    env.close()
+    venv = ms2.make_vec(
+        "PickCube-v0", num_envs=2, obs_mode="pointcloud", camera_cfgs={"width": 8, "height": 8}
+    )
+    obs, _ = venv.reset(seed=0)
+    assert obs["pointcloud"]["xyzw"].shape == (2, 2 * 8 * 8, 4)
+    venv.close()
+
+
+@pytest.mark.parametrize(
+    "camera_cfgs, named",
+    [
+        ({"widht": 64}, "widht"),
+        ({"width": 0}, "width"),
+        ({"width": "64"}, "width"),
+        ({"fov": float("nan")}, "fov"),
+        ({"base_camera": {"p": [0.0, 1.0]}}, "p"),
+        ({"base_camera": {"colour": 1}}, "colour"),
+        ({"side_camera": {"width": 8}}, "side_camera"),
+        ({"near": 2.0, "far": 1.0}, "near"),
+    ],
+)
+def test_bad_camera_cfgs_raise_value_error_naming_them(camera_cfgs, named):
+    with pytest.raises(ValueError, match=named):
+        gym.make("PickCube-v0", obs_mode="rgbd", camera_cfgs=camera_cfgs)
+
+
+def test_make_vec_batched_images_equal_single_env_images():
+    cfgs = {"width": 32, "height": 32}
+    venv = ms2.make_vec("PickCube-v0", num_envs=3, obs_mode="rgbd", camera_cfgs=cfgs)
+    batched, _ = venv.reset(seed=[5, 6, 7])
+    actions = np.stack([venv.single_action_space.sample() for _ in range(3)])
+    stepped, *_ = venv.step(actions)
+    venv.close()
+    for k in range(3):
+        env = gym.make("PickCube-v0", obs_mode="rgbd", camera_cfgs=cfgs)
+        alone, _ = env.reset(seed=5 + k)
+        after, *_ = env.step(actions[k])
+        env.close()
+        for cam in CAMERAS:
+            for key in ("rgb", "depth"):
+                got_reset, got_step = batched["image"][cam][key], stepped["image"][cam][key]
+                np.testing.assert_array_equal(got_reset[k], alone["image"][cam][key])
+                np.testing.assert_array_equal(got_step[k], after["image"][cam][key])
+    assert not np.array_equal(
+        batched["image"]["base_camera"]["rgb"][0], batched["image"]["base_camera"]["rgb"][1]
+    )

@@ -12,6 +12,7 @@ use crate::scene::MAX_DIRECTIONAL_LIGHTS;
 use crate::shadow::light_clip_from_world;
 use crate::targets::{linear_to_srgb8, CameraTargets, FrameResources};
 use crate::{Camera, CameraOutput, RenderError, Scene};
+use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
 
 /// One instance to draw: which mesh, which texture (if any), which instance record.
@@ -40,6 +41,8 @@ fn instance_record(instance: &crate::Instance) -> [u32; 32] {
     }
     words[28] = instance.segmentation.actor;
     words[29] = instance.segmentation.link;
+    // Untextured instances skip the texture fetch in the fragment shader.
+    words[30] = u32::from(instance.material.texture.is_some());
     words
 }
 
@@ -404,7 +407,10 @@ impl PendingFrame {
                 .get_mapped_range()
                 .map_err(|e| RenderError::Gpu(format!("reading images back failed: {e}")))?;
             let bytes: &[u8] = &view;
+            // Decoding (unpacking colour and G-buffer rows) is per-camera CPU work: spread it
+            // over rayon's pool, which matters for batches of many environments' cameras.
             (0..self.cameras.len())
+                .into_par_iter()
                 .map(|c| resources.targets[c].decode(bytes, self.cameras[c], self.backgrounds[c]))
                 .collect()
         };

@@ -48,6 +48,13 @@ pub(crate) trait EnvBackend: Send {
     fn capture_cameras(&self) -> Result<crate::sensors::CameraFrame, EnvError> {
         Err(self.not_renderable())
     }
+    /// The observation sensors (built on first use) and the world they see, for batched
+    /// rendering across envs (robot tasks only).
+    fn sensors_mut(
+        &mut self,
+    ) -> Result<(&mut crate::sensors::Sensors, &ms2_physics::World), EnvError> {
+        Err(self.not_renderable())
+    }
     /// Renders the human view, goal marker shown (robot tasks only).
     fn render_human(&self) -> Result<ms2_render::CameraOutput, EnvError> {
         Err(self.not_renderable())

@@ -121,6 +121,73 @@ impl Env {
         seed: Option<u64>,
         reconfigure: bool,
     ) -> Result<(ObsValue, Info), EnvError> {
+        let info = self.start_episode(seed, reconfigure)?;
+        Ok((self.try_observe()?, info))
+    }
+
+    /// Applies `action` (length = `action_space().size()`, finite) for one control period of
+    /// `sim_freq / control_freq` physics substeps, then observes, evaluates and rewards.
+    pub fn step(&mut self, action: &[f32]) -> Result<StepOutput, EnvError> {
+        let (reward, terminated, truncated, info) = self.advance(action)?;
+        Ok(StepOutput {
+            obs: self.try_observe()?,
+            reward,
+            terminated,
+            truncated,
+            info,
+        })
+    }
+
+    /// [`Env::reset`] without rendering: the observation is [`Env::observe_deferred`]'s.
+    pub(crate) fn reset_deferred(
+        &mut self,
+        seed: Option<u64>,
+    ) -> Result<(ObsValue, Info), EnvError> {
+        let info = self.start_episode(seed, false)?;
+        Ok((self.observe_deferred(), info))
+    }
+
+    /// [`Env::step`] without rendering: the observation is [`Env::observe_deferred`]'s.
+    pub(crate) fn step_deferred(&mut self, action: &[f32]) -> Result<StepOutput, EnvError> {
+        let (reward, terminated, truncated, info) = self.advance(action)?;
+        Ok(StepOutput {
+            obs: self.observe_deferred(),
+            reward,
+            terminated,
+            truncated,
+            info,
+        })
+    }
+
+    /// The observation of a step whose images are rendered later, batched with other envs: in
+    /// state modes the full observation; in visual modes the privileged `state_dict`, which
+    /// [`crate::sensors::visual_obs::assemble`] turns into the observation given the frame.
+    fn observe_deferred(&self) -> ObsValue {
+        match self.obs_mode.visual() {
+            Some(_) => self.backend.observe_state_dict(),
+            None => self.observe(),
+        }
+    }
+
+    /// The visual layout of the obs mode and whether it adds a robot mask; `None` in state modes.
+    pub(crate) fn visual_layout(&self) -> Option<(crate::sensors::VisualLayout, bool)> {
+        self.obs_mode.visual()
+    }
+
+    /// Synchronises the render scene with the world and returns the observation cameras at
+    /// their current poses (for batched rendering; see [`crate::sensors::capture_batch`]).
+    pub(crate) fn prepare_cameras(&mut self) -> Result<Vec<ms2_render::Camera>, EnvError> {
+        let (sensors, world) = self.backend.sensors_mut()?;
+        sensors.prepare(world)
+    }
+
+    /// The env's sensors (built on first use).
+    pub(crate) fn sensors(&mut self) -> Result<&crate::sensors::Sensors, EnvError> {
+        Ok(self.backend.sensors_mut()?.0)
+    }
+
+    /// Seeds and samples a new episode; the info of its first state.
+    fn start_episode(&mut self, seed: Option<u64>, reconfigure: bool) -> Result<Info, EnvError> {
         let mut rng = self.seeding.start_episode(seed);
         if reconfigure {
             self.backend.reconfigure(&mut rng)?;
@@ -128,12 +195,12 @@ impl Env {
         self.backend.initialize_episode(&mut rng)?;
         self.elapsed_steps = 0;
         let eval = self.backend.evaluate();
-        Ok((self.try_observe()?, self.make_info(eval)))
+        Ok(self.make_info(eval))
     }
 
-    /// Applies `action` (length = `action_space().size()`, finite) for one control period of
-    /// `sim_freq / control_freq` physics substeps, then observes, evaluates and rewards.
-    pub fn step(&mut self, action: &[f32]) -> Result<StepOutput, EnvError> {
+    /// Checks and applies `action`, counts the step and evaluates: (reward, terminated,
+    /// truncated, info).
+    fn advance(&mut self, action: &[f32]) -> Result<(f64, bool, bool, Info), EnvError> {
         self.check_action(action)?;
         self.backend.apply_action(action)?;
         self.elapsed_steps = self.elapsed_steps.saturating_add(1);
@@ -146,13 +213,8 @@ impl Env {
             }
         };
         let terminated = eval.success;
-        Ok(StepOutput {
-            obs: self.try_observe()?,
-            reward,
-            terminated,
-            truncated: self.elapsed_steps >= self.max_episode_steps,
-            info: self.make_info(eval),
-        })
+        let truncated = self.elapsed_steps >= self.max_episode_steps;
+        Ok((reward, terminated, truncated, self.make_info(eval)))
     }
 
     fn check_action(&self, action: &[f32]) -> Result<(), EnvError> {
@@ -192,7 +254,7 @@ impl Env {
                 let frame = self.backend.capture_cameras()?;
                 Ok(crate::sensors::visual_obs::assemble(
                     self.backend.observe_state_dict(),
-                    &frame,
+                    frame,
                     layout,
                     robot_seg,
                 ))

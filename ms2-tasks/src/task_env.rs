@@ -108,15 +108,20 @@ impl<T: Task> TaskEnv<T> {
             .map_err(|_| EnvError::Render("sensor lock poisoned by an earlier panic".to_owned()))?;
         let sensors = match &mut *guard {
             Some(sensors) => sensors,
-            slot @ None => slot.insert(Sensors::new(
-                RenderContext::shared()?,
-                &self.scene.world,
-                Some(self.scene.agent.articulation),
-                self.camera_cfgs.clone(),
-                CameraConfig::render_camera(),
-            )?),
+            slot @ None => slot.insert(self.new_sensors()?),
         };
         f(sensors, &self.scene.world)
+    }
+
+    /// The env's cameras and render scene, drawing through the process-wide render context.
+    fn new_sensors(&self) -> Result<Sensors, EnvError> {
+        Sensors::new(
+            RenderContext::shared()?,
+            &self.scene.world,
+            Some(self.scene.agent.articulation),
+            self.camera_cfgs.clone(),
+            CameraConfig::render_camera(),
+        )
     }
 
     fn controller_state(&self) -> Vec<f32> {
@@ -128,6 +133,11 @@ impl<T: Task> TaskEnv<T> {
             .flat_map(|(_, v)| v.iter().map(|&x| x as f32))
             .collect()
     }
+}
+
+/// The error of a sensor lock poisoned by a panic during an earlier render.
+fn poisoned<T>(_: std::sync::PoisonError<T>) -> EnvError {
+    EnvError::Render("sensor lock poisoned by an earlier panic".to_owned())
 }
 
 /// A fresh world with the ground, the robot and the task's actors.
@@ -286,6 +296,20 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
 
     fn capture_cameras(&self) -> Result<CameraFrame, EnvError> {
         self.with_sensors(|sensors, world| sensors.capture(world))
+    }
+
+    fn sensors_mut(&mut self) -> Result<(&mut Sensors, &World), EnvError> {
+        if self.sensors.get_mut().map_err(poisoned)?.is_none() {
+            let built = self.new_sensors()?;
+            *self.sensors.get_mut().map_err(poisoned)? = Some(built);
+        }
+        let sensors = self
+            .sensors
+            .get_mut()
+            .map_err(poisoned)?
+            .as_mut()
+            .ok_or_else(|| EnvError::Render("sensors missing after being built".to_owned()))?;
+        Ok((sensors, &self.scene.world))
     }
 
     fn render_human(&self) -> Result<ms2_render::CameraOutput, EnvError> {

@@ -1,4 +1,5 @@
-//! [`VecEnv`]: several envs stepped in parallel on rayon's thread pool.
+//! [`VecEnv`]: several envs stepped in parallel on rayon's thread pool, their cameras rendered
+//! in one batch.
 
 use rayon::prelude::*;
 
@@ -7,9 +8,31 @@ use crate::env::{Env, StepOutput};
 use crate::error::EnvError;
 use crate::info::Info;
 use crate::obs::ObsValue;
+use crate::sensors::batch::{submit_batch, BatchItem, PendingBatch};
+use crate::sensors::{visual_obs, CameraFrame, VisualLayout};
+
+/// What one env does during [`VecEnv::run`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EnvCommand<'a> {
+    /// Step with this action (`action_dim` floats).
+    Step(&'a [f32]),
+    /// Start a new episode (`seed = None` draws the next seed from the env's RNG).
+    Reset {
+        /// Episode seed.
+        seed: Option<u64>,
+    },
+    /// Leave the env as it is (it reports nothing).
+    Keep,
+}
 
 /// `num_envs` copies of one env config, reset and stepped in parallel (no autoreset: the Python
 /// layer implements gymnasium's).
+///
+/// In visual obs modes a vector step has three phases: physics (and the poses of every env's
+/// render scene and cameras) in parallel; batched rendering of every camera (one GPU
+/// submission and one readback per half of the envs, pipelined with the other half's physics:
+/// [`submit_batch`]); then observation assembly (point-cloud fusion, robot masks) in
+/// parallel. The images equal those of stepping each env alone.
 ///
 /// ```
 /// use ms2_tasks::{EnvConfig, VecEnv};
@@ -23,6 +46,8 @@ use crate::obs::ObsValue;
 pub struct VecEnv {
     envs: Vec<Env>,
     action_dim: usize,
+    /// Whether visual steps render in two pipelined halves (see [`VecEnv::run`]).
+    pipelined: bool,
 }
 
 impl VecEnv {
@@ -38,7 +63,11 @@ impl VecEnv {
             .map(|_| Env::new(cfg))
             .collect::<Result<Vec<_>, _>>()?;
         let action_dim = envs[0].action_space().size();
-        Ok(VecEnv { envs, action_dim })
+        Ok(VecEnv {
+            envs,
+            action_dim,
+            pipelined: true,
+        })
     }
 
     /// Number of envs.
@@ -56,6 +85,13 @@ impl VecEnv {
         &mut self.envs
     }
 
+    /// Turns the two-half render pipeline of visual steps on (the default) or off (all envs'
+    /// physics, then one batch of all cameras). The outputs are the same either way; this is
+    /// for measuring the overlap.
+    pub fn set_pipelined_rendering(&mut self, pipelined: bool) {
+        self.pipelined = pipelined;
+    }
+
     /// Resets every env; `seeds` has one entry per env (`None` = draw from that env's RNG).
     pub fn reset(&mut self, seeds: &[Option<u64>]) -> Result<Vec<(ObsValue, Info)>, EnvError> {
         if seeds.len() != self.envs.len() {
@@ -64,11 +100,16 @@ impl VecEnv {
                 got: seeds.len(),
             });
         }
-        self.envs
-            .par_iter_mut()
-            .zip(seeds.par_iter())
-            .map(|(env, seed)| env.reset(*seed, false))
-            .collect()
+        let commands: Vec<EnvCommand<'_>> = seeds
+            .iter()
+            .map(|&seed| EnvCommand::Reset { seed })
+            .collect();
+        Ok(self
+            .run(&commands)?
+            .into_iter()
+            .flatten()
+            .map(|out| (out.obs, out.info))
+            .collect())
     }
 
     /// Steps every env; `actions` holds `num_envs * action_dim` floats, row-major (env-major).
@@ -81,10 +122,128 @@ impl VecEnv {
                 got: actions.len(),
             });
         }
-        self.envs
-            .par_iter_mut()
-            .zip(actions.par_chunks(self.action_dim))
-            .map(|(env, action)| env.step(action))
-            .collect()
+        let commands: Vec<EnvCommand<'_>> = if self.action_dim == 0 {
+            vec![EnvCommand::Step(&[]); self.envs.len()]
+        } else {
+            actions
+                .chunks(self.action_dim)
+                .map(EnvCommand::Step)
+                .collect()
+        };
+        Ok(self.run(&commands)?.into_iter().flatten().collect())
     }
+
+    /// Runs one command per env in parallel and returns, per env, its step output (`None` for
+    /// [`EnvCommand::Keep`]). A reset reports its first observation and info with reward 0
+    /// and both flags false (gymnasium's "next step" autoreset convention).
+    ///
+    /// In visual modes the envs run as two halves in a pipeline: the first half's physics,
+    /// then its cameras are submitted in one batch; the second half's physics runs while the
+    /// first half renders, then its batch is submitted; observations are assembled as each
+    /// batch arrives.
+    pub fn run(
+        &mut self,
+        commands: &[EnvCommand<'_>],
+    ) -> Result<Vec<Option<StepOutput>>, EnvError> {
+        if commands.len() != self.envs.len() {
+            return Err(EnvError::InvalidConfig(format!(
+                "expected one command per env ({}), got {}",
+                self.envs.len(),
+                commands.len()
+            )));
+        }
+        let Some((layout, robot_seg)) = self.envs[0].visual_layout() else {
+            let stepped = simulate(&mut self.envs, commands, false)?;
+            return Ok(stepped.into_iter().map(|s| s.map(|(out, _)| out)).collect());
+        };
+        let n = self.envs.len();
+        let split = if n >= 2 && self.pipelined {
+            n.div_ceil(2)
+        } else {
+            n
+        };
+        let (first_envs, second_envs) = self.envs.split_at_mut(split);
+        let (first_commands, second_commands) = commands.split_at(split);
+        let first = simulate(first_envs, first_commands, true)?;
+        let first_batch = submit(first_envs, &first)?;
+        let second = simulate(second_envs, second_commands, true)?;
+        let second_batch = submit(second_envs, &second)?;
+        let mut outs = assemble(first, first_batch.wait()?, layout, robot_seg);
+        outs.extend(assemble(second, second_batch.wait()?, layout, robot_seg));
+        Ok(outs)
+    }
+}
+
+/// An env's step output before its images, and its cameras posed for rendering (`None` for
+/// [`EnvCommand::Keep`]).
+type Simulated = Option<(StepOutput, Vec<ms2_render::Camera>)>;
+
+/// Runs the commands' physics in parallel; with `visual`, also poses each env's render scene
+/// and cameras.
+fn simulate(
+    envs: &mut [Env],
+    commands: &[EnvCommand<'_>],
+    visual: bool,
+) -> Result<Vec<Simulated>, EnvError> {
+    envs.par_iter_mut()
+        .zip(commands.par_iter())
+        .map(|(env, command)| {
+            let out = match *command {
+                EnvCommand::Keep => return Ok(None),
+                EnvCommand::Step(action) => env.step_deferred(action)?,
+                EnvCommand::Reset { seed } => {
+                    let (obs, info) = env.reset_deferred(seed)?;
+                    StepOutput {
+                        obs,
+                        reward: 0.0,
+                        terminated: false,
+                        truncated: false,
+                        info,
+                    }
+                }
+            };
+            let cameras = match visual {
+                true => env.prepare_cameras()?,
+                false => Vec::new(),
+            };
+            Ok(Some((out, cameras)))
+        })
+        .collect()
+}
+
+/// Submits every camera of the simulated envs in one batch.
+fn submit(envs: &mut [Env], simulated: &[Simulated]) -> Result<PendingBatch, EnvError> {
+    let items: Vec<BatchItem<'_>> = envs
+        .iter_mut()
+        .zip(simulated)
+        .filter_map(|(env, s)| {
+            s.as_ref()
+                .map(|(_, cameras)| env.sensors().map(|sensors| (sensors, &cameras[..])))
+        })
+        .collect::<Result<_, EnvError>>()?;
+    submit_batch(&items)
+}
+
+/// The visual observations (image copies, fused point clouds, masks), in parallel.
+fn assemble(
+    simulated: Vec<Simulated>,
+    frames: Vec<CameraFrame>,
+    layout: VisualLayout,
+    robot_seg: bool,
+) -> Vec<Option<StepOutput>> {
+    let mut frames = frames.into_iter();
+    let frames: Vec<Option<CameraFrame>> = simulated
+        .iter()
+        .map(|s| s.as_ref().and_then(|_| frames.next()))
+        .collect();
+    simulated
+        .into_par_iter()
+        .zip(frames)
+        .map(|(s, frame)| {
+            let (mut out, _) = s?;
+            let state_dict = std::mem::replace(&mut out.obs, ObsValue::Dict(Vec::new()));
+            out.obs = visual_obs::assemble(state_dict, frame?, layout, robot_seg);
+            Some(out)
+        })
+        .collect()
 }

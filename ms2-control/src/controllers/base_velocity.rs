@@ -1,9 +1,10 @@
 //! Ego-centric velocity control of a mobile base (`base_pd_joint_vel`).
 
 use super::{
-    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+    BuildContext, BuildError, JointVelocityConfig, JointVelocityController, PartController,
+    PartConversion,
 };
-use crate::action::{ActionBounds, ActionScaling};
+use crate::action::ActionBounds;
 use crate::articulation::{Articulation, DriveGains};
 
 /// Configuration of a [`BaseVelocityController`].
@@ -34,78 +35,69 @@ pub struct BaseVelocityConfig {
 /// Action `(v_forward, v_left, ω, rest…)`: the planar velocity is rotated by the current yaw
 /// `θ = qpos[yaw]` into world axes, `(ẋ, ẏ) = R(θ) (v_forward, v_left)`, and set as velocity
 /// targets of the x and y joints; ω and the rest are velocity targets of their joints.
+///
+/// It is a [`JointVelocityController`] on the base joints whose action is turned from the ego
+/// frame into world axes.
 #[derive(Debug, Clone)]
 pub struct BaseVelocityController {
-    config: BaseVelocityConfig,
-    joint_indices: Vec<usize>,
-    bounds: ActionBounds,
-    control_period_s: f64,
+    /// The velocity drives of the base joints (x, y, yaw, then any others), world axes.
+    joints: JointVelocityController,
 }
 
 impl BaseVelocityController {
     /// Builds the controller for the articulation layout in `ctx`.
     pub fn new(config: &BaseVelocityConfig, ctx: &BuildContext<'_>) -> Result<Self, BuildError> {
-        let joint_indices = ctx.indices(&config.name, &config.joint_names)?;
-        let n = joint_indices.len();
+        let n = ctx.indices(&config.name, &config.joint_names)?.len();
         if n < 3 {
             return Err(BuildError::BadConfig {
                 controller: config.name.clone(),
                 message: format!("a base controller needs at least x, y and yaw joints, got {n}"),
             });
         }
-        let low = per_joint(&config.name, "lower", &config.lower, n)?;
-        let high = per_joint(&config.name, "upper", &config.upper, n)?;
-        check_bounds(&config.name, &low, &high)?;
-        let scaling = if config.normalize_action {
-            ActionScaling::Normalized
-        } else {
-            ActionScaling::Physical
-        };
-        Ok(Self {
-            config: config.clone(),
-            joint_indices,
-            bounds: ActionBounds { low, high, scaling },
-            control_period_s: ctx.timing.control_period_s(),
-        })
+        let joints = JointVelocityController::new(
+            &JointVelocityConfig {
+                name: config.name.clone(),
+                joint_names: config.joint_names.clone(),
+                lower: config.lower.clone(),
+                upper: config.upper.clone(),
+                normalize_action: config.normalize_action,
+                damping: config.damping,
+                force_limit: config.force_limit,
+            },
+            ctx,
+        )?;
+        Ok(Self { joints })
+    }
+
+    /// Current yaw of the base (rad), the angle from the ego frame to world axes.
+    fn yaw(&self, articulation: &dyn Articulation) -> f64 {
+        articulation.qpos()[self.joints.joint_indices()[2]]
     }
 }
 
 impl PartController for BaseVelocityController {
     fn name(&self) -> &str {
-        &self.config.name
+        self.joints.name()
     }
     fn joint_indices(&self) -> &[usize] {
-        &self.joint_indices
+        self.joints.joint_indices()
     }
     fn bounds(&self) -> &ActionBounds {
-        &self.bounds
+        self.joints.bounds()
     }
     fn drive_gains(&self) -> Vec<DriveGains> {
-        vec![
-            DriveGains {
-                stiffness: 0.0,
-                damping: self.config.damping,
-                force_limit: self.config.force_limit
-            };
-            self.joint_indices.len()
-        ]
+        self.joints.drive_gains()
     }
     fn reset(&mut self, articulation: &mut dyn Articulation) {
-        articulation
-            .set_drive_velocity_targets(&self.joint_indices, &vec![0.0; self.joint_indices.len()]);
+        self.joints.reset(articulation);
     }
     fn set_action(&mut self, articulation: &mut dyn Articulation, action: &[f64]) {
-        let x: Vec<f64> = action
-            .iter()
-            .enumerate()
-            .map(|(i, &a)| self.bounds.to_physical(i, a))
-            .collect();
-        let yaw = articulation.qpos()[self.joint_indices[2]];
-        let (s, c) = yaw.sin_cos();
+        let x = self.joints.bounds().to_physical_all(action);
+        let (s, c) = self.yaw(articulation).sin_cos();
         let mut v = x.clone();
         v[0] = c * x[0] - s * x[1];
         v[1] = s * x[0] + c * x[1];
-        articulation.set_drive_velocity_targets(&self.joint_indices, &v);
+        self.joints.set_velocity_targets(articulation, v);
     }
     fn position_targets(&self) -> Option<Vec<f64>> {
         None
@@ -116,38 +108,17 @@ impl PartController for BaseVelocityController {
         articulation: &dyn Articulation,
         joint_targets: &[f64],
     ) -> PartConversion {
-        let q = gather(&articulation.qpos(), &self.joint_indices);
-        let world: Vec<f64> = (0..q.len())
-            .map(|j| (joint_targets[j] - q[j]) / self.control_period_s)
-            .collect();
-        let (s, c) = q[2].sin_cos();
+        let world = self.joints.velocities_to_reach(articulation, joint_targets);
+        let (s, c) = self.yaw(articulation).sin_cos();
         let mut ego = world.clone();
         ego[0] = c * world[0] + s * world[1];
         ego[1] = -s * world[0] + c * world[1];
-        let mut saturated = false;
-        let action = ego
-            .iter()
-            .enumerate()
-            .map(|(i, &x)| {
-                let (a, sat) = self.bounds.to_user(i, x);
-                saturated |= sat;
-                a
-            })
-            .collect();
-        PartConversion { action, saturated }
+        PartConversion::from_physical(self.joints.bounds(), &ego)
     }
     fn state(&self) -> Vec<f64> {
-        Vec::new()
+        self.joints.state()
     }
     fn set_state(&mut self, state: &[f64]) -> Result<(), String> {
-        if state.is_empty() {
-            Ok(())
-        } else {
-            Err(format!(
-                "{}: stateless controller got {} state values",
-                self.config.name,
-                state.len()
-            ))
-        }
+        self.joints.set_state(state)
     }
 }

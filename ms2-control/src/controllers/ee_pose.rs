@@ -5,8 +5,9 @@ use std::sync::Arc;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
+use super::position_targets::PositionTargets;
 use super::{
-    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+    action_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
 };
 use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
@@ -160,11 +161,8 @@ pub struct EePoseController {
     driven_in_chain: Vec<usize>,
     joint_indices: Vec<usize>,
     bounds: ActionBounds,
-    substeps: usize,
     target_pose: Isometry3<f64>,
-    target_qpos: Vec<f64>,
-    start_qpos: Vec<f64>,
-    substep: usize,
+    targets: PositionTargets,
     last_ik: Option<IkReport>,
 }
 
@@ -209,7 +207,7 @@ impl EePoseController {
             low.extend([-config.rot_bound; 3]);
             high.extend([config.rot_bound; 3]);
         }
-        check_bounds(name, &low, &high)?;
+        let bounds = action_bounds(name, low, high, config.normalize_action)?;
         if let EeIkSolver::Qp(QpIkOptions {
             max_displacement_from_seed: Some(d),
             ..
@@ -226,11 +224,6 @@ impl EePoseController {
                 });
             }
         }
-        let scaling = if config.normalize_action {
-            ActionScaling::Normalized
-        } else {
-            ActionScaling::Physical
-        };
         let n = joint_indices.len();
         Ok(Self {
             config: config.clone(),
@@ -240,12 +233,9 @@ impl EePoseController {
             free,
             driven_in_chain,
             joint_indices,
-            bounds: ActionBounds { low, high, scaling },
-            substeps: ctx.timing.substeps(),
+            bounds,
             target_pose: Isometry3::identity(),
-            target_qpos: vec![0.0; n],
-            start_qpos: vec![0.0; n],
-            substep: 0,
+            targets: PositionTargets::new(n, ctx.timing.substeps(), config.interpolate),
             last_ik: None,
         })
     }
@@ -328,24 +318,15 @@ impl PartController for EePoseController {
     }
 
     fn reset(&mut self, articulation: &mut dyn Articulation) {
-        let qpos = articulation.qpos();
-        self.target_pose = self
-            .chain
-            .fk_unchecked(&gather(&qpos, &self.chain_to_articulation));
-        self.target_qpos = gather(&qpos, &self.joint_indices);
-        self.start_qpos = self.target_qpos.clone();
-        self.substep = 0;
+        self.target_pose = self.ee_pose_in_base(articulation);
         self.last_ik = None;
-        articulation.set_drive_position_targets(&self.joint_indices, &self.target_qpos);
-        articulation
-            .set_drive_velocity_targets(&self.joint_indices, &vec![0.0; self.joint_indices.len()]);
+        self.targets.reset(articulation, &self.joint_indices);
     }
 
     fn set_action(&mut self, articulation: &mut dyn Articulation, action: &[f64]) {
         let qpos = articulation.qpos();
         let seed = gather(&qpos, &self.chain_to_articulation);
-        self.start_qpos = gather(&qpos, &self.joint_indices);
-        self.substep = 0;
+        self.targets.begin_step(&qpos, &self.joint_indices);
         let prev = if self.config.use_target {
             self.target_pose
         } else {
@@ -375,28 +356,20 @@ impl PartController for EePoseController {
                 }
             }
         };
-        self.target_qpos = match chain_q {
+        self.targets.target = match chain_q {
             Some(q) => self.driven_in_chain.iter().map(|&c| q[c]).collect(),
-            None => self.start_qpos.clone(),
+            None => self.targets.start.clone(),
         };
-        if !self.config.interpolate {
-            articulation.set_drive_position_targets(&self.joint_indices, &self.target_qpos);
-        }
+        self.targets.commit(articulation, &self.joint_indices);
     }
 
     fn before_substep(&mut self, articulation: &mut dyn Articulation) {
-        if self.config.interpolate {
-            self.substep = (self.substep + 1).min(self.substeps);
-            let s = self.substep as f64 / self.substeps as f64;
-            let ramp: Vec<f64> = (0..self.joint_indices.len())
-                .map(|j| self.start_qpos[j] + (self.target_qpos[j] - self.start_qpos[j]) * s)
-                .collect();
-            articulation.set_drive_position_targets(&self.joint_indices, &ramp);
-        }
+        self.targets
+            .before_substep(articulation, &self.joint_indices);
     }
 
     fn position_targets(&self) -> Option<Vec<f64>> {
-        Some(self.target_qpos.clone())
+        Some(self.targets.target.clone())
     }
 
     /// `T̄ = FK(q̄)`, then the delta that maps the previous pose (current, or the previous target
@@ -428,14 +401,10 @@ impl PartController for EePoseController {
                 UnitQuaternion::identity(),
             )
         };
-        let mut saturated = false;
-        let mut action: Vec<f64> = (0..3)
-            .map(|i| {
-                let (a, s) = self.bounds.to_user(i, dp[i]);
-                saturated |= s;
-                a
-            })
-            .collect();
+        let PartConversion {
+            mut action,
+            mut saturated,
+        } = PartConversion::from_physical(&self.bounds, dp.as_slice());
         if self.config.control_rotation {
             let mut r = dr.scaled_axis();
             let norm = r.norm();

@@ -1,10 +1,11 @@
 //! PD joint position control: `pd_joint_pos`, `pd_joint_delta_pos`, `pd_joint_target_delta_pos`,
 //! `pd_joint_pos_vel`, `pd_joint_delta_pos_vel` and the mimic gripper.
 
+use super::position_targets::PositionTargets;
 use super::{
-    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+    action_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
 };
-use crate::action::{ActionBounds, ActionScaling};
+use crate::action::ActionBounds;
 use crate::articulation::{Articulation, DriveGains};
 
 /// Configuration of a [`JointPositionController`].
@@ -45,11 +46,8 @@ pub struct JointPositionController {
     bounds: ActionBounds,
     /// Number of position entries in the action (1 for mimic).
     position_dim: usize,
-    substeps: usize,
-    target_qpos: Vec<f64>,
+    targets: PositionTargets,
     target_qvel: Vec<f64>,
-    start_qpos: Vec<f64>,
-    substep: usize,
 }
 
 impl JointPositionController {
@@ -105,31 +103,15 @@ impl JointPositionController {
             low.extend(std::iter::repeat_n(vlo, n));
             high.extend(std::iter::repeat_n(vhi, n));
         }
-        check_bounds(name, &low, &high)?;
-        let scaling = if config.normalize_action {
-            ActionScaling::Normalized
-        } else {
-            ActionScaling::Physical
-        };
+        let bounds = action_bounds(name, low, high, config.normalize_action)?;
         Ok(Self {
             config: config.clone(),
             joint_indices,
-            bounds: ActionBounds { low, high, scaling },
+            bounds,
             position_dim,
-            substeps: ctx.timing.substeps(),
-            target_qpos: vec![0.0; n],
+            targets: PositionTargets::new(n, ctx.timing.substeps(), config.interpolate),
             target_qvel: vec![0.0; n],
-            start_qpos: vec![0.0; n],
-            substep: 0,
         })
-    }
-
-    fn physical(&self, action: &[f64]) -> Vec<f64> {
-        action
-            .iter()
-            .enumerate()
-            .map(|(i, &a)| self.bounds.to_physical(i, a))
-            .collect()
     }
 }
 
@@ -151,36 +133,30 @@ impl PartController for JointPositionController {
     }
 
     fn reset(&mut self, articulation: &mut dyn Articulation) {
-        let q = gather(&articulation.qpos(), &self.joint_indices);
-        self.start_qpos = q.clone();
-        self.target_qpos = q;
+        self.targets.reset(articulation, &self.joint_indices);
         self.target_qvel = vec![0.0; self.joint_indices.len()];
-        self.substep = 0;
-        articulation.set_drive_position_targets(&self.joint_indices, &self.target_qpos);
-        articulation.set_drive_velocity_targets(&self.joint_indices, &self.target_qvel);
     }
 
     fn set_action(&mut self, articulation: &mut dyn Articulation, action: &[f64]) {
-        let x = self.physical(action);
+        let x = self.bounds.to_physical_all(action);
         let n = self.joint_indices.len();
-        self.substep = 0;
-        self.start_qpos = gather(&articulation.qpos(), &self.joint_indices);
+        self.targets
+            .begin_step(&articulation.qpos(), &self.joint_indices);
         let position = &x[..self.position_dim];
+        let targets = &mut self.targets;
         for j in 0..n {
             let a = if self.config.mimic {
                 position[0]
             } else {
                 position[j]
             };
-            self.target_qpos[j] = match (self.config.use_delta, self.config.use_target) {
+            targets.target[j] = match (self.config.use_delta, self.config.use_target) {
                 (false, _) => a,
-                (true, false) => self.start_qpos[j] + a,
-                (true, true) => self.target_qpos[j] + a,
+                (true, false) => targets.start[j] + a,
+                (true, true) => targets.target[j] + a,
             };
         }
-        if !self.config.interpolate {
-            articulation.set_drive_position_targets(&self.joint_indices, &self.target_qpos);
-        }
+        self.targets.commit(articulation, &self.joint_indices);
         if self.config.velocity_bounds.is_some() {
             self.target_qvel = x[self.position_dim..].to_vec();
             articulation.set_drive_velocity_targets(&self.joint_indices, &self.target_qvel);
@@ -188,18 +164,12 @@ impl PartController for JointPositionController {
     }
 
     fn before_substep(&mut self, articulation: &mut dyn Articulation) {
-        if self.config.interpolate {
-            self.substep = (self.substep + 1).min(self.substeps);
-            let s = self.substep as f64 / self.substeps as f64;
-            let ramp: Vec<f64> = (0..self.joint_indices.len())
-                .map(|j| self.start_qpos[j] + (self.target_qpos[j] - self.start_qpos[j]) * s)
-                .collect();
-            articulation.set_drive_position_targets(&self.joint_indices, &ramp);
-        }
+        self.targets
+            .before_substep(articulation, &self.joint_indices);
     }
 
     fn position_targets(&self) -> Option<Vec<f64>> {
-        Some(self.target_qpos.clone())
+        Some(self.targets.target.clone())
     }
 
     fn action_for_joint_targets(
@@ -212,28 +182,18 @@ impl PartController for JointPositionController {
             .map(|j| match (self.config.use_delta, self.config.use_target) {
                 (false, _) => joint_targets[j],
                 (true, false) => joint_targets[j] - q[j],
-                (true, true) => joint_targets[j] - self.target_qpos[j],
+                (true, true) => joint_targets[j] - self.targets.target[j],
             })
             .collect();
         if self.config.velocity_bounds.is_some() {
             physical.extend(std::iter::repeat_n(0.0, self.joint_indices.len()));
         }
-        let mut saturated = false;
-        let action = physical
-            .iter()
-            .enumerate()
-            .map(|(i, &x)| {
-                let (a, s) = self.bounds.to_user(i, x);
-                saturated |= s;
-                a
-            })
-            .collect();
-        PartConversion { action, saturated }
+        PartConversion::from_physical(&self.bounds, &physical)
     }
 
     fn state(&self) -> Vec<f64> {
         if self.config.use_target {
-            self.target_qpos.clone()
+            self.targets.target.clone()
         } else {
             Vec::new()
         }
@@ -249,7 +209,7 @@ impl PartController for JointPositionController {
             ));
         }
         if self.config.use_target {
-            self.target_qpos = state.to_vec();
+            self.targets.target = state.to_vec();
         }
         Ok(())
     }

@@ -1,9 +1,9 @@
 //! PD joint velocity control: `pd_joint_vel` (stiffness 0, velocity targets).
 
 use super::{
-    check_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+    action_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
 };
-use crate::action::{ActionBounds, ActionScaling};
+use crate::action::ActionBounds;
 use crate::articulation::{Articulation, DriveGains};
 
 /// Configuration of a [`JointVelocityController`].
@@ -42,16 +42,11 @@ impl JointVelocityController {
         let n = joint_indices.len();
         let low = per_joint(&config.name, "lower", &config.lower, n)?;
         let high = per_joint(&config.name, "upper", &config.upper, n)?;
-        check_bounds(&config.name, &low, &high)?;
-        let scaling = if config.normalize_action {
-            ActionScaling::Normalized
-        } else {
-            ActionScaling::Physical
-        };
+        let bounds = action_bounds(&config.name, low, high, config.normalize_action)?;
         Ok(Self {
             config: config.clone(),
             joint_indices,
-            bounds: ActionBounds { low, high, scaling },
+            bounds,
             control_period_s: ctx.timing.control_period_s(),
             target_qvel: vec![0.0; n],
         })
@@ -60,6 +55,28 @@ impl JointVelocityController {
     /// Current velocity targets (rad/s or m/s).
     pub fn velocity_targets(&self) -> &[f64] {
         &self.target_qvel
+    }
+
+    /// Sets the velocity targets (rad/s or m/s, physical, not clipped) of the driven joints.
+    pub(crate) fn set_velocity_targets(
+        &mut self,
+        articulation: &mut dyn Articulation,
+        velocities: Vec<f64>,
+    ) {
+        self.target_qvel = velocities;
+        articulation.set_drive_velocity_targets(&self.joint_indices, &self.target_qvel);
+    }
+
+    /// The constant joint velocities (rad/s or m/s) that cover `q̄ − q` in one control period.
+    pub(crate) fn velocities_to_reach(
+        &self,
+        articulation: &dyn Articulation,
+        joint_targets: &[f64],
+    ) -> Vec<f64> {
+        let q = gather(&articulation.qpos(), &self.joint_indices);
+        (0..q.len())
+            .map(|j| (joint_targets[j] - q[j]) / self.control_period_s)
+            .collect()
     }
 }
 
@@ -84,16 +101,11 @@ impl PartController for JointVelocityController {
         ]
     }
     fn reset(&mut self, articulation: &mut dyn Articulation) {
-        self.target_qvel = vec![0.0; self.joint_indices.len()];
-        articulation.set_drive_velocity_targets(&self.joint_indices, &self.target_qvel);
+        self.set_velocity_targets(articulation, vec![0.0; self.joint_indices.len()]);
     }
     fn set_action(&mut self, articulation: &mut dyn Articulation, action: &[f64]) {
-        self.target_qvel = action
-            .iter()
-            .enumerate()
-            .map(|(i, &a)| self.bounds.to_physical(i, a))
-            .collect();
-        articulation.set_drive_velocity_targets(&self.joint_indices, &self.target_qvel);
+        let velocities = self.bounds.to_physical_all(action);
+        self.set_velocity_targets(articulation, velocities);
     }
     fn position_targets(&self) -> Option<Vec<f64>> {
         None
@@ -104,18 +116,8 @@ impl PartController for JointVelocityController {
         articulation: &dyn Articulation,
         joint_targets: &[f64],
     ) -> PartConversion {
-        let q = gather(&articulation.qpos(), &self.joint_indices);
-        let mut saturated = false;
-        let action = (0..q.len())
-            .map(|j| {
-                let (a, s) = self
-                    .bounds
-                    .to_user(j, (joint_targets[j] - q[j]) / self.control_period_s);
-                saturated |= s;
-                a
-            })
-            .collect();
-        PartConversion { action, saturated }
+        let velocities = self.velocities_to_reach(articulation, joint_targets);
+        PartConversion::from_physical(&self.bounds, &velocities)
     }
     fn state(&self) -> Vec<f64> {
         Vec::new()

@@ -8,6 +8,7 @@ mod base_velocity;
 mod ee_pose;
 mod joint_position;
 mod joint_velocity;
+mod position_targets;
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -17,7 +18,7 @@ pub use ee_pose::{EeFrame, EeIkSolver, EePoseConfig, EePoseController, IkFailure
 pub use joint_position::{JointPositionConfig, JointPositionController};
 pub use joint_velocity::{JointVelocityConfig, JointVelocityController};
 
-use crate::action::ActionBounds;
+use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
 use crate::kinematics::{KinematicModel, KinematicsError};
 
@@ -130,6 +131,24 @@ pub struct PartConversion {
     pub action: Vec<f64>,
     /// Whether the exact action lay outside the action space and was clipped.
     pub saturated: bool,
+}
+
+impl PartConversion {
+    /// The user-facing action for physical action entries `0..physical.len()` of `bounds`,
+    /// clipped into the action space; `saturated` if any entry was clipped.
+    pub(crate) fn from_physical(bounds: &ActionBounds, physical: &[f64]) -> Self {
+        let mut saturated = false;
+        let action = physical
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| {
+                let (a, clipped) = bounds.to_user(i, x);
+                saturated |= clipped;
+                a
+            })
+            .collect();
+        Self { action, saturated }
+    }
 }
 
 /// A controller of one robot part.
@@ -245,9 +264,15 @@ pub(crate) fn per_joint(
     }
 }
 
-/// Checks that every action bound is finite with `low < high`.
-pub(crate) fn check_bounds(controller: &str, low: &[f64], high: &[f64]) -> Result<(), BuildError> {
-    for (i, (&lo, &hi)) in low.iter().zip(high).enumerate() {
+/// The action bounds `[low, high]` (physical units), normalised to `[-1, 1]` or not, after
+/// checking that every bound is finite with `low < high`.
+pub(crate) fn action_bounds(
+    controller: &str,
+    low: Vec<f64>,
+    high: Vec<f64>,
+    normalize_action: bool,
+) -> Result<ActionBounds, BuildError> {
+    for (i, (&lo, &hi)) in low.iter().zip(&high).enumerate() {
         if !lo.is_finite() || !hi.is_finite() || lo >= hi {
             return Err(BuildError::BadConfig {
                 controller: controller.to_string(),
@@ -257,5 +282,10 @@ pub(crate) fn check_bounds(controller: &str, low: &[f64], high: &[f64]) -> Resul
             });
         }
     }
-    Ok(())
+    let scaling = if normalize_action {
+        ActionScaling::Normalized
+    } else {
+        ActionScaling::Physical
+    };
+    Ok(ActionBounds { low, high, scaling })
 }

@@ -138,6 +138,18 @@ trait StepRule {
     ) -> Result<Vec<f64>, IkError>;
 }
 
+/// Checks that an optional per-joint vector (free-joint mask, displacement bound) has one entry
+/// per chain joint.
+fn check_per_joint_len<T>(chain: &KinematicChain, values: Option<&[T]>) -> Result<(), IkError> {
+    match values {
+        Some(v) if v.len() != chain.dof() => Err(IkError::WrongMaskLength {
+            expected: chain.dof(),
+            got: v.len(),
+        }),
+        _ => Ok(()),
+    }
+}
+
 fn check_inputs(
     chain: &KinematicChain,
     target: &Isometry3<f64>,
@@ -150,15 +162,7 @@ fn check_inputs(
         return Err(IkError::NonFiniteTarget(*target));
     }
     chain.forward_kinematics(seed)?;
-    if let Some(mask) = free {
-        if mask.len() != chain.dof() {
-            return Err(IkError::WrongMaskLength {
-                expected: chain.dof(),
-                got: mask.len(),
-            });
-        }
-    }
-    Ok(())
+    check_per_joint_len(chain, free)
 }
 
 /// One attempt from `start` with Levenberg-Marquardt step acceptance: a step that does not
@@ -273,6 +277,7 @@ fn solve_with(
     step_limit: Option<&[f64]>,
     rule: &mut dyn StepRule,
 ) -> Result<IkSolution, IkError> {
+    check_per_joint_len(chain, step_limit)?;
     check_inputs(chain, target, seed, free)?;
     let n = chain.dof();
     let free_idx: Vec<usize> = (0..n).filter(|&j| free.is_none_or(|m| m[j])).collect();
@@ -570,14 +575,6 @@ impl QpIk {
         seed: &[f64],
         free: Option<&[bool]>,
     ) -> Result<IkSolution, IkError> {
-        if let Some(d) = &self.options.max_displacement_from_seed {
-            if d.len() != chain.dof() {
-                return Err(IkError::WrongMaskLength {
-                    expected: chain.dof(),
-                    got: d.len(),
-                });
-            }
-        }
         solve_with(
             chain,
             target,

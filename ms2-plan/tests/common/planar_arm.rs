@@ -1,9 +1,10 @@
 //! A planar 3R arm implementing `PlanningRobot`: joints about z, links along x, capsules of
 //! radius 0.03 m at height 0 of the base frame. Closed-form IK for poses in the plane.
-//! Shared by the tests and the `custom_robot` example.
+//! Also a wall scene with a start and goal on either side of it. Shared by the tests, the
+//! benchmarks and the `custom_robot` example.
 
 use ms2_plan::parry3d::shape::SharedShape;
-use ms2_plan::{CollisionLink, JointLimits, LinkShape, PlanError, PlanningRobot};
+use ms2_plan::{CollisionLink, CollisionScene, JointLimits, LinkShape, PlanError, PlanningRobot};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 /// Link lengths (m).
@@ -149,3 +150,22 @@ impl PlanningRobot for PlanarArm {
 pub fn planar_pose(x: f64, y: f64, yaw: f64) -> Isometry3<f64> {
     planar(x, y, yaw)
 }
+
+/// A wall the arm must swing around: a box at x ≈ 0.55 m between y = 0.25 and 0.75 m.
+pub fn wall_scene() -> CollisionScene {
+    let mut scene = CollisionScene::new();
+    scene
+        .add_box(
+            "wall",
+            Vector3::new(0.1, 0.5, 0.2),
+            Isometry3::translation(0.55, 0.5, 0.0),
+        )
+        .expect("a fresh scene takes any box");
+    scene
+}
+
+/// A start configuration (rad) on one side of the wall of [`wall_scene`].
+pub const START: [f64; 3] = [-0.3, 0.2, 0.1];
+/// A goal configuration (rad) on the other side of the wall of [`wall_scene`]: the straight
+/// joint-space motion from [`START`] goes through the wall.
+pub const GOAL: [f64; 3] = [1.6, -0.3, 0.2];

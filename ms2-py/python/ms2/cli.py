@@ -6,6 +6,11 @@ Subcommands:
 * ``ms2 run PickCube-v0 --policy scripted|random --episodes 20`` — run episodes and print the
   success rate and env steps/s.
 * ``ms2 bench`` — env steps/s and peak memory of a single env and of ``make_vec`` with 1-16 envs.
+* ``ms2 demos generate PickCube-v0 -n 100 -o demos/PickCube-v0.h5 --workers 2`` — write
+  successful ``pd_joint_pos`` demonstrations (ManiSkill2's trajectory layout).
+* ``ms2 demos bench PickCube-v0 -n 20`` — seconds per generated demo and per converted episode.
+* ``ms2 replay --traj-path X.h5 [--obs-mode M] [--target-control-mode C] ...`` — replay or
+  convert a trajectory file, writing ``X.<obs_mode>.<control_mode>.h5``.
 """
 
 from __future__ import annotations
@@ -93,6 +98,149 @@ def _add_run_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_cmd_run)
 
 
+def _cmd_demos_generate(args: argparse.Namespace) -> int:
+    from . import demos
+
+    result = demos.generate(
+        args.env_id,
+        args.num_episodes,
+        args.output,
+        num_workers=args.workers,
+        seed=args.seed,
+        max_seeds=args.max_seeds,
+        policy=args.policy,
+        progress=not args.quiet,
+    )
+    print(
+        f"wrote {result.num_episodes} {args.env_id} episodes to {result.path} "
+        f"({result.seeds_tried} seeds tried, {result.planner_errors} planner errors) in "
+        f"{result.seconds:.1f} s = {result.seconds_per_episode:.3f} s per demo "
+        f"with {args.workers} workers"
+    )
+    return 0
+
+
+def _cmd_demos_bench(args: argparse.Namespace) -> int:
+    import tempfile
+    from pathlib import Path
+
+    from . import demos
+
+    targets = args.target_control_modes.split(",")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / f"{args.env_id}.h5"
+        gen = demos.generate(
+            args.env_id,
+            args.num_episodes,
+            path,
+            num_workers=args.workers,
+            policy=args.policy,
+            progress=False,
+        )
+        print(
+            f"{args.env_id}: {gen.seconds_per_episode:.3f} s per generated demo "
+            f"({args.policy}, {gen.num_episodes} demos, {gen.seeds_tried} seeds, "
+            f"{args.workers} workers)"
+        )
+        for target in targets:
+            rep = demos.replay(
+                path,
+                target_control_mode=target,
+                num_workers=args.workers,
+                max_retry=args.max_retry,
+                progress=False,
+            )
+            print(
+                f"  -> {target:<26} {rep.num_succeeded}/{rep.num_episodes} converted "
+                f"successfully ({100 * rep.success_rate:.1f} %), "
+                f"{rep.seconds_per_episode:.3f} s per converted episode"
+            )
+    return 0
+
+
+def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("demos", help="generate demonstrations (trajectory files)")
+    demos_sub = p.add_subparsers(dest="demos_command", required=True)
+    g = demos_sub.add_parser("generate", help="write successful pd_joint_pos demonstrations")
+    g.add_argument("env_id", help="task id, e.g. PickCube-v0")
+    g.add_argument("-n", "--num-episodes", type=int, default=100)
+    g.add_argument("-o", "--output", required=True, help="output .h5 (its .json is written too)")
+    g.add_argument("--workers", type=int, default=1, help="native worker threads")
+    g.add_argument("--seed", type=int, default=0, help="first episode seed (then +1 each)")
+    g.add_argument("--max-seeds", type=int, default=None, help="give up after this many seeds")
+    g.add_argument(
+        "--policy",
+        choices=["solution", "scripted"],
+        default="solution",
+        help="motion-planning solution (default) or the scripted oracle",
+    )
+    g.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    g.set_defaults(func=_cmd_demos_generate)
+    b = demos_sub.add_parser("bench", help="seconds per generated demo and per converted episode")
+    b.add_argument("env_id", nargs="?", default="PickCube-v0")
+    b.add_argument("-n", "--num-episodes", type=int, default=20)
+    b.add_argument("--workers", type=int, default=1)
+    b.add_argument("--policy", choices=["solution", "scripted"], default="solution")
+    b.add_argument("--max-retry", type=int, default=0)
+    b.add_argument(
+        "--target-control-modes",
+        default="pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos",
+        help="comma-separated target modes",
+    )
+    b.set_defaults(func=_cmd_demos_bench)
+
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    from . import demos
+
+    result = demos.replay(
+        args.traj_path,
+        obs_mode=args.obs_mode,
+        target_control_mode=args.target_control_mode,
+        use_env_states=args.use_env_states,
+        save_traj=args.save_traj,
+        save_video=args.save_video,
+        num_workers=args.num_workers,
+        max_retry=args.max_retry,
+        allow_failure=args.allow_failure,
+        count=args.count,
+        progress=not args.quiet,
+    )
+    print(
+        f"replayed {result.num_episodes} episodes: {result.num_succeeded} succeeded "
+        f"({100 * result.success_rate:.1f} %) in {result.seconds:.1f} s = "
+        f"{result.seconds_per_episode:.3f} s per episode"
+    )
+    if result.failed_episode_ids:
+        kept = "kept (--allow-failure)" if args.allow_failure else "not saved"
+        print(f"failed episode ids ({kept}): {result.failed_episode_ids}")
+    if result.output is not None:
+        print(f"wrote {result.output}")
+    for video in result.videos:
+        print(f"wrote {video}")
+    return 0
+
+
+def _add_replay_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("replay", help="replay / convert a trajectory file")
+    p.add_argument("--traj-path", required=True, help="the X.h5 to replay (with X.json)")
+    p.add_argument("-o", "--obs-mode", default=None, help="record observations of this mode")
+    p.add_argument(
+        "-c", "--target-control-mode", default=None, help="convert actions to this control mode"
+    )
+    p.add_argument("--use-env-states", action="store_true", help="restore the recorded states")
+    p.add_argument("--save-traj", action="store_true", help="write X.<obs_mode>.<control_mode>.h5")
+    p.add_argument("--save-video", action="store_true", help="write one MP4 per episode")
+    p.add_argument("--num-workers", type=int, default=1, help="native worker threads")
+    p.add_argument("--max-retry", type=int, default=0, help="retries of a failed conversion")
+    p.add_argument(
+        "--allow-failure", action="store_true", help="also save episodes that do not succeed"
+    )
+    p.add_argument("--count", type=int, default=None, help="replay only the first N episodes")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_replay)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Runs the ``ms2`` command line with ``argv`` (default: ``sys.argv[1:]``)."""
     from . import bench
@@ -103,10 +251,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     p_envs.set_defaults(func=_cmd_envs)
     _add_run_parser(sub)
     bench.add_parser(sub)
+    _add_demos_parser(sub)
+    _add_replay_parser(sub)
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))
-    except (ValueError, RuntimeError) as err:
+    except (ValueError, RuntimeError, FileNotFoundError) as err:
         print(f"ms2 {args.command}: error: {err}", file=sys.stderr)
         return 2
 

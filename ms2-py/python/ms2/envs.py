@@ -39,6 +39,12 @@ class Ms2Env(gym.Env):
         control_freq: env step frequency in Hz (20 by default); ``sim_freq`` must be a multiple.
         max_episode_steps: episode limit in env steps after which ``truncated`` is set;
             ``None`` = the task's default (200).
+        camera_cfgs: changes to the observation cameras of the visual obs modes, as ManiSkill2's
+            keyword: ``{"width": 64, "height": 64, "fov": 1.2}`` sets fields of every camera,
+            ``{"base_camera": {"p": [..], "q": [..]}}`` of one camera (fields: ``width``,
+            ``height``, ``fov`` (vertical, radians), ``near``, ``far`` (m), ``p``, ``q`` (pose
+            in the mount's frame, quaternion wxyz)). Unknown keys or bad values raise
+            ``ValueError``.
 
     Unknown ids or modes raise ``ValueError`` listing the valid ones.
     """
@@ -55,6 +61,7 @@ class Ms2Env(gym.Env):
         sim_freq: float = 500.0,
         control_freq: float = 20.0,
         max_episode_steps: int | None = None,
+        camera_cfgs: dict[str, Any] | None = None,
     ) -> None:
         self._native = _native.NativeEnv(
             env_id,
@@ -65,6 +72,7 @@ class Ms2Env(gym.Env):
             sim_freq=float(sim_freq),
             control_freq=float(control_freq),
             max_episode_steps=max_episode_steps,
+            camera_cfgs=camera_cfgs,
         )
         config = self._native.config()
         self.env_id: str = config["env_id"]

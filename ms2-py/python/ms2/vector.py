@@ -42,6 +42,7 @@ class Ms2VectorEnv(VectorEnv):
         sim_freq: float = 500.0,
         control_freq: float = 20.0,
         max_episode_steps: int | None = None,
+        camera_cfgs: dict[str, Any] | None = None,
     ) -> None:
         if int(num_envs) < 1:
             raise ValueError(f"num_envs must be at least 1, got {num_envs}")
@@ -55,6 +56,7 @@ class Ms2VectorEnv(VectorEnv):
             sim_freq=float(sim_freq),
             control_freq=float(control_freq),
             max_episode_steps=max_episode_steps,
+            camera_cfgs=camera_cfgs,
         )
         config = self._native.config()
         self.env_id: str = config["env_id"]
@@ -127,6 +129,8 @@ def make_vec(env_id: str, num_envs: int = 1, **kwargs: Any) -> Ms2VectorEnv:
     """A vector env of ``num_envs`` copies of ``env_id`` stepped in parallel in native threads.
 
     Keyword arguments are those of ``gymnasium.make`` for ms2 (``obs_mode``, ``control_mode``,
-    ``reward_mode``, ``render_mode``, ``sim_freq``, ``control_freq``, ``max_episode_steps``).
+    ``reward_mode``, ``render_mode``, ``sim_freq``, ``control_freq``, ``max_episode_steps``,
+    ``camera_cfgs``). In visual obs modes every env's cameras render in one batch per step
+    (one GPU submission through the process's shared renderer).
     """
     return Ms2VectorEnv(env_id, num_envs=num_envs, **kwargs)

@@ -5,17 +5,23 @@
 //! - [`Sensors`]: one env's render scene (an [`WorldRenderScene`] of its world), its cameras
 //!   and the goal marker drawn only in human renders; it renders through the process-wide
 //!   [`RenderContext`].
+//! - [`camera_update`]: [`CameraCfgUpdates`], ManiSkill2's `camera_cfgs` keyword.
+//! - [`batch`]: [`capture_batch`], the cameras of many envs in one GPU submission.
 
+pub mod batch;
 pub mod camera;
+pub mod camera_update;
 pub mod visual_obs;
 
 use std::sync::Arc;
 
 use ms2_physics::{ArticulationId, World};
-use ms2_render::{CameraOutput, Instance, InstanceId, Material, SegmentationIds};
+use ms2_render::{Camera, CameraOutput, Instance, InstanceId, Material, Scene, SegmentationIds};
 use nalgebra::{Isometry3, Vector3};
 
+pub use batch::capture_batch;
 pub use camera::{look_at_robotics, CameraConfig, CameraMount};
+pub use camera_update::{CameraCfgUpdates, CameraUpdate, CAMERA_UPDATE_KEYS};
 pub use visual_obs::{CameraFrame, VisualLayout, NON_PRIVILEGED_EXTRA_KEYS};
 
 use crate::adapters::render_scene::render_err;
@@ -100,22 +106,43 @@ impl Sensors {
 
     /// Copies poses from `world` and renders every observation camera in one submission.
     pub fn capture(&mut self, world: &World) -> Result<CameraFrame, EnvError> {
-        self.scene.sync_poses(world)?;
-        let cams = self
-            .cameras
-            .iter()
-            .map(|c| c.camera_at(world, self.robot))
-            .collect::<Result<Vec<_>, _>>()?;
+        let cams = self.prepare(world)?;
         let outputs = self
             .ctx
             .renderer()
             .render(&[(self.scene.scene(), &cams[..])])
             .map_err(render_err)?;
-        Ok(CameraFrame {
+        Ok(self.frame(outputs))
+    }
+
+    /// Copies poses from `world` into the render scene and returns the observation cameras at
+    /// their current poses (in config order), ready to be drawn with [`Sensors::scene`] — alone
+    /// or batched with other envs' scenes ([`capture_batch`]).
+    pub fn prepare(&mut self, world: &World) -> Result<Vec<Camera>, EnvError> {
+        self.scene.sync_poses(world)?;
+        self.cameras
+            .iter()
+            .map(|c| c.camera_at(world, self.robot))
+            .collect()
+    }
+
+    /// The render scene as last synchronised by [`Sensors::prepare`].
+    pub fn scene(&self) -> &Scene {
+        self.scene.scene()
+    }
+
+    /// The shared render context this env draws through.
+    pub fn context(&self) -> &Arc<RenderContext> {
+        &self.ctx
+    }
+
+    /// Wraps the outputs of this env's observation cameras (config order) into a frame.
+    pub fn frame(&self, outputs: Vec<CameraOutput>) -> CameraFrame {
+        CameraFrame {
             uids: self.cameras.iter().map(|c| c.uid.clone()).collect(),
             outputs,
             robot_ids: self.robot_ids.clone(),
-        })
+        }
     }
 
     /// Renders the human view (render camera) with the goal marker at `goal_world` (m) when

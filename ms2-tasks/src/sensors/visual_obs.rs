@@ -75,10 +75,11 @@ pub fn non_privileged_state(state_dict: ObsValue) -> Vec<(String, ObsValue)> {
 }
 
 /// The full visual observation: `state_dict`'s non-privileged part plus the camera data in
-/// `layout`, with a robot mask when `robot_seg`.
+/// `layout`, with a robot mask when `robot_seg`. Takes the frame by value: its images move
+/// into the observation without copies.
 pub fn assemble(
     state_dict: ObsValue,
-    frame: &CameraFrame,
+    frame: CameraFrame,
     layout: VisualLayout,
     robot_seg: bool,
 ) -> ObsValue {
@@ -88,7 +89,7 @@ pub fn assemble(
         VisualLayout::Rgbd => {
             let mut params = Vec::with_capacity(frame.outputs.len());
             let mut images = Vec::with_capacity(frame.outputs.len());
-            for (uid, out) in frame.uids.iter().zip(&frame.outputs) {
+            for (uid, out) in frame.uids.iter().zip(frame.outputs) {
                 let (h, w) = (out.height() as usize, out.width() as usize);
                 params.push((
                     uid.clone(),
@@ -98,18 +99,18 @@ pub fn assemble(
                         ("intrinsic_cv".to_owned(), matrix_rows(&out.intrinsic_cv())),
                     ]),
                 ));
+                let mask = robot_seg.then(|| out.segmentation_link.iter().map(is_robot).collect());
                 let mut image = vec![
                     (
                         "rgb".to_owned(),
-                        array(vec![h, w, 3], ArrayData::U8(out.rgb.clone())),
+                        array(vec![h, w, 3], ArrayData::U8(out.rgb)),
                     ),
                     (
                         "depth".to_owned(),
-                        array(vec![h, w, 1], ArrayData::F32(out.depth_m.clone())),
+                        array(vec![h, w, 1], ArrayData::F32(out.depth_m)),
                     ),
                 ];
-                if robot_seg {
-                    let mask = out.segmentation_link.iter().map(is_robot).collect();
+                if let Some(mask) = mask {
                     image.push((
                         "robot_seg".to_owned(),
                         array(vec![h, w, 1], ArrayData::Bool(mask)),

@@ -1,0 +1,310 @@
+"""Demonstrations: generating trajectory files and replaying / converting them.
+
+* :func:`generate` — runs a demonstration source (the motion-planning solution, or the scripted
+  oracle) over seeds ``seed, seed + 1, ...`` on native worker threads, keeps the successful
+  episodes and writes them to ``X.h5`` + ``X.json`` (:mod:`ms2.trajectory`), committing after
+  every chunk of seeds so an interrupted run leaves a valid file of the episodes finished so far.
+* :func:`replay` — replays the episodes of a trajectory file from their seeds, optionally
+  restoring the recorded states, recording observations of any obs mode, converting the actions
+  closed-loop to another control mode (ManiSkill2 paper, Sec. 2.2), and writing the result to
+  ``X.<obs_mode>.<control_mode>.h5``.
+
+The simulation runs in Rust (``ms2._native.solve_episodes`` / ``scripted_episodes`` /
+``replay_episodes``) with the GIL released, on a pool of ``num_workers`` threads.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from . import _native
+from .trajectory import TrajectoryWriter, open_trajectory
+
+#: Control mode the demonstration sources produce.
+SOURCE_CONTROL_MODE = "pd_joint_pos"
+#: Demonstration sources of :func:`generate`.
+POLICIES = ("solution", "scripted")
+
+
+def _progress(total: int, desc: str, enabled: bool) -> Any:
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, desc=desc, unit="ep", disable=not enabled, dynamic_ncols=True)
+
+
+def _chunks(items: Sequence[Any], size: int) -> Iterator[Sequence[Any]]:
+    for start in range(0, len(items), size):
+        yield items[start : start + size]
+
+
+def _succeeded(episode: dict[str, Any]) -> bool:
+    """Whether an episode dict succeeds at its last step."""
+    success = episode["success"]
+    return len(success) > 0 and bool(success[-1])
+
+
+@dataclass
+class GenerateResult:
+    """What :func:`generate` did."""
+
+    path: Path
+    num_episodes: int
+    seeds_tried: int
+    planner_errors: int
+    seconds: float
+    failed_seeds: list[int] = field(default_factory=list)
+
+    @property
+    def seconds_per_episode(self) -> float:
+        """Wall-clock seconds per kept episode."""
+        return self.seconds / max(self.num_episodes, 1)
+
+
+def generate(
+    env_id: str,
+    num_episodes: int,
+    output: str | os.PathLike[str],
+    num_workers: int = 1,
+    seed: int = 0,
+    max_seeds: int | None = None,
+    policy: str = "solution",
+    chunk_size: int | None = None,
+    progress: bool = True,
+) -> GenerateResult:
+    """Writes ``num_episodes`` successful ``pd_joint_pos`` demonstrations of ``env_id`` to
+    ``output`` (``.h5``; the ``.json`` is written next to it).
+
+    Seeds ``seed, seed + 1, ...`` are tried in chunks of ``chunk_size`` (default
+    ``4 * num_workers``) until ``num_episodes`` succeed or ``max_seeds`` (default
+    ``4 * num_episodes + 20``) were tried; the file is committed after each chunk. ``policy`` is
+    ``"solution"`` (the motion-planning solution, see ``ms2._native.solution_env_ids()``) or
+    ``"scripted"`` (the scripted oracle). Raises ``ValueError`` for bad arguments or an env
+    without that policy; ``RuntimeError`` when fewer episodes than asked succeeded within
+    ``max_seeds`` (the file then holds those that did).
+    """
+    if num_episodes < 1:
+        raise ValueError(f"num_episodes must be at least 1, got {num_episodes}")
+    if num_workers < 1:
+        raise ValueError(f"num_workers must be at least 1, got {num_workers}")
+    if seed < 0:
+        raise ValueError(f"seed must be non-negative, got {seed}")
+    if policy not in POLICIES:
+        raise ValueError(f"unknown policy {policy!r}; valid: {list(POLICIES)}")
+    if policy == "solution" and env_id not in _native.solution_env_ids():
+        raise ValueError(
+            f"no motion-planning solution for {env_id!r}; envs with one: "
+            f"{sorted(_native.solution_env_ids())} (or use policy='scripted')"
+        )
+    max_seeds = 4 * num_episodes + 20 if max_seeds is None else max_seeds
+    chunk_size = chunk_size or 4 * num_workers
+    env_kwargs = {"obs_mode": "state", "control_mode": SOURCE_CONTROL_MODE}
+    run = _native.solve_episodes if policy == "solution" else _native.scripted_episodes
+    env_info = {
+        "env_id": env_id,
+        "max_episode_steps": int(_native.default_max_episode_steps(env_id)),
+        "env_kwargs": {**env_kwargs, "sim_freq": 500.0, "control_freq": 20.0},
+    }
+    started = time.perf_counter()
+    result = GenerateResult(Path(output), 0, 0, 0, 0.0)
+    with (
+        TrajectoryWriter(output, env_info) as writer,
+        _progress(num_episodes, f"{env_id} demos", progress) as bar,
+    ):
+        writer.commit()  # a valid (empty) file from the start
+        next_seed = seed
+        while result.num_episodes < num_episodes and result.seeds_tried < max_seeds:
+            # Whole chunks while many episodes remain; near the end, no more seeds than needed.
+            remaining = num_episodes - result.num_episodes
+            count = min(chunk_size, max(remaining, num_workers), max_seeds - result.seeds_tried)
+            seeds = list(range(next_seed, next_seed + count))
+            next_seed += count
+            result.seeds_tried += count
+            for episode in run(env_id, seeds, env_kwargs, num_workers):
+                if "error" in episode:
+                    result.planner_errors += 1
+                    result.failed_seeds.append(int(episode["episode_seed"]))
+                elif _succeeded(episode):
+                    if result.num_episodes == num_episodes:
+                        continue  # the chunk found more than needed
+                    writer.append(episode)
+                    result.num_episodes += 1
+                    bar.update(1)
+                else:
+                    result.failed_seeds.append(int(episode["episode_seed"]))
+            writer.commit()
+            bar.set_postfix(seeds=result.seeds_tried)
+    result.seconds = time.perf_counter() - started
+    if result.num_episodes < num_episodes:
+        raise RuntimeError(
+            f"only {result.num_episodes} of {num_episodes} {env_id} episodes succeeded within "
+            f"{result.seeds_tried} seeds ({result.path} holds them); raise max_seeds"
+        )
+    return result
+
+
+def replay_output_path(
+    traj_path: str | os.PathLike[str], obs_mode: str | None, control_mode: str
+) -> Path:
+    """ManiSkill2's name of a replayed copy: ``X.<obs_mode>.<control_mode>.h5`` (``none`` when
+    no observations are recorded)."""
+    path = Path(traj_path)
+    return path.with_name(f"{path.stem}.{obs_mode or 'none'}.{control_mode}.h5")
+
+
+@dataclass
+class ReplayResult:
+    """What :func:`replay` did."""
+
+    num_episodes: int
+    num_succeeded: int
+    seconds: float
+    output: Path | None
+    attempts: int
+    failed_episode_ids: list[int] = field(default_factory=list)
+    videos: list[Path] = field(default_factory=list)
+
+    @property
+    def success_rate(self) -> float:
+        return self.num_succeeded / max(self.num_episodes, 1)
+
+    @property
+    def seconds_per_episode(self) -> float:
+        return self.seconds / max(self.num_episodes, 1)
+
+
+def _write_video(env_id: str, env_kwargs: dict[str, Any], episode: dict[str, Any], path: Path):
+    """Renders each recorded state of ``episode`` (the human view) into an MP4 at ``path``."""
+    from .recording import write_video
+
+    env = _native.NativeEnv(
+        env_id,
+        obs_mode="state",
+        control_mode=episode["control_mode"],
+        render_mode="rgb_array",
+        sim_freq=float(env_kwargs.get("sim_freq", 500.0)),
+        control_freq=float(env_kwargs.get("control_freq", 20.0)),
+    )
+    env.reset(seed=int(episode["episode_seed"]))
+    frames = []
+    for state in episode["env_states"]:
+        env.set_state(state)
+        frames.append(env.render())
+    return write_video(path, frames, fps=float(env_kwargs.get("control_freq", 20.0)))
+
+
+def replay(
+    traj_path: str | os.PathLike[str],
+    obs_mode: str | None = None,
+    target_control_mode: str | None = None,
+    use_env_states: bool = False,
+    save_traj: bool = False,
+    save_video: bool = False,
+    num_workers: int = 1,
+    max_retry: int = 0,
+    allow_failure: bool = False,
+    count: int | None = None,
+    progress: bool = True,
+) -> ReplayResult:
+    """Replays (and optionally converts) the episodes of ``traj_path``.
+
+    Args:
+        traj_path: the ``X.h5`` to replay (with its ``X.json``).
+        obs_mode: record observations of this mode (``None``: none).
+        target_control_mode: convert the actions closed-loop to this mode (``None``: keep).
+        use_env_states: restore the recorded state after every step (no conversion).
+        save_traj: write ``X.<obs_mode>.<control_mode>.h5`` (+ ``.json``).
+        save_video: write one MP4 per episode to ``X.<obs_mode>.<control_mode>.videos/``.
+        num_workers: native worker threads.
+        max_retry: further attempts for a failed conversion.
+        allow_failure: also save episodes that do not succeed at their last step.
+        count: replay only the first ``count`` episodes.
+        progress: show a progress bar.
+    """
+    if num_workers < 1:
+        raise ValueError(f"num_workers must be at least 1, got {num_workers}")
+    if max_retry < 0:
+        raise ValueError(f"max_retry must be non-negative, got {max_retry}")
+    started = time.perf_counter()
+    with open_trajectory(traj_path) as traj:
+        episodes_meta = traj.episodes[: count if count is not None else len(traj.episodes)]
+        env_kwargs = dict(traj.env_info.get("env_kwargs") or {})
+        source_modes = {ep["control_mode"] for ep in episodes_meta} or {
+            env_kwargs.get("control_mode", SOURCE_CONTROL_MODE)
+        }
+        if target_control_mode is None and len(source_modes) > 1:
+            raise ValueError(
+                f"{traj_path}: episodes use several control modes {sorted(source_modes)}; pass "
+                "target_control_mode"
+            )
+        out_mode = target_control_mode or next(iter(source_modes))
+        native_kwargs = {
+            key: env_kwargs[key]
+            for key in ("reward_mode", "sim_freq", "control_freq")
+            if key in env_kwargs
+        }
+        native_kwargs["obs_mode"] = obs_mode or "state"
+        native_kwargs["max_episode_steps"] = traj.env_info.get("max_episode_steps")
+        output = replay_output_path(traj_path, obs_mode, out_mode)
+        if save_traj and output.resolve() == Path(traj_path).resolve():
+            raise ValueError(f"{traj_path}: the replayed copy would overwrite its source")
+        out_info = {
+            "env_id": traj.env_id,
+            "max_episode_steps": traj.env_info.get("max_episode_steps"),
+            "env_kwargs": {**env_kwargs, "obs_mode": obs_mode or "none", "control_mode": out_mode},
+        }
+        writer = TrajectoryWriter(output, out_info) if save_traj else None
+        result = ReplayResult(0, 0, 0.0, output if save_traj else None, 0)
+        indices = list(range(len(episodes_meta)))
+        try:
+            with _progress(len(indices), f"replay {traj.env_id}", progress) as bar:
+                for chunk in _chunks(indices, 4 * num_workers):
+                    sources = [traj.read_episode(i) for i in chunk]
+                    replayed = _native.replay_episodes(
+                        traj.env_id,
+                        sources,
+                        native_kwargs,
+                        target_control_mode,
+                        use_env_states,
+                        obs_mode is not None,
+                        max_retry,
+                        num_workers,
+                    )
+                    for source, episode in zip(sources, replayed, strict=True):
+                        result.num_episodes += 1
+                        result.attempts += int(episode["attempts"])
+                        ok = _succeeded(episode)
+                        result.num_succeeded += int(ok)
+                        if not ok:
+                            result.failed_episode_ids.append(int(source["episode_id"]))
+                        if ok or allow_failure:
+                            episode["reset_kwargs"] = source.get("reset_kwargs")
+                            if writer is not None:
+                                writer.append(episode, obs=episode.get("obs"))
+                            if save_video:
+                                video_dir = output.with_suffix(".videos")
+                                path = video_dir / f"traj_{source['episode_id']}.mp4"
+                                result.videos.append(
+                                    _write_video(traj.env_id, env_kwargs, episode, path)
+                                )
+                        bar.update(1)
+                    if writer is not None:
+                        writer.commit()
+        finally:
+            if writer is not None:
+                writer.close()
+    result.seconds = time.perf_counter() - started
+    return result
+
+
+__all__ = [
+    "GenerateResult",
+    "ReplayResult",
+    "generate",
+    "replay",
+    "replay_output_path",
+]

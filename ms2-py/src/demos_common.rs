@@ -1,0 +1,151 @@
+//! Helpers shared by the demonstration bindings (`demos_solve`, `demos_replay`): env configs
+//! from keyword dicts, episodes to/from Python dicts, and a sized rayon pool.
+
+use ms2_tasks::demos::{DemoEpisode, DemoError};
+use ms2_tasks::EnvConfig;
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::info_to_py;
+use crate::errors::{env_error_to_py, NativeError};
+
+/// The `env_kwargs` keys a demonstration env accepts (ManiSkill2's `gym.make` names).
+const ENV_KWARGS: [&str; 6] = [
+    "obs_mode",
+    "control_mode",
+    "reward_mode",
+    "sim_freq",
+    "control_freq",
+    "max_episode_steps",
+];
+
+/// The config of env `env_id` made with `kwargs` (a subset of [`ENV_KWARGS`]; `None` values take
+/// the defaults). Unknown keys raise `ValueError`.
+pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<EnvConfig> {
+    let mut cfg = EnvConfig::new(env_id);
+    let Some(kwargs) = kwargs else {
+        return Ok(cfg);
+    };
+    for (key, value) in kwargs.iter() {
+        let key: String = key.extract()?;
+        if value.is_none() {
+            continue;
+        }
+        match key.as_str() {
+            "obs_mode" => cfg.obs_mode = value.extract()?,
+            "control_mode" => cfg.control_mode = Some(value.extract()?),
+            "reward_mode" => cfg.reward_mode = Some(value.extract()?),
+            "sim_freq" => cfg.sim_freq = value.extract()?,
+            "control_freq" => cfg.control_freq = value.extract()?,
+            "max_episode_steps" => cfg.max_episode_steps = Some(value.extract()?),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "unknown env_kwargs key {other:?}; valid keys: {ENV_KWARGS:?}"
+                )))
+            }
+        }
+    }
+    Ok(cfg)
+}
+
+/// The Python exception for a [`DemoError`]: env errors as in `errors`, unsupported conversions,
+/// missing solutions and invalid episodes as `ValueError`, planning failures as `RuntimeError`.
+pub fn demo_error_to_py(err: &DemoError) -> PyErr {
+    match err {
+        DemoError::Env(env_err) => env_error_to_py(env_err),
+        DemoError::Planning { .. } => PyRuntimeError::new_err(err.to_string()),
+        _ => PyValueError::new_err(err.to_string()),
+    }
+}
+
+impl From<DemoError> for NativeError {
+    fn from(err: DemoError) -> Self {
+        match err {
+            DemoError::Env(env_err) => NativeError::Env(env_err),
+            other => NativeError::Input(other.to_string()),
+        }
+    }
+}
+
+/// Rows `[N][M]` as a float32 numpy array of shape `(N, width)` (`width` is used when `N == 0`).
+pub fn rows_to_py<'py>(
+    py: Python<'py>,
+    rows: &[Vec<f32>],
+    width: usize,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let width = rows.first().map_or(width, Vec::len);
+    if let Some((i, row)) = rows.iter().enumerate().find(|(_, r)| r.len() != width) {
+        return Err(PyValueError::new_err(format!(
+            "row {i} has {} elements, expected {width}",
+            row.len()
+        )));
+    }
+    let flat: Vec<f32> = rows.iter().flatten().copied().collect();
+    PyArray1::from_vec(py, flat).reshape([rows.len(), width])
+}
+
+/// A float32 `(N, M)` numpy array as rows.
+pub fn rows_from_py(array: &PyReadonlyArray2<'_, f32>) -> Vec<Vec<f32>> {
+    array
+        .as_array()
+        .rows()
+        .into_iter()
+        .map(|r| r.to_vec())
+        .collect()
+}
+
+/// An episode as the dict the Python side writes to trajectory files:
+/// `{"episode_seed", "control_mode", "actions" f32[T,A], "env_states" f32[T+1,S],
+/// "success" bool[T], "elapsed_steps", "info"}`.
+pub fn episode_to_py<'py>(py: Python<'py>, ep: &DemoEpisode) -> PyResult<Bound<'py, PyDict>> {
+    let dict = PyDict::new(py);
+    dict.set_item("env_id", &ep.env_id)?;
+    dict.set_item("episode_seed", ep.episode_seed)?;
+    dict.set_item("control_mode", &ep.control_mode)?;
+    dict.set_item("actions", rows_to_py(py, &ep.actions, 0)?)?;
+    let state_len = ep.env_states.first().map_or(0, Vec::len);
+    dict.set_item("env_states", rows_to_py(py, &ep.env_states, state_len)?)?;
+    dict.set_item("success", PyArray1::from_slice(py, &ep.success))?;
+    dict.set_item("elapsed_steps", ep.elapsed_steps)?;
+    dict.set_item("info", info_to_py(py, &ep.info)?)?;
+    Ok(dict)
+}
+
+/// An episode from a dict with the keys of [`episode_to_py`] (`info` is ignored: replay
+/// recomputes it). Arrays must be float32 / bool numpy arrays.
+pub fn episode_from_py(env_id: &str, dict: &Bound<'_, PyDict>) -> PyResult<DemoEpisode> {
+    let get = |key: &str| {
+        dict.get_item(key)?
+            .ok_or_else(|| PyValueError::new_err(format!("episode dict has no key {key:?}")))
+    };
+    let actions: PyReadonlyArray2<'_, f32> = get("actions")?.extract()?;
+    let env_states: PyReadonlyArray2<'_, f32> = get("env_states")?.extract()?;
+    let success: PyReadonlyArray1<'_, bool> = get("success")?.extract()?;
+    let actions = rows_from_py(&actions);
+    Ok(DemoEpisode {
+        env_id: env_id.to_owned(),
+        episode_seed: get("episode_seed")?.extract()?,
+        control_mode: get("control_mode")?.extract()?,
+        elapsed_steps: u32::try_from(actions.len()).unwrap_or(u32::MAX),
+        actions,
+        env_states: rows_from_py(&env_states),
+        success: success.as_array().to_vec(),
+        info: Vec::new(),
+    })
+}
+
+/// Runs `f` on a rayon pool of `num_workers` threads (at least 1).
+pub fn in_pool<T: Send>(
+    num_workers: usize,
+    f: impl FnOnce() -> T + Send,
+) -> Result<T, NativeError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(num_workers.max(1))
+        .build()
+        .map_err(|e| {
+            NativeError::Input(format!("cannot start {num_workers} worker threads: {e}"))
+        })?;
+    Ok(pool.install(f))
+}

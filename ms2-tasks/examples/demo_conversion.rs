@@ -1,0 +1,134 @@
+//! Demonstration conversion rates and cost: records `pd_joint_pos` source episodes (the
+//! motion-planning solution when the env has one, else the scripted oracle), keeps the
+//! successful ones and converts each to the target control modes with
+//! `ms2_tasks::demos::replay_episode`, printing the conversion success rate and the seconds per
+//! converted episode of each target mode, plus seconds per source episode.
+//!
+//! ```text
+//! cargo run -p ms2-tasks --release --example demo_conversion -- PickCube-v0 20
+//! cargo run -p ms2-tasks --release --example demo_conversion -- StackCube-v0 100 \
+//!     pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos --max-retry 1 --source scripted
+//! ```
+//! Episodes run in parallel on rayon's pool (`RAYON_NUM_THREADS`); times are CPU-seconds per
+//! episode summed over threads divided by the episode count.
+
+use std::time::Instant;
+
+use ms2_tasks::demos::solutions::{solution_env_ids, solve_episode};
+use ms2_tasks::demos::{replay_episode, scripted_episode, DemoEpisode, DemoError, ReplayOptions};
+use ms2_tasks::EnvConfig;
+use rayon::prelude::*;
+
+const DEFAULT_TARGETS: &str = "pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos";
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let positional: Vec<&String> = args.iter().filter(|a| !a.starts_with("--")).collect();
+    let flag = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1))
+    };
+    let env_id = positional.first().map_or("PickCube-v0", |s| s.as_str());
+    let n: u64 = positional.get(1).map_or(Ok(10), |s| s.parse())?;
+    let targets: Vec<String> = positional
+        .get(2)
+        .map_or(DEFAULT_TARGETS, |s| s.as_str())
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    let max_retry: u32 = flag("--max-retry").map_or(Ok(0), |s| s.parse())?;
+    let use_solution = match flag("--source").map(String::as_str) {
+        Some("scripted") => false,
+        Some("solution") => true,
+        Some(other) => {
+            return Err(format!("--source must be scripted or solution, got {other}").into())
+        }
+        None => solution_env_ids().contains(&env_id),
+    };
+    let cfg = EnvConfig {
+        obs_mode: "state".to_owned(),
+        control_mode: Some("pd_joint_pos".to_owned()),
+        ..EnvConfig::new(env_id)
+    };
+    let start = Instant::now();
+    let sources: Vec<Result<DemoEpisode, DemoError>> = (0..n)
+        .into_par_iter()
+        .map(|seed| {
+            if use_solution {
+                solve_episode(&cfg, seed)
+            } else {
+                scripted_episode(&cfg, seed)
+            }
+        })
+        .collect();
+    let source_secs = start.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+    let sources: Vec<DemoEpisode> = sources
+        .into_iter()
+        .filter_map(Result::ok)
+        .filter(DemoEpisode::succeeded)
+        .collect();
+    println!(
+        "{env_id}: {} of {n} source episodes ({}) succeeded; {:.3} s per source episode \
+         ({} threads)",
+        sources.len(),
+        if use_solution {
+            "motion planning"
+        } else {
+            "scripted oracle"
+        },
+        source_secs / n as f64,
+        rayon::current_num_threads()
+    );
+    let replay_cfg = EnvConfig {
+        control_mode: None,
+        ..cfg.clone()
+    };
+    for target in targets {
+        let opts = ReplayOptions {
+            target_control_mode: Some(target.clone()),
+            max_retry,
+            ..ReplayOptions::default()
+        };
+        let start = Instant::now();
+        let results: Vec<_> = sources
+            .par_iter()
+            .map(|ep| replay_episode(&replay_cfg, ep, &opts))
+            .collect();
+        let secs = start.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+        let mut ok = 0;
+        let mut steps = 0usize;
+        let mut failed_seeds = Vec::new();
+        for (ep, r) in sources.iter().zip(&results) {
+            match r {
+                Ok(r) if r.episode.succeeded() => {
+                    ok += 1;
+                    steps += r.episode.actions.len();
+                }
+                Ok(r) => {
+                    let ever = r.episode.success.iter().any(|&s| s);
+                    failed_seeds.push(format!(
+                        "{} ({} steps vs {}{})",
+                        ep.episode_seed,
+                        r.episode.actions.len(),
+                        ep.actions.len(),
+                        if ever { ", succeeded earlier" } else { "" }
+                    ));
+                    steps += r.episode.actions.len();
+                }
+                Err(e) => failed_seeds.push(format!("{} ({e})", ep.episode_seed)),
+            }
+        }
+        let src_steps: usize = sources.iter().map(|e| e.actions.len()).sum();
+        println!(
+            "  -> {target:<26} {ok}/{} succeeded ({:.1} %), {:.3} s per converted episode, \
+             {:.3} target steps per source step; failed seeds: {:?}",
+            sources.len(),
+            100.0 * ok as f64 / sources.len().max(1) as f64,
+            secs / sources.len().max(1) as f64,
+            steps as f64 / src_steps.max(1) as f64,
+            failed_seeds
+        );
+    }
+    Ok(())
+}

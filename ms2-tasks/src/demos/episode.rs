@@ -1,0 +1,167 @@
+//! [`DemoEpisode`] (one episode in ManiSkill2's trajectory layout) and [`EpisodeRecorder`],
+//! which records one while an env is stepped.
+
+use super::DemoError;
+use crate::env::{Env, StepOutput};
+use crate::info::{info_get, Info, InfoValue};
+use crate::obs::ObsValue;
+
+/// One episode in ManiSkill2's trajectory layout (row-major, float32 like the `.h5` file).
+///
+/// Invariants (checked by [`DemoEpisode::validate`]): `actions`, `success` have `T =
+/// elapsed_steps` rows, `env_states` has `T + 1`, rows of one array have equal lengths, and every
+/// value is finite.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DemoEpisode {
+    /// Registered env id, e.g. `"PickCube-v0"`.
+    pub env_id: String,
+    /// Seed the episode was reset with (`Env::reset(Some(seed), false)`).
+    pub episode_seed: u64,
+    /// Control mode of `actions`, e.g. `"pd_joint_pos"`.
+    pub control_mode: String,
+    /// Actions `[T][A]`, one per env step, in `control_mode`'s units.
+    pub actions: Vec<Vec<f32>>,
+    /// Env states `[T+1][S]`: [`crate::Env::get_state`] after reset, then after each step.
+    pub env_states: Vec<Vec<f32>>,
+    /// `info["success"]` after each step `[T]`.
+    pub success: Vec<bool>,
+    /// Number of env steps (`== actions.len()`).
+    pub elapsed_steps: u32,
+    /// The info of the last step (of the reset when `T == 0`).
+    pub info: Info,
+}
+
+impl DemoEpisode {
+    /// Whether the episode succeeds at its last step (what demo generation keeps and what
+    /// conversion must preserve).
+    pub fn succeeded(&self) -> bool {
+        self.success.last() == Some(&true)
+    }
+
+    /// Checks the layout invariants (see the type docs); the error names the array and the
+    /// offending row.
+    pub fn validate(&self) -> Result<(), DemoError> {
+        let invalid = |reason: String| DemoError::InvalidEpisode {
+            seed: self.episode_seed,
+            reason,
+        };
+        let steps = self.actions.len();
+        if self.elapsed_steps as usize != steps {
+            return Err(invalid(format!(
+                "elapsed_steps is {} but there are {steps} actions",
+                self.elapsed_steps
+            )));
+        }
+        if self.success.len() != steps {
+            return Err(invalid(format!(
+                "success has {} entries, expected one per action ({steps})",
+                self.success.len()
+            )));
+        }
+        if self.env_states.len() != steps + 1 {
+            return Err(invalid(format!(
+                "env_states has {} rows, expected actions + 1 = {}",
+                self.env_states.len(),
+                steps + 1
+            )));
+        }
+        check_rows("actions", &self.actions).map_err(invalid)?;
+        check_rows("env_states", &self.env_states).map_err(invalid)
+    }
+}
+
+/// Checks that `rows` have equal lengths and finite values.
+fn check_rows(name: &str, rows: &[Vec<f32>]) -> Result<(), String> {
+    let Some(width) = rows.first().map(Vec::len) else {
+        return Ok(());
+    };
+    for (i, row) in rows.iter().enumerate() {
+        if row.len() != width {
+            return Err(format!(
+                "{name} row {i} has {} values, row 0 has {width}",
+                row.len()
+            ));
+        }
+        if let Some((j, v)) = row.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(format!("{name}[{i}][{j}] is {v}; values must be finite"));
+        }
+    }
+    Ok(())
+}
+
+/// Records a [`DemoEpisode`] while an env is stepped: the state after reset, then action,
+/// state and success of every step.
+///
+/// ```
+/// use ms2_tasks::demos::EpisodeRecorder;
+/// use ms2_tasks::{make_env, EnvConfig};
+/// let mut env = make_env(&EnvConfig::new("Dummy-v0")).unwrap();
+/// let (mut rec, _obs) = EpisodeRecorder::reset(&mut env, 7).unwrap();
+/// rec.step(&mut env, &vec![0.0; env.action_space().size()]).unwrap();
+/// let episode = rec.finish();
+/// assert_eq!((episode.elapsed_steps, episode.env_states.len()), (1, 2));
+/// episode.validate().unwrap();
+/// ```
+#[derive(Debug, Clone)]
+pub struct EpisodeRecorder {
+    episode: DemoEpisode,
+}
+
+impl EpisodeRecorder {
+    /// Resets `env` with episode seed `seed` and starts recording; returns the first
+    /// observation too.
+    pub fn reset(env: &mut Env, seed: u64) -> Result<(Self, ObsValue), DemoError> {
+        let (obs, info) = env.reset(Some(seed), false)?;
+        let recorder = Self {
+            episode: DemoEpisode {
+                env_id: env.config().env_id.clone(),
+                episode_seed: seed,
+                control_mode: env.control_mode().to_owned(),
+                actions: Vec::new(),
+                env_states: vec![env.get_state()],
+                success: Vec::new(),
+                elapsed_steps: 0,
+                info,
+            },
+        };
+        Ok((recorder, obs))
+    }
+
+    /// Steps `env` with `action` and records the step.
+    pub fn step(&mut self, env: &mut Env, action: &[f32]) -> Result<StepOutput, DemoError> {
+        let out = env.step(action)?;
+        self.push(action, env.get_state(), out.info.clone());
+        Ok(out)
+    }
+
+    /// Replaces the state recorded after reset (e.g. after restoring a recorded state).
+    pub fn restart_from_state(&mut self, state: Vec<f32>) {
+        self.episode.env_states[0] = state;
+    }
+
+    /// Records a step taken elsewhere: its action, the env state after it and its info.
+    pub fn push(&mut self, action: &[f32], state_after: Vec<f32>, info: Info) {
+        let ep = &mut self.episode;
+        ep.actions.push(action.to_vec());
+        ep.env_states.push(state_after);
+        ep.success
+            .push(info_get(&info, "success") == Some(InfoValue::Bool(true)));
+        ep.elapsed_steps += 1;
+        ep.info = info;
+    }
+
+    /// The episode recorded so far.
+    pub fn episode(&self) -> &DemoEpisode {
+        &self.episode
+    }
+
+    /// Number of steps recorded.
+    pub fn steps(&self) -> u32 {
+        self.episode.elapsed_steps
+    }
+
+    /// Ends recording.
+    pub fn finish(self) -> DemoEpisode {
+        self.episode
+    }
+}

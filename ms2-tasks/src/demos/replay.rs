@@ -1,0 +1,242 @@
+//! [`replay_episode`]: replays a recorded episode from its seed, optionally restoring the
+//! recorded states, recording observations, or converting its actions closed-loop to another
+//! control mode (the ManiSkill2 paper, Sec. 2.2).
+
+use super::source_targets::SourceJointTargets;
+use super::{DemoEpisode, DemoError, EpisodeRecorder};
+use crate::adapters::snapshot_articulation;
+use crate::config::EnvConfig;
+use crate::env::{make_env, Env};
+use crate::obs::ObsValue;
+
+/// Target steps allowed per source step when converting: the first, plus up to this many more
+/// while the target controller cannot reach the source's joint targets in one step (its action
+/// saturated or its IK did not converge). ManiSkill2's converter allows 4 steps in total for
+/// end-effector modes.
+pub const MAX_EXTRA_STEPS_PER_SOURCE_STEP: u32 = 3;
+
+/// Target steps allowed after the last source step, holding its joint targets, for a converted
+/// episode whose successful source it trails to reach success too.
+pub const MAX_SETTLE_STEPS: u32 = 10;
+
+/// How [`replay_episode`] replays an episode.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct ReplayOptions {
+    /// Control mode of the replayed actions; `None` = the source's (no conversion).
+    pub target_control_mode: Option<String>,
+    /// Restore the recorded env state after every step (replay without conversion only): the
+    /// output's states are then exactly the recorded ones.
+    pub use_env_states: bool,
+    /// Collect the observations (in `cfg.obs_mode`) after reset and after every step.
+    pub record_obs: bool,
+    /// Further attempts after a converted episode fails; each retry lets the converter take
+    /// extra target steps per source step while the target robot trails the recorded one.
+    pub max_retry: u32,
+}
+
+/// The result of [`replay_episode`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReplayedEpisode {
+    /// The replayed (or converted) episode, in the target control mode.
+    pub episode: DemoEpisode,
+    /// Observations `[T+1]` in `cfg.obs_mode` when `record_obs` was set.
+    pub obs: Option<Vec<ObsValue>>,
+    /// Attempts made (1 + retries used).
+    pub attempts: u32,
+}
+
+/// Replays `source` in an env made from `cfg` (its `env_id` must be the source's; its
+/// `control_mode` is ignored: the target mode comes from `opts`).
+///
+/// * Same control mode: the source actions are stepped from the source's seed; with
+///   `use_env_states`, each recorded state is restored after its step (and before the first).
+/// * Another control mode: closed-loop conversion. At each source step `t` the source action's
+///   desired joint targets `q̄_src(t)` are computed (see [`SourceJointTargets`]); the target
+///   controller then gets the action that makes its drive targets reproduce `q̄_src(t)` *from
+///   the target env's current state* (`CombinedController::action_for_joint_targets`, e.g.
+///   `T_a = T⁻¹ · FK(q̄_src)` for `pd_ee_delta_pose`). When the action saturates or IK fails,
+///   more target steps toward the same `q̄_src(t)` follow (at most
+///   [`MAX_EXTRA_STEPS_PER_SOURCE_STEP`]). A failed converted episode is retried up to
+///   `opts.max_retry` times with a stricter "reached" test (see [`ReplayOptions::max_retry`]).
+///
+/// Returns the last attempt whether it succeeded or not (check `episode.succeeded()`).
+pub fn replay_episode(
+    cfg: &EnvConfig,
+    source: &DemoEpisode,
+    opts: &ReplayOptions,
+) -> Result<ReplayedEpisode, DemoError> {
+    source.validate()?;
+    if cfg.env_id != source.env_id {
+        return Err(DemoError::InvalidOptions(format!(
+            "the episode was recorded in env {:?} but the replay env is {:?}",
+            source.env_id, cfg.env_id
+        )));
+    }
+    let target_mode = opts
+        .target_control_mode
+        .clone()
+        .unwrap_or_else(|| source.control_mode.clone());
+    let converting = target_mode != source.control_mode;
+    if converting && opts.use_env_states {
+        return Err(DemoError::InvalidOptions(format!(
+            "use_env_states restores the recorded {:?} states, which a conversion to {target_mode:?} \
+             cannot follow; convert without it",
+            source.control_mode
+        )));
+    }
+    let env_cfg = EnvConfig {
+        control_mode: Some(target_mode),
+        // Without recorded observations, visual modes would only render for nothing.
+        obs_mode: if opts.record_obs {
+            cfg.obs_mode.clone()
+        } else {
+            "state".to_owned()
+        },
+        render_mode: None,
+        ..cfg.clone()
+    };
+    let mut env = make_env(&env_cfg)?;
+    if !converting {
+        let (episode, obs) = replay_same_mode(&mut env, source, opts)?;
+        return Ok(ReplayedEpisode {
+            episode,
+            obs,
+            attempts: 1,
+        });
+    }
+    let mut attempt = 0;
+    loop {
+        let strict = attempt > 0;
+        let (episode, obs) = convert_once(&env_cfg, &mut env, source, opts.record_obs, strict)?;
+        attempt += 1;
+        if episode.succeeded() || attempt > opts.max_retry {
+            return Ok(ReplayedEpisode {
+                episode,
+                obs,
+                attempts: attempt,
+            });
+        }
+    }
+}
+
+/// Observations collected during a replay.
+struct ObsLog(Option<Vec<ObsValue>>);
+
+impl ObsLog {
+    fn new(record: bool, first: ObsValue) -> Self {
+        Self(record.then(|| vec![first]))
+    }
+
+    fn push(&mut self, env: &Env, from_step: Option<ObsValue>) -> Result<(), DemoError> {
+        if let Some(log) = &mut self.0 {
+            log.push(match from_step {
+                Some(obs) => obs,
+                None => env.try_observe()?,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Replays the source actions in the source's own control mode.
+fn replay_same_mode(
+    env: &mut Env,
+    source: &DemoEpisode,
+    opts: &ReplayOptions,
+) -> Result<(DemoEpisode, Option<Vec<ObsValue>>), DemoError> {
+    let (mut recorder, mut first_obs) = EpisodeRecorder::reset(env, source.episode_seed)?;
+    if opts.use_env_states {
+        env.set_state(&source.env_states[0])?;
+        recorder.restart_from_state(env.get_state());
+        if opts.record_obs {
+            first_obs = env.try_observe()?;
+        }
+    }
+    let mut obs = ObsLog::new(opts.record_obs, first_obs);
+    for (t, action) in source.actions.iter().enumerate() {
+        let out = env.step(action)?;
+        let mut state = env.get_state();
+        let mut step_obs = Some(out.obs);
+        if opts.use_env_states && state != source.env_states[t + 1] {
+            env.set_state(&source.env_states[t + 1])?;
+            state = env.get_state();
+            step_obs = None;
+        }
+        recorder.push(action, state, out.info);
+        obs.push(env, step_obs)?;
+    }
+    Ok((recorder.finish(), obs.0))
+}
+
+/// One closed-loop conversion of `source` into `env`'s control mode. `strict` also takes extra
+/// target steps while the arm trails the recorded arm by more than [`TRAILING_TOLERANCE_RAD`].
+fn convert_once(
+    cfg: &EnvConfig,
+    env: &mut Env,
+    source: &DemoEpisode,
+    record_obs: bool,
+    strict: bool,
+) -> Result<(DemoEpisode, Option<Vec<ObsValue>>), DemoError> {
+    let (mut recorder, first_obs) = EpisodeRecorder::reset(env, source.episode_seed)?;
+    let mut obs = ObsLog::new(record_obs, first_obs);
+    let mut targets = SourceJointTargets::new(cfg, env, source)?;
+    let dof = targets.dof();
+    let mut desired = Vec::new();
+    for t in 0..source.actions.len() {
+        desired = targets.targets(source, t)?;
+        debug_assert_eq!(desired.len(), dof);
+        for extra in 0..=MAX_EXTRA_STEPS_PER_SOURCE_STEP {
+            let reached = step_toward(env, &mut recorder, &mut obs, &desired, source, t)?;
+            let _ = strict;
+            if reached || extra == MAX_EXTRA_STEPS_PER_SOURCE_STEP {
+                break;
+            }
+        }
+    }
+    // The source ends successful; the target robot may trail it by a step or two (extra steps
+    // above, tracking lag): hold the final targets until the task is solved, briefly.
+    if source.succeeded() {
+        let last = source.actions.len();
+        for _ in 0..MAX_SETTLE_STEPS {
+            if recorder.episode().succeeded() {
+                break;
+            }
+            step_toward(env, &mut recorder, &mut obs, &desired, source, last)?;
+        }
+    }
+    Ok((recorder.finish(), obs.0))
+}
+
+/// One target step with the action that makes the target controller's drive targets reproduce
+/// `desired`; returns whether they were reproduced (no saturated part, IK converged).
+fn step_toward(
+    env: &mut Env,
+    recorder: &mut EpisodeRecorder,
+    obs: &mut ObsLog,
+    desired: &[f64],
+    source: &DemoEpisode,
+    t: usize,
+) -> Result<bool, DemoError> {
+    let converted = {
+        let scene = env
+            .task_scene()
+            .expect("checked by SourceJointTargets::new");
+        let snapshot = snapshot_articulation(&scene.world, scene.agent.articulation);
+        scene
+            .agent
+            .controller
+            .action_for_joint_targets(&snapshot, desired)
+            .map_err(|e| DemoError::InvalidEpisode {
+                seed: source.episode_seed,
+                reason: format!("step {t}: {e}"),
+            })?
+    };
+    let action: Vec<f32> = converted.action.iter().map(|&v| v as f32).collect();
+    let out = recorder.step(env, &action)?;
+    obs.push(env, Some(out.obs))?;
+    let ik_failed = env
+        .task_scene()
+        .and_then(|s| s.agent.controller.last_ik_report())
+        .is_some_and(|r| !r.converged);
+    Ok(converted.saturated_parts.is_empty() && !ik_failed)
+}

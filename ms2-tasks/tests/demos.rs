@@ -1,0 +1,209 @@
+//! Demonstration replay and closed-loop conversion (`ms2_tasks::demos`), on PickCube /
+//! StackCube episodes recorded from the scripted oracle in the source control mode.
+
+use ms2_tasks::demos::{replay_episode, scripted_episode, DemoEpisode, DemoError, ReplayOptions};
+use ms2_tasks::{make_env, EnvConfig, EnvError};
+
+fn cfg(env_id: &str, control_mode: &str) -> EnvConfig {
+    EnvConfig {
+        obs_mode: "state".to_owned(),
+        control_mode: Some(control_mode.to_owned()),
+        ..EnvConfig::new(env_id)
+    }
+}
+
+/// The scripted oracle's episode for `seed` in `control_mode`, until success (asserted).
+fn oracle_episode(env_id: &str, control_mode: &str, seed: u64) -> DemoEpisode {
+    let episode = scripted_episode(&cfg(env_id, control_mode), seed).unwrap();
+    episode.validate().unwrap();
+    assert_eq!(episode.control_mode, control_mode);
+    assert_eq!(episode.env_states.len(), episode.actions.len() + 1);
+    assert!(episode.succeeded(), "oracle failed {env_id} seed {seed}");
+    episode
+}
+
+fn replay(
+    source: &DemoEpisode,
+    opts: ReplayOptions,
+) -> Result<ms2_tasks::demos::ReplayedEpisode, DemoError> {
+    replay_episode(&EnvConfig::new(&source.env_id), source, &opts)
+}
+
+#[test]
+fn replay_with_env_states_reproduces_the_recorded_states_exactly() {
+    let source = oracle_episode("StackCube-v0", "pd_joint_pos", 3);
+    let out = replay(
+        &source,
+        ReplayOptions {
+            use_env_states: true,
+            record_obs: true,
+            ..ReplayOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(out.episode.env_states, source.env_states);
+    assert_eq!(out.episode.actions, source.actions);
+    assert_eq!(out.episode.success, source.success);
+    assert_eq!(out.episode.control_mode, "pd_joint_pos");
+    let obs = out.obs.expect("record_obs");
+    assert_eq!(obs.len(), source.env_states.len());
+
+    // The states come from the recording, not from the actions: with the arm told to hold its
+    // reset pose, replaying with the recorded states still reproduces them exactly, while an
+    // open-loop replay of the same actions leaves the recorded trajectory.
+    let mut held = source.clone();
+    let rest = held.actions[0].clone();
+    held.actions.iter_mut().for_each(|a| a.clone_from(&rest));
+    let with_states = replay(
+        &held,
+        ReplayOptions {
+            use_env_states: true,
+            ..ReplayOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(with_states.episode.env_states, source.env_states);
+    let open_loop = replay(&held, ReplayOptions::default()).unwrap();
+    assert_ne!(open_loop.episode.env_states, source.env_states);
+}
+
+#[test]
+fn open_loop_replay_from_the_seed_reproduces_the_episode() {
+    let source = oracle_episode("PickCube-v0", "pd_joint_pos", 5);
+    let out = replay(&source, ReplayOptions::default()).unwrap();
+    assert_eq!(out.episode.env_states, source.env_states);
+    assert_eq!(out.episode.success, source.success);
+    assert!(out.obs.is_none());
+}
+
+/// Converts `source` to `target` and checks the converted episode: it succeeds at its last
+/// step, is in the target mode, and stays close to the source's length.
+fn assert_converts(source: &DemoEpisode, target: &str) {
+    let out = replay(
+        source,
+        ReplayOptions {
+            target_control_mode: Some(target.to_owned()),
+            ..ReplayOptions::default()
+        },
+    )
+    .unwrap();
+    let ep = &out.episode;
+    ep.validate().unwrap();
+    assert_eq!(ep.control_mode, target);
+    assert!(
+        ep.succeeded(),
+        "{} seed {} converted to {target} failed after {} steps (source {})",
+        source.env_id,
+        source.episode_seed,
+        ep.actions.len(),
+        source.actions.len()
+    );
+    let width = make_env(&cfg(&source.env_id, target))
+        .unwrap()
+        .action_space()
+        .size();
+    assert!(ep.actions.iter().all(|a| a.len() == width));
+    assert!(ep.actions.len() >= source.actions.len());
+    assert!(ep.actions.len() <= 2 * source.actions.len() + 10);
+    // The converted actions are really in the target space: replaying them open-loop in the
+    // target mode reproduces the converted episode.
+    let again = replay(ep, ReplayOptions::default()).unwrap();
+    assert_eq!(again.episode.env_states, ep.env_states);
+}
+
+#[test]
+fn pd_joint_pos_episodes_convert_to_ee_and_joint_delta_modes() {
+    for (env_id, seed) in [("PickCube-v0", 1), ("StackCube-v0", 2)] {
+        let source = oracle_episode(env_id, "pd_joint_pos", seed);
+        for target in ["pd_ee_delta_pose", "pd_ee_delta_pos", "pd_joint_delta_pos"] {
+            assert_converts(&source, target);
+        }
+    }
+}
+
+#[test]
+fn pd_joint_pos_converts_to_target_delta_modes() {
+    let source = oracle_episode("PickCube-v0", "pd_joint_pos", 4);
+    for target in ["pd_joint_target_delta_pos", "pd_ee_target_delta_pose"] {
+        assert_converts(&source, target);
+    }
+}
+
+#[test]
+fn pd_joint_delta_pos_converts_to_pd_joint_pos() {
+    let source = oracle_episode("PickCube-v0", "pd_joint_delta_pos", 6);
+    assert_converts(&source, "pd_joint_pos");
+}
+
+#[test]
+fn bad_replay_requests_are_refused_with_typed_errors() {
+    let source = oracle_episode("PickCube-v0", "pd_joint_pos", 0);
+    let err = replay(
+        &source,
+        ReplayOptions {
+            target_control_mode: Some("pd_ee_delta_pose".to_owned()),
+            use_env_states: true,
+            ..ReplayOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, DemoError::InvalidOptions(ref m) if m.contains("use_env_states")),
+        "{err}"
+    );
+
+    let err = replay(
+        &source,
+        ReplayOptions {
+            target_control_mode: Some("pd_teleport".to_owned()),
+            ..ReplayOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, DemoError::Env(EnvError::UnknownControlMode { ref got, .. }) if got == "pd_teleport"),
+        "{err}"
+    );
+
+    let err = replay_episode(
+        &EnvConfig::new("StackCube-v0"),
+        &source,
+        &ReplayOptions::default(),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, DemoError::InvalidOptions(ref m) if m.contains("PickCube-v0")),
+        "{err}"
+    );
+
+    let mut short = source.clone();
+    short.env_states.pop();
+    let err = replay(&short, ReplayOptions::default()).unwrap_err();
+    assert!(
+        matches!(err, DemoError::InvalidEpisode { ref reason, .. } if reason.contains("env_states")),
+        "{err}"
+    );
+
+    let mut nan = source.clone();
+    nan.actions[3][1] = f32::NAN;
+    let err = replay(&nan, ReplayOptions::default()).unwrap_err();
+    assert!(
+        matches!(err, DemoError::InvalidEpisode { ref reason, .. } if reason.contains("actions[3][1]")),
+        "{err}"
+    );
+
+    let mut velocity = source.clone();
+    velocity.control_mode = "pd_joint_vel".to_owned();
+    let err = replay(
+        &velocity,
+        ReplayOptions {
+            target_control_mode: Some("pd_joint_pos".to_owned()),
+            ..ReplayOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, DemoError::UnsupportedConversion { .. }),
+        "{err}"
+    );
+}
