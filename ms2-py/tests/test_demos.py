@@ -165,6 +165,11 @@ def test_converted_trajectories_succeed(demo_file, target, capsys):
             assert ep["actions"].shape[1] == width
             assert ep["success"][-1] and ep["info"]["success"]
             assert np.all(np.abs(ep["actions"]) <= 1.0 + 1e-6)  # normalised target space
+    if target == "pd_joint_delta_pos":
+        # ... and back: pd_joint_delta_pos -> pd_joint_pos.
+        back = replay(out, target_control_mode="pd_joint_pos", save_traj=True, progress=False)
+        assert back.num_succeeded == NUM_DEMOS
+        assert back.output.name == f"PickCube-v0.none.{target}.none.pd_joint_pos.h5"
 
 
 def test_replayed_state_dict_observations_are_nested_groups(demo_file):
@@ -232,6 +237,7 @@ def test_missing_truncated_and_foreign_files_give_clear_errors(demo_file, tmp_pa
 
 def test_interrupted_writer_keeps_the_last_commit(tmp_path):
     path = tmp_path / "partial.h5"
+    path.write_bytes(b"an older file of the same name")
     info = {"env_id": ENV_ID, "max_episode_steps": 200, "env_kwargs": {}}
     episodes = _native.scripted_episodes(ENV_ID, [0, 1, 2], {}, 2)
     with pytest.raises(KeyboardInterrupt):
@@ -319,3 +325,15 @@ def test_replay_saves_one_video_per_episode(demo_file):
     assert [v.name for v in result.videos] == ["traj_0.mp4"]
     assert result.videos[0].parent.name == "PickCube-v0.none.pd_joint_pos.videos"
     assert result.videos[0].stat().st_size > 1000
+
+
+def test_a_new_writer_replaces_an_older_file_from_its_first_commit(demo_file, tmp_path):
+    path = tmp_path / "again.h5"
+    path.write_bytes(demo_file.read_bytes())
+    path.with_suffix(".json").write_text(demo_file.with_suffix(".json").read_text())
+    info = {"env_id": ENV_ID, "max_episode_steps": 200, "env_kwargs": {}}
+    with TrajectoryWriter(path, info) as writer:
+        writer.commit()
+    with open_trajectory(path) as traj:
+        assert len(traj) == 0
+        assert list(traj.h5.keys()) == []
