@@ -227,6 +227,17 @@ def test_missing_truncated_and_foreign_files_give_clear_errors(demo_file, tmp_pa
     with pytest.raises(TrajectoryFileError, match="not a trajectory metadata file"):
         open_trajectory(other_json)
 
+    soft = tmp_path / "soft.h5"
+    with h5py.File(soft, "w") as f:
+        f.create_dataset("traj_0/actions", data=np.zeros((2, 8), np.float32))
+        f.create_dataset("traj_0/success", data=np.zeros(2, bool))
+        f.create_dataset("traj_0/env_init_state", data=np.zeros(5, np.float32))
+    soft_meta = json.loads(text_json)
+    soft_meta["episodes"] = soft_meta["episodes"][:1]
+    soft.with_suffix(".json").write_text(json.dumps(soft_meta))
+    with open_trajectory(soft) as traj, pytest.raises(TrajectoryFileError, match="soft-body"):
+        traj.read_episode(0)
+
     fewer = tmp_path / "fewer.h5"
     with h5py.File(demo_file, "r") as src, h5py.File(fewer, "w") as dst:
         src.copy("traj_0", dst)

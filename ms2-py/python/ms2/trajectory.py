@@ -262,6 +262,11 @@ class Trajectory:
         meta = self.episodes[index]
         name = f"traj_{meta['episode_id']}"
         group = self.h5[name]
+        if "env_states" not in group and "env_init_state" in group:
+            raise TrajectoryFileError(
+                f"{self.path}: {name} stores only env_init_state (a soft-body trajectory); ms2 "
+                "reads rigid-body trajectories with per-step env_states"
+            )
         try:
             out = dict(meta)
             out["actions"] = np.asarray(group["actions"][()], dtype=np.float32)
