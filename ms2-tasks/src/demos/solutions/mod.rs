@@ -4,7 +4,7 @@
 //! [ms2-plan](ms2_plan) (a top-down grasp from the cube's bounding box at the yaw closest to the
 //! hand's, screw motions and RRT-Connect, TOPP-RA timing at the control frequency, the ground
 //! and the other cubes as obstacles) and plays the planned joint targets as `pd_joint_pos`
-//! actions, recording the episode ([`recorder`]). The three cube tasks share one
+//! actions, recording the episode ([`driver`]). The three cube tasks share one
 //! pick-and-place skeleton ([`pick_place`]); a task is a [`CubeTaskSolution`] value.
 //!
 //! ```no_run
@@ -16,8 +16,8 @@
 //! println!("success: {:?}", episode.success.last());
 //! ```
 
+pub mod driver;
 pub mod pick_place;
-pub mod recorder;
 pub mod scene;
 
 use std::sync::OnceLock;
@@ -33,8 +33,8 @@ use crate::env::{make_env, Env};
 use crate::error::EnvError;
 use crate::tasks::common::CUBE_HALF_SIZE;
 use crate::tasks::lift_cube::GOAL_HEIGHT;
+pub use driver::{Gripper, JointTargetDriver, CONTROL_MODE};
 pub use pick_place::{CubeTaskSolution, Finish};
-pub use recorder::{EpisodeRecorder, Gripper, CONTROL_MODE};
 pub use scene::{SensedCube, SensedState};
 
 /// Height (m) LiftCube's cube is carried to above its success height (cube centre at
@@ -94,9 +94,9 @@ pub enum SolveError {
         /// The planner's error.
         source: PlanError,
     },
-    /// The env failed.
+    /// The env failed while stepping or resetting.
     #[error(transparent)]
-    Env(#[from] EnvError),
+    Demo(#[from] DemoError),
     /// The episode limit was reached before the motion ended.
     #[error("the episode limit was reached")]
     OutOfSteps,
@@ -184,17 +184,17 @@ impl DemoSolver {
     pub fn solve(&mut self, seed: u64) -> Result<(DemoEpisode, SolveTimings), DemoError> {
         let t0 = Instant::now();
         let mut timings = SolveTimings::default();
-        let mut recorder =
-            EpisodeRecorder::start(&mut self.env, seed).map_err(|e| to_demo(e, seed))?;
+        let mut driver =
+            JointTargetDriver::start(&mut self.env, seed).map_err(|e| to_demo(e, seed))?;
         match self
             .solution
-            .run(&mut recorder, self.panda, seed, &mut timings)
+            .run(&mut driver, self.panda, seed, &mut timings)
         {
             Ok(()) | Err(SolveError::OutOfSteps) => {}
             Err(e) => return Err(to_demo(e, seed)),
         }
         timings.total_seconds = t0.elapsed().as_secs_f64();
-        Ok((recorder.finish(), timings))
+        Ok((driver.finish(), timings))
     }
 }
 
@@ -211,7 +211,7 @@ pub fn solve_episode(cfg: &EnvConfig, seed: u64) -> Result<DemoEpisode, DemoErro
 
 fn to_demo(e: SolveError, seed: u64) -> DemoError {
     match e {
-        SolveError::Env(e) => DemoError::Env(e),
+        SolveError::Demo(e) => e,
         other => DemoError::Planning {
             seed,
             reason: other.to_string(),

@@ -14,7 +14,7 @@ use ms2_plan::{
 };
 use nalgebra::{Isometry3, Translation3, Vector3};
 
-use super::recorder::{EpisodeRecorder, Gripper};
+use super::driver::{Gripper, JointTargetDriver};
 use super::scene::SensedState;
 use super::{SolveError, SolveTimings};
 
@@ -69,21 +69,21 @@ const CARRIED_SHRINK: f64 = 0.003;
 const SPEED_SCALE: f64 = 0.5;
 
 impl CubeTaskSolution {
-    /// Runs the solution on `recorder`'s freshly reset env. `seed` seeds the planners.
+    /// Runs the solution on `driver`'s freshly reset env. `seed` seeds the planners.
     ///
     /// # Errors
     /// [`SolveError::OutOfSteps`] when the episode limit ends the motion, planning and env
     /// errors otherwise.
     pub fn run(
         &self,
-        recorder: &mut EpisodeRecorder<'_>,
+        driver: &mut JointTargetDriver<'_>,
         panda: &KinematicRobot,
         seed: u64,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
         let mut names = vec![self.cube];
         names.extend_from_slice(self.obstacles);
-        let sensed = SensedState::read(recorder.env(), &names)?;
+        let sensed = SensedState::read(driver.env(), &names)?;
         let goal_world = (self.goal_world)(&sensed)?;
         let goal_base = sensed.world_point_in_base(&goal_world);
         let gripper = GripperSpec {
@@ -99,7 +99,7 @@ impl CubeTaskSolution {
 
         // Grasp: top-down, at the cube's yaw symmetry closest to the hand's yaw.
         let scene = sensed.collision_scene().map_err(plan_error("scene"))?;
-        let start = recorder.arm_target().to_vec();
+        let start = driver.arm_target().to_vec();
         let cube = sensed.cube(self.cube)?.oriented_box();
         let grasp = timings.time(|| {
             let candidates = top_down_grasps(&cube, &gripper, &panda.tcp_pose(&start));
@@ -128,7 +128,7 @@ impl CubeTaskSolution {
                 })
                 .map_err(plan_error("reach"))
         })?;
-        recorder.follow(&reach.trajectory, Gripper::Open)?;
+        driver.follow(&reach.trajectory, Gripper::Open)?;
 
         // Screw down to the grasp (the fingers may touch the cube) and close.
         let mut approach_scene = scene.clone();
@@ -139,23 +139,23 @@ impl CubeTaskSolution {
             planner
                 .plan_screw(
                     &approach_scene,
-                    recorder.arm_target(),
+                    driver.arm_target(),
                     &grasp.grasp.pose_base_from_tcp,
                 )
                 .map_err(plan_error("descend"))
         })?;
-        recorder.follow(&descend.trajectory, Gripper::Open)?;
-        recorder.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Open)?;
-        recorder.hold(CLOSE_STEPS, Gripper::Closed)?;
+        driver.follow(&descend.trajectory, Gripper::Open)?;
+        driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Open)?;
+        driver.hold(CLOSE_STEPS, Gripper::Closed)?;
 
         // Carry: the cube rides on the hand; the planner sees the fingers closed on it.
-        let grasped = SensedState::read(recorder.env(), &names)?;
+        let grasped = SensedState::read(driver.env(), &names)?;
         let cube_now = grasped.cube(self.cube)?.clone();
         let mut holding = panda.clone();
         holding
             .set_panda_finger_opening(cube_now.half_size)
             .map_err(plan_error("carry"))?;
-        let grasp_q = recorder.arm_target().to_vec();
+        let grasp_q = driver.arm_target().to_vec();
         let carry_scene = scene_carrying(&grasped, &holding, &grasp_q, self.cube, &gripper)?;
         let mut carry_planner =
             MotionPlanner::new(&holding, config(1)).map_err(plan_error("config"))?;
@@ -180,10 +180,10 @@ impl CubeTaskSolution {
                     .plan_screw(&carry_scene, &grasp_q, &tcp_for_cube(&lifted))
                     .map_err(plan_error("lift"))
             })?;
-            recorder.follow(&lift.trajectory, Gripper::Closed)?;
+            driver.follow(&lift.trajectory, Gripper::Closed)?;
         }
         let carry = timings.time(|| {
-            let start = recorder.arm_target();
+            let start = driver.arm_target();
             let mut last = None;
             for tcp in tilted_about(&tcp_for_cube(&carry_target), &carry_target) {
                 match move_to_pose(&mut carry_planner, &carry_scene, start, &tcp) {
@@ -195,25 +195,21 @@ impl CubeTaskSolution {
                 last.unwrap_or(PlanError::NoPathFound { iterations: 0 }),
             ))
         })?;
-        recorder.follow(&carry.trajectory, Gripper::Closed)?;
+        driver.follow(&carry.trajectory, Gripper::Closed)?;
 
         match self.finish {
-            Finish::HoldStill => recorder.hold_until_success(SUCCESS_STEPS, Gripper::Closed),
+            Finish::HoldStill => driver.hold_until_success(SUCCESS_STEPS, Gripper::Closed),
             Finish::PlaceAndRelease => {
                 let lower = timings.time(|| {
                     carry_planner
-                        .plan_screw(
-                            &carry_scene,
-                            recorder.arm_target(),
-                            &tcp_for_cube(&goal_base),
-                        )
+                        .plan_screw(&carry_scene, driver.arm_target(), &tcp_for_cube(&goal_base))
                         .map_err(plan_error("lower"))
                 })?;
-                recorder.follow(&lower.trajectory, Gripper::Closed)?;
-                recorder.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Closed)?;
-                recorder.hold(OPEN_STEPS, Gripper::Open)?;
-                self.retreat(recorder, panda, &names, &gripper, config(2), timings)?;
-                recorder.hold_until_success(SUCCESS_STEPS, Gripper::Open)
+                driver.follow(&lower.trajectory, Gripper::Closed)?;
+                driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Closed)?;
+                driver.hold(OPEN_STEPS, Gripper::Open)?;
+                self.retreat(driver, panda, &names, &gripper, config(2), timings)?;
+                driver.hold_until_success(SUCCESS_STEPS, Gripper::Open)
             }
         }
     }
@@ -222,19 +218,19 @@ impl CubeTaskSolution {
     /// released cube).
     fn retreat(
         &self,
-        recorder: &mut EpisodeRecorder<'_>,
+        driver: &mut JointTargetDriver<'_>,
         panda: &KinematicRobot,
         names: &[&str],
         gripper: &GripperSpec,
         config: PlannerConfig,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
-        let released = SensedState::read(recorder.env(), names)?;
+        let released = SensedState::read(driver.env(), names)?;
         let mut scene = released.collision_scene().map_err(plan_error("retreat"))?;
         for finger in &gripper.touch_links {
             scene.allow_collision(finger.clone(), self.cube);
         }
-        let start = recorder.arm_target().to_vec();
+        let start = driver.arm_target().to_vec();
         let up = Translation3::new(0.0, 0.0, RETREAT_HEIGHT) * panda.tcp_pose(&start);
         let mut planner = MotionPlanner::new(panda, config).map_err(plan_error("config"))?;
         let motion = timings.time(|| {
@@ -242,7 +238,7 @@ impl CubeTaskSolution {
                 .plan_screw(&scene, &start, &up)
                 .map_err(plan_error("retreat"))
         })?;
-        recorder.follow(&motion.trajectory, Gripper::Open)
+        driver.follow(&motion.trajectory, Gripper::Open)
     }
 }
 
