@@ -60,6 +60,10 @@ const RETREAT_HEIGHT: f64 = 0.05;
 const SETTLE_TOLERANCE: f64 = 0.005;
 /// Most env steps spent waiting for the arm to settle.
 const SETTLE_MAX_STEPS: u32 = 10;
+/// Env steps the arm holds still at the grasp / place pose after settling, before the gripper
+/// moves: a replay converting the episode to another control mode lags the recorded arm
+/// slightly and catches up here.
+const PAUSE_STEPS: u32 = 3;
 /// Consecutive successful steps that end an episode.
 const SUCCESS_STEPS: usize = 3;
 /// How much (m) the carried cube's collision box is shrunk: it rests on the ground (or is
@@ -146,6 +150,7 @@ impl CubeTaskSolution {
         })?;
         driver.follow(&descend.trajectory, Gripper::Open)?;
         driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Open)?;
+        driver.hold(PAUSE_STEPS, Gripper::Open)?;
         driver.hold(CLOSE_STEPS, Gripper::Closed)?;
 
         // Carry: the cube rides on the hand; the planner sees the fingers closed on it.
@@ -172,9 +177,17 @@ impl CubeTaskSolution {
         } else {
             goal_base
         };
-        if carry_target.z < cube_z + LIFT_CLEARANCE {
-            let lifted = cube_now.pose_base_from_cube.translation.vector
-                + Vector3::new(0.0, 0.0, LIFT_CLEARANCE);
+        // Lift straight up first: by LIFT_CLEARANCE for a low goal, and to the carry height
+        // when other cubes stand around (a slanted carry could clip them: the arm lags its
+        // targets by a few centimetres).
+        let lift_z = if self.obstacles.is_empty() {
+            cube_z + LIFT_CLEARANCE
+        } else {
+            carry_target.z.max(cube_z + LIFT_CLEARANCE)
+        };
+        if carry_target.z < cube_z + LIFT_CLEARANCE || !self.obstacles.is_empty() {
+            let mut lifted = cube_now.pose_base_from_cube.translation.vector;
+            lifted.z = lift_z;
             let lift = timings.time(|| {
                 carry_planner
                     .plan_screw(&carry_scene, &grasp_q, &tcp_for_cube(&lifted))
@@ -207,6 +220,7 @@ impl CubeTaskSolution {
                 })?;
                 driver.follow(&lower.trajectory, Gripper::Closed)?;
                 driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Closed)?;
+                driver.hold(PAUSE_STEPS, Gripper::Closed)?;
                 driver.hold(OPEN_STEPS, Gripper::Open)?;
                 self.retreat(driver, panda, &names, &gripper, config(2), timings)?;
                 driver.hold_until_success(SUCCESS_STEPS, Gripper::Open)
