@@ -43,6 +43,11 @@ const LIFT_MARGIN: f64 = 0.03;
 /// Height (m) of the moved cube's bottom above the other cube's top when StackCube releases it.
 const STACK_GAP: f64 = 0.002;
 
+/// How far (m) PickCube's cube may be carried short of the goal when the upright hand cannot
+/// reach it (success needs 0.025 m; an upright hand keeps the episode convertible to
+/// `pd_ee_delta_pos`, whose hand orientation is fixed).
+const PICK_GOAL_TOLERANCE: f64 = 0.02;
+
 /// The registered solutions.
 const SOLUTIONS: [CubeTaskSolution; 3] = [
     CubeTaskSolution {
@@ -53,6 +58,7 @@ const SOLUTIONS: [CubeTaskSolution; 3] = [
             let g = scene::privileged_vector(&s.obs, "extra/goal_pos", 3)?;
             Ok(Vector3::new(g[0], g[1], g[2]).cast())
         },
+        goal_tolerance: PICK_GOAL_TOLERANCE,
         finish: Finish::HoldStill,
     },
     CubeTaskSolution {
@@ -65,6 +71,7 @@ const SOLUTIONS: [CubeTaskSolution; 3] = [
             goal.z = f64::from(GOAL_HEIGHT + CUBE_HALF_SIZE) + LIFT_MARGIN;
             Ok(goal)
         },
+        goal_tolerance: 0.0,
         finish: Finish::HoldStill,
     },
     CubeTaskSolution {
@@ -76,6 +83,7 @@ const SOLUTIONS: [CubeTaskSolution; 3] = [
             let on_top = s.pose_world_from_base * b.pose_base_from_cube;
             Ok(on_top.translation.vector + Vector3::new(0.0, 0.0, 2.0 * b.half_size + STACK_GAP))
         },
+        goal_tolerance: 0.0,
         finish: Finish::PlaceAndRelease,
     },
 ];

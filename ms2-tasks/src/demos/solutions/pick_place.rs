@@ -40,6 +40,10 @@ pub struct CubeTaskSolution {
     /// Where the moved cube's centre must end up (world frame, m), from the state sensed after
     /// reset.
     pub goal_world: fn(&SensedState) -> Result<Vector3<f64>, SolveError>,
+    /// How far (m) the cube may end from the goal and still succeed with margin; when the
+    /// upright hand cannot bring the cube to the goal, points up to this far toward the robot's
+    /// shoulder are tried before tilting the hand (0 = the goal exactly).
+    pub goal_tolerance: f64,
     /// How the motion ends.
     pub finish: Finish,
 }
@@ -198,7 +202,14 @@ impl CubeTaskSolution {
         let carry = timings.time(|| {
             let start = driver.arm_target();
             let mut last = None;
-            for tcp in tilted_about(&tcp_for_cube(&carry_target), &carry_target) {
+            let toward_shoulder = (Vector3::new(0.0, 0.0, SHOULDER_HEIGHT) - carry_target)
+                .try_normalize(1e-9)
+                .unwrap_or_else(Vector3::zeros);
+            let upright_near_goal = GOAL_SLACK_FRACTIONS.iter().map(|f| {
+                tcp_for_cube(&(carry_target + toward_shoulder * (f * self.goal_tolerance)))
+            });
+            let poses = tilted_about(&tcp_for_cube(&carry_target), &carry_target);
+            for tcp in upright_near_goal.chain(poses.skip(1)) {
                 match move_to_pose(&mut carry_planner, &carry_scene, start, &tcp) {
                     Ok(motion) => return Ok(motion),
                     Err(e) => last = Some(e),
@@ -294,6 +305,12 @@ fn move_to_pose(
         .plan_screw(scene, start, pose_base_from_tcp)
         .or_else(|_| planner.plan_to_pose(scene, start, pose_base_from_tcp))
 }
+
+/// Height (m) of the Panda's shoulder (joint 2) above its base: the centre of its reach.
+const SHOULDER_HEIGHT: f64 = 0.333;
+/// Fractions of [`CubeTaskSolution::goal_tolerance`] by which the carried cube's target is
+/// moved toward the shoulder, tried in order with an upright hand (0 = the goal itself).
+const GOAL_SLACK_FRACTIONS: [f64; 4] = [0.0, 0.4, 0.7, 1.0];
 
 /// Tilts (rad) of the carrying hand's approach axis away from the robot, tried in order when
 /// the cube's goal cannot be reached with the grasp orientation (high, far goals are reachable
