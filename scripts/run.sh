@@ -11,4 +11,4 @@ bash scripts/setup.sh
 if [ "$#" -gt 0 ]; then
   exec ms2 "$@"
 fi
-exec ms2 run PickCube-v0 --policy scripted --episodes 1 --verbose
+exec ms2 run PickCube-v0 --policy scripted --episodes 1 --verbose --record out/PickCube-v0
