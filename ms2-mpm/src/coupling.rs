@@ -28,6 +28,7 @@ use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
 use crate::error::MpmError;
+use crate::grid::GridSpec;
 use crate::mesh::TriMesh;
 use crate::sdf::{Sdf, SdfVolume};
 use crate::solver::{MpmSolver, ParticleForces, ParticleView};
@@ -478,5 +479,56 @@ impl ParticleForces for Coupling {
             }
         }
         self.accumulated_time += dt as f64;
+    }
+
+    fn blocked_nodes(
+        &mut self,
+        particles: ParticleView<'_>,
+        grid: &GridSpec,
+        masks: &mut [u32],
+    ) -> bool {
+        if self.shapes.is_empty() {
+            return false;
+        }
+        let dx = grid.cell_size;
+        let inv_dx = 1.0 / dx;
+        // A stencil node is at most 1.5·√3 cells from its particle.
+        let reach = Vec3::splat(2.6 * dx);
+        let shapes = &self.shapes;
+        masks
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(ci, out)| {
+                let mut any = false;
+                for (k, mask) in out.iter_mut().enumerate() {
+                    let x = particles.positions[ci * CHUNK + k];
+                    for sh in shapes {
+                        if x.cmplt(sh.world_min - reach).any()
+                            || x.cmpgt(sh.world_max + reach).any()
+                        {
+                            continue;
+                        }
+                        let local = sh.inverse_rotation * (x - sh.world_position);
+                        let (base, _, _) =
+                            crate::math::quadratic_weights((x - grid.origin) * inv_dx);
+                        for bit in 0..27 {
+                            let (i, j, l) = (bit / 9, (bit / 3) % 3, bit % 3);
+                            let node = grid.origin
+                                + dx * Vec3::new(
+                                    (base[0] + i) as f32,
+                                    (base[1] + j) as f32,
+                                    (base[2] + l) as f32,
+                                );
+                            let node_local = sh.inverse_rotation * (node - sh.world_position);
+                            if sh.sdf.segment_hits(local, node_local) {
+                                *mask |= 1 << bit;
+                            }
+                        }
+                    }
+                    any |= *mask != 0;
+                }
+                any
+            })
+            .reduce(|| false, |a, b| a | b)
     }
 }

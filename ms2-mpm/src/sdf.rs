@@ -44,6 +44,19 @@ pub enum Sdf {
 }
 
 impl Sdf {
+    /// Whether the segment from local point `a` to local point `b` passes through the solid
+    /// (touches its inside). Exact for boxes (slab test); for the other shapes an
+    /// approximation that checks the two ends and the midpoint, enough for shapes thicker
+    /// than a grid cell.
+    pub fn segment_hits(&self, a: Vec3, b: Vec3) -> bool {
+        match self {
+            Sdf::Box { half_extents } => segment_hits_box(a, b, *half_extents),
+            _ => [a, b, 0.5 * (a + b)]
+                .iter()
+                .any(|p| self.distance_and_normal(*p).0 < 0.0),
+        }
+    }
+
     /// Signed distance (m) at local point `p` and the outward unit normal there.
     #[inline]
     pub fn distance_and_normal(&self, p: Vec3) -> (f32, Vec3) {
@@ -237,6 +250,33 @@ impl SdfVolume {
         };
         (d + extra, n)
     }
+}
+
+/// Slab test: does the segment `a → b` (local frame) meet the box `[-h, h]`?
+#[inline]
+fn segment_hits_box(a: Vec3, b: Vec3, h: Vec3) -> bool {
+    let d = b - a;
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for axis in 0..3 {
+        let (p, v, e) = (a[axis], d[axis], h[axis]);
+        if v.abs() < 1e-12 {
+            if p < -e || p > e {
+                return false;
+            }
+        } else {
+            let inv = 1.0 / v;
+            let (mut ta, mut tb) = ((-e - p) * inv, (e - p) * inv);
+            if ta > tb {
+                std::mem::swap(&mut ta, &mut tb);
+            }
+            t0 = t0.max(ta);
+            t1 = t1.min(tb);
+            if t0 > t1 {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 #[cfg(test)]

@@ -44,6 +44,22 @@ pub trait ParticleForces {
     /// Writes the force (N, world frame) on each particle into `forces` (zeroed on entry,
     /// same order as `particles`). `dt` is the substep length (s).
     fn particle_forces(&mut self, particles: ParticleView<'_>, dt: f32, forces: &mut [Vec3]);
+
+    /// Marks the grid nodes each particle must not exchange momentum with because a rigid
+    /// surface lies between them (compatible particle-in-cell, as in the MLS-MPM paper): bit
+    /// `(i·3 + j)·3 + k` of `masks[p]` stands for node `base + (i, j, k)` of particle `p`'s
+    /// quadratic stencil (`base = floor(x/dx − ½)` in grid coordinates). `masks` is zeroed
+    /// on entry. Without this, material on the two sides of a wall thinner than about three
+    /// cells shares grid nodes and drags itself through the wall. Returns whether any bit
+    /// was set; the default marks nothing.
+    fn blocked_nodes(
+        &mut self,
+        _particles: ParticleView<'_>,
+        _grid: &GridSpec,
+        _masks: &mut [u32],
+    ) -> bool {
+        false
+    }
 }
 
 /// Read-only view of the particles, in the solver's current order.
@@ -85,6 +101,7 @@ pub struct MpmSolver {
     /// No particle moved since the last sort.
     freshly_sorted: bool,
     forces: Vec<Vec3>,
+    blocked: Vec<u32>,
     next_id: ParticleId,
     substeps: u64,
 }
@@ -138,6 +155,7 @@ impl MpmSolver {
             needs_sort: true,
             freshly_sorted: false,
             forces: Vec::new(),
+            blocked: Vec::new(),
             next_id: 0,
             substeps: 0,
         })
@@ -336,6 +354,7 @@ impl MpmSolver {
             self.sort_particles();
         }
         let has_forces = external.is_some();
+        let mut has_blocked = false;
         if let Some(ext) = external {
             self.forces.clear();
             self.forces.resize(self.particles.len(), Vec3::ZERO);
@@ -347,6 +366,9 @@ impl MpmSolver {
                 ids: &p.id,
             };
             ext.particle_forces(view, dt, &mut self.forces);
+            self.blocked.clear();
+            self.blocked.resize(self.particles.len(), 0);
+            has_blocked = ext.blocked_nodes(view, &self.config.grid, &mut self.blocked);
         }
         self.grid.clear_active();
         let params = TransferParams {
@@ -354,6 +376,8 @@ impl MpmSolver {
             dt,
             materials: &self.compiled,
             forces: has_forces.then_some(&self.forces[..]),
+            blocked: has_blocked.then_some(&self.blocked[..]),
+            gravity: self.config.gravity,
         };
         particle_to_grid(&params, &mut self.particles, &self.binning, &mut self.grid);
         self.grid.update_velocities(
@@ -364,8 +388,7 @@ impl MpmSolver {
         );
         let (lo, hi) = self.usable_domain();
         let report = grid_to_particle(
-            &self.config.grid,
-            dt,
+            &params,
             lo,
             hi,
             &mut self.particles,

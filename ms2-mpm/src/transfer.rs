@@ -56,6 +56,11 @@ pub(crate) struct TransferParams<'a> {
     pub materials: &'a [CompiledMaterial],
     /// External force per particle (N), if any.
     pub forces: Option<&'a [Vec3]>,
+    /// Per particle, the stencil nodes across a rigid surface (see
+    /// [`crate::ParticleForces::blocked_nodes`]), if any.
+    pub blocked: Option<&'a [u32]>,
+    /// Gravity (m/s²), for the particle's own update on blocked nodes.
+    pub gravity: Vec3,
 }
 
 /// Particle to grid: updates each particle's deformation gradient (affine update, then the
@@ -116,6 +121,7 @@ pub(crate) fn particle_to_grid(
                     // Momentum at node offset (i, j, k): mv + affine·((i, j, k) − fx)·dx.
                     let a = affine * dx;
                     let m0 = mv - a * fx;
+                    let blocked = prm.blocked.map_or(0, |b| b[pi]);
                     let o = [
                         (base[0] - corner[0]) as usize,
                         (base[1] - corner[1]) as usize,
@@ -128,6 +134,9 @@ pub(crate) fn particle_to_grid(
                             let wij = w[0][i] * w[1][j];
                             let row = local_index(o[0] + i, o[1] + j, o[2]);
                             for k in 0..3 {
+                                if blocked != 0 && blocked & (1 << ((i * 3 + j) * 3 + k)) != 0 {
+                                    continue;
+                                }
                                 let wt = wij * w[2][k];
                                 let mom = (mij + a.z_axis * k as f32) * wt;
                                 let node = &mut local[row + k];
@@ -176,18 +185,19 @@ pub(crate) struct G2pReport {
 /// Grid to particle: gathers velocity and the APIC affine matrix, then advects the particle,
 /// confining it to `[lo, hi]` (m).
 pub(crate) fn grid_to_particle(
-    spec: &GridSpec,
-    dt: f32,
+    prm: &TransferParams<'_>,
     lo: Vec3,
     hi: Vec3,
     p: &mut Particles,
     binning: &Binning,
     grid: &GridStorage,
 ) -> G2pReport {
+    let (spec, dt) = (prm.spec, prm.dt);
     let dx = spec.cell_size;
     let inv_dx = 1.0 / dx;
     let origin = spec.origin;
     let bins = grid.bins;
+    let mass = &p.mass;
     let x_ptr = SyncPtr::new(p.x.as_mut_ptr());
     let v_ptr = SyncPtr::new(p.v.as_mut_ptr());
     let c_ptr = SyncPtr::new(p.c.as_mut_ptr());
@@ -229,6 +239,16 @@ pub(crate) fn grid_to_particle(
                 let mut vel = Vec3::ZERO;
                 // Σ w·v·(i, j, k)ᵀ, as three columns.
                 let mut b = [Vec3::ZERO; 3];
+                let pi = start + q;
+                let blocked = prm.blocked.map_or(0, |bl| bl[pi]);
+                // Blocked nodes stand in with the particle's own update (its velocity plus
+                // gravity and its external force), so it is not dragged across the surface.
+                let own = if blocked != 0 {
+                    let f = prm.forces.map_or(Vec3::ZERO, |f| f[pi]);
+                    vs[q] + dt * (prm.gravity + f / mass[pi])
+                } else {
+                    Vec3::ZERO
+                };
                 for i in 0..3 {
                     for j in 0..3 {
                         let wij = w[0][i] * w[1][j];
@@ -236,7 +256,13 @@ pub(crate) fn grid_to_particle(
                         for k in 0..3 {
                             let wt = wij * w[2][k];
                             let n = local[row + k];
-                            let gv = Vec3::new(n[0], n[1], n[2]) * wt;
+                            let node_v =
+                                if blocked != 0 && blocked & (1 << ((i * 3 + j) * 3 + k)) != 0 {
+                                    own
+                                } else {
+                                    Vec3::new(n[0], n[1], n[2])
+                                };
+                            let gv = node_v * wt;
                             vel += gv;
                             b[0] += gv * i as f32;
                             b[1] += gv * j as f32;

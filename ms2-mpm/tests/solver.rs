@@ -229,3 +229,50 @@ fn state_round_trip_and_particle_removal() {
         Err(ms2_mpm::MpmError::OutsideDomain { .. })
     ));
 }
+
+/// Clay block of 6 × 6 × 2 cm sliding along +x at `speed` (m/s) on a floor of friction
+/// coefficient `mu`; returns how far its centre of mass travels in `seconds` (m).
+fn slide_distance(mu: f32, speed: f32, seconds: f32) -> f32 {
+    let mut s = solver(Boundary::uniform(WallKind::Slip { friction: mu }));
+    let clay = s
+        .add_material(Material::clay(1000.0, 1e4, 0.3, 2e3))
+        .unwrap();
+    let floor = s.usable_domain().0.z;
+    let lo = Vec3::new(0.04, 0.13, floor);
+    let pts = sampling::sample_box(lo, lo + Vec3::new(0.06, 0.06, 0.02), SPACING);
+    s.add_particles(&pts, clay, SPACING.powi(3), Vec3::ZERO)
+        .unwrap();
+    // Let it settle onto the floor at rest, then launch it.
+    run(&mut s, 400);
+    let start = center_of_mass(&s).x;
+    let mut state = s.state();
+    for v in state.velocities.iter_mut() {
+        *v = Vec3::new(speed, 0.0, 0.0);
+    }
+    for c in state.affine_velocities.iter_mut() {
+        *c = Mat3::ZERO;
+    }
+    s.set_state(&state).unwrap();
+    let substeps = (seconds / s.config().substep_dt).round() as usize;
+    run(&mut s, substeps);
+    center_of_mass(&s).x - start
+}
+
+#[test]
+fn floor_friction_stops_a_sliding_block_as_coulomb_predicts() {
+    // Coulomb: a block launched at v on a floor of friction μ stops after v²/(2μg).
+    let (mu, v) = (0.5, 0.5);
+    let expected = v * v / (2.0 * mu * 9.81);
+    let with_friction = slide_distance(mu, v, 0.2);
+    eprintln!("slid {with_friction} expected {expected}");
+    assert!(
+        (0.6 * expected..1.4 * expected).contains(&with_friction),
+        "slid {with_friction} m on μ = {mu}; Coulomb predicts {expected} m"
+    );
+    // Without friction it keeps going (the clay's own plasticity aside).
+    let frictionless = slide_distance(0.0, v, 0.2);
+    assert!(
+        frictionless > 0.8 * v * 0.2,
+        "slid only {frictionless} m on a frictionless floor"
+    );
+}

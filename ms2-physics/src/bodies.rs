@@ -5,7 +5,7 @@ use nalgebra::{Point3, Vector3};
 use rapier3d::prelude::{ActiveHooks, RigidBodyHandle, RigidBodyType};
 
 use crate::articulation::{Articulation, ArticulationId};
-use crate::error::{check_finite, PhysicsError, Result};
+use crate::error::{check_finite, check_pose_finite, PhysicsError, Result};
 use crate::math::{pose_from_na, pose_to_na, vec_from_na, vec_to_na, Pose3};
 use crate::shape::{ShapeSpec, VisualShape};
 use crate::world::{BodyEntry, BodyId, BodyKind, ExcludedPairs, World};
@@ -135,18 +135,7 @@ impl World {
     /// actor counts as a configuration change (see [`World::set_state`]).
     pub fn set_body_pose(&mut self, body: BodyId, pose: &Pose3) -> Result<()> {
         let h = self.actor_handle(body, "pose")?;
-        check_finite(
-            || "body pose".into(),
-            &[
-                pose.translation.x,
-                pose.translation.y,
-                pose.translation.z,
-                pose.rotation.i,
-                pose.rotation.j,
-                pose.rotation.k,
-                pose.rotation.w,
-            ],
-        )?;
+        check_pose_finite(|| "body pose".into(), pose)?;
         let rb = &mut self.sim.bodies[h];
         rb.set_position(pose_from_na(pose), true);
         if rb.is_kinematic() {

@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+use crate::math::Pose3;
+
 /// Errors from loading a URDF robot description.
 ///
 /// Every variant names the file (`"<string>"` for descriptions given as text), the element and the
@@ -160,6 +162,32 @@ pub(crate) fn check_finite(what: impl FnOnce() -> String, values: &[f32]) -> Res
             index,
             value: values[index],
         }),
+    }
+}
+
+/// Checks that every component of `pose` (translation x, y, z, then quaternion i, j, k, w) is
+/// finite; `what` names the pose for the error.
+pub(crate) fn check_pose_finite(what: impl FnOnce() -> String, pose: &Pose3) -> Result<()> {
+    let t = &pose.translation;
+    let r = &pose.rotation;
+    check_finite(what, &[t.x, t.y, t.z, r.i, r.j, r.k, r.w])
+}
+
+/// Checks that parameter `name` is finite and `>= 0`; `expected` describes the valid range (with
+/// its unit) for the error.
+pub(crate) fn check_non_negative(
+    name: &'static str,
+    value: f32,
+    expected: &'static str,
+) -> Result<f32> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(PhysicsError::InvalidParameter {
+            name,
+            value: value.to_string(),
+            expected,
+        })
     }
 }
 

@@ -4,7 +4,7 @@ use nalgebra::{DVector, Vector3};
 use rapier3d::dynamics::{MotorModel, Multibody};
 
 use crate::articulation::{ArticulationId, DriveParams, JointInfo};
-use crate::error::{check_finite, check_len, PhysicsError, Result};
+use crate::error::{check_finite, check_len, check_pose_finite, PhysicsError, Result};
 use crate::math::{pose_from_na, vec_from_na, Pose3};
 use crate::shape::VisualShape;
 use crate::world::{BodyId, World};
@@ -191,12 +191,7 @@ impl World {
     /// same bits.
     pub fn set_qpos(&mut self, art: ArticulationId, qpos: &[f32]) -> Result<()> {
         let a = self.articulation_ref(art)?;
-        check_len(
-            || format!("qpos of \"{}\"", a.name),
-            a.dofs.len(),
-            qpos.len(),
-        )?;
-        check_finite(|| format!("qpos of \"{}\"", a.name), qpos)?;
+        check_joint_values(&a.name, "qpos", a.dofs.len(), qpos)?;
         let (dofs, mbi) = (a.dofs.clone(), a.multibody);
         let mb = self
             .sim
@@ -219,12 +214,7 @@ impl World {
     /// Sets the joint velocities (rad/s or m/s, dof order).
     pub fn set_qvel(&mut self, art: ArticulationId, qvel: &[f32]) -> Result<()> {
         let a = self.articulation_ref(art)?;
-        check_len(
-            || format!("qvel of \"{}\"", a.name),
-            a.dofs.len(),
-            qvel.len(),
-        )?;
-        check_finite(|| format!("qvel of \"{}\"", a.name), qvel)?;
+        check_joint_values(&a.name, "qvel", a.dofs.len(), qvel)?;
         let (dofs, mbi) = (a.dofs.clone(), a.multibody);
         let mb = self
             .sim
@@ -275,18 +265,7 @@ impl World {
     pub fn set_root_pose(&mut self, art: ArticulationId, pose: &Pose3) -> Result<()> {
         let a = self.articulation_ref(art)?;
         let (root, mbi) = (a.bodies[0], a.multibody);
-        check_finite(
-            || "root pose".into(),
-            &[
-                pose.translation.x,
-                pose.translation.y,
-                pose.translation.z,
-                pose.rotation.i,
-                pose.rotation.j,
-                pose.rotation.k,
-                pose.rotation.w,
-            ],
-        )?;
+        check_pose_finite(|| "root pose".into(), pose)?;
         let h = self.table[root.index()].handle;
         self.sim.bodies[h].set_position(pose_from_na(pose), true);
         let mb = self
@@ -304,11 +283,7 @@ impl World {
     pub fn set_drive(&mut self, art: ArticulationId, dof: usize, drive: DriveParams) -> Result<()> {
         drive.validate()?;
         let a = self.articulation_ref(art)?;
-        let d = *a.dofs.get(dof).ok_or(PhysicsError::InvalidParameter {
-            name: "dof",
-            value: dof.to_string(),
-            expected: "an index below the articulation's dof count",
-        })?;
+        let d = *a.dofs.get(dof).ok_or_else(|| bad_dof(dof))?;
         let mbi = a.multibody;
         let mb = self
             .sim
@@ -348,11 +323,7 @@ impl World {
     /// The PD drive of one degree of freedom (zero gains if never set).
     pub fn drive(&self, art: ArticulationId, dof: usize) -> Result<DriveParams> {
         let a = self.articulation_ref(art)?;
-        let d = *a.dofs.get(dof).ok_or(PhysicsError::InvalidParameter {
-            name: "dof",
-            value: dof.to_string(),
-            expected: "an index below the articulation's dof count",
-        })?;
+        let d = *a.dofs.get(dof).ok_or_else(|| bad_dof(dof))?;
         let mb = self.multibody(art)?;
         let data = &mb.link(d.mb_link).expect("link").joint.data;
         Ok(data
@@ -380,19 +351,9 @@ impl World {
     ) -> Result<()> {
         let a = self.articulation_ref(art)?;
         let n = a.dofs.len();
-        let expected = dofs.map_or(n, <[usize]>::len);
-        check_len(
-            || format!("{what} of \"{}\"", a.name),
-            expected,
-            values.len(),
-        )?;
-        check_finite(|| format!("{what} of \"{}\"", a.name), values)?;
-        if let Some(bad) = dofs.and_then(|d| d.iter().find(|&&i| i >= n)) {
-            return Err(PhysicsError::InvalidParameter {
-                name: "dof",
-                value: bad.to_string(),
-                expected: "an index below the articulation's dof count",
-            });
+        check_joint_values(&a.name, what, dofs.map_or(n, <[usize]>::len), values)?;
+        if let Some(&bad) = dofs.and_then(|d| d.iter().find(|&&i| i >= n)) {
+            return Err(bad_dof(bad));
         }
         let all: Vec<usize>;
         let indices = match dofs {
@@ -484,5 +445,30 @@ impl World {
     /// The drives' velocity targets (dof order).
     pub fn drive_velocity_targets(&self, art: ArticulationId) -> Result<Vec<f32>> {
         self.read_targets(art, true)
+    }
+}
+
+/// Checks that `values` (the `what` of articulation `articulation`, e.g. its qpos) has `expected`
+/// entries, all finite.
+fn check_joint_values(
+    articulation: &str,
+    what: &str,
+    expected: usize,
+    values: &[f32],
+) -> Result<()> {
+    check_len(
+        || format!("{what} of \"{articulation}\""),
+        expected,
+        values.len(),
+    )?;
+    check_finite(|| format!("{what} of \"{articulation}\""), values)
+}
+
+/// The error for a dof index past the articulation's dof count.
+fn bad_dof(dof: usize) -> PhysicsError {
+    PhysicsError::InvalidParameter {
+        name: "dof",
+        value: dof.to_string(),
+        expected: "an index below the articulation's dof count",
     }
 }

@@ -6,7 +6,7 @@
 use nalgebra::{Point3, Vector3};
 use rapier3d::prelude::{ColliderBuilder, SharedShape};
 
-use crate::error::{PhysicsError, Result};
+use crate::error::{check_non_negative, PhysicsError, Result};
 use crate::math::{pose_from_na, vec_from_na, Pose3};
 
 /// A collision (or visual) geometry in its own frame.
@@ -334,26 +334,12 @@ impl ShapeSpec {
             .friction(self.material.static_friction)
             .restitution(self.material.restitution);
         b = match self.mass {
-            MassSpec::Density(d) => {
-                if !(d.is_finite() && d >= 0.0) {
-                    return Err(PhysicsError::InvalidParameter {
-                        name: "density",
-                        value: d.to_string(),
-                        expected: "a finite density >= 0 in kg/m^3",
-                    });
-                }
-                b.density(d)
-            }
-            MassSpec::Mass(m) => {
-                if !(m.is_finite() && m >= 0.0) {
-                    return Err(PhysicsError::InvalidParameter {
-                        name: "mass",
-                        value: m.to_string(),
-                        expected: "a finite mass >= 0 in kg",
-                    });
-                }
-                b.mass(m)
-            }
+            MassSpec::Density(d) => b.density(check_non_negative(
+                "density",
+                d,
+                "a finite density >= 0 in kg/m^3",
+            )?),
+            MassSpec::Mass(m) => b.mass(check_non_negative("mass", m, "a finite mass >= 0 in kg")?),
             MassSpec::Massless => b.density(0.0),
         };
         Ok(b)

@@ -13,7 +13,7 @@ use rapier3d::prelude::{
 
 use crate::articulation::{Articulation, ArticulationId};
 use crate::config::WorldConfig;
-use crate::error::{check_finite, PhysicsError, Result};
+use crate::error::{check_finite, check_non_negative, check_pose_finite, PhysicsError, Result};
 use crate::math::{pose_from_na, vec_from_na, Pose3};
 use crate::shape::{ShapeSpec, VisualShape};
 use crate::state::SnapshotCache;
@@ -305,15 +305,7 @@ impl World {
     /// Errors: a triangle mesh on a non-static actor, an invalid shape, material or mass, or a
     /// non-finite pose.
     pub fn add_actor(&mut self, desc: ActorDesc) -> Result<BodyId> {
-        let pose_values: Vec<f32> = desc
-            .pose
-            .translation
-            .vector
-            .iter()
-            .chain(desc.pose.rotation.coords.iter())
-            .copied()
-            .collect();
-        check_finite(|| format!("pose of actor \"{}\"", desc.name), &pose_values)?;
+        check_pose_finite(|| format!("pose of actor \"{}\"", desc.name), &desc.pose)?;
         if desc.kind != ActorKind::Static {
             if let Some(s) = desc.shapes.iter().find(|s| s.shape.is_static_only()) {
                 let _ = s;
@@ -328,13 +320,7 @@ impl World {
             ("linear_damping", desc.linear_damping),
             ("angular_damping", desc.angular_damping),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(PhysicsError::InvalidParameter {
-                    name,
-                    value: v.to_string(),
-                    expected: "a finite damping >= 0 in 1/s",
-                });
-            }
+            check_non_negative(name, v, "a finite damping >= 0 in 1/s")?;
         }
         let builders = desc
             .shapes

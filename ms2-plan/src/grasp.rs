@@ -150,7 +150,8 @@ pub fn box_grasp_poses(object: &OrientedBox, gripper: &GripperSpec) -> Vec<Grasp
     poses
 }
 
-/// Grasps of `object` that the robot can reach from near `seed` (IK) without collisions.
+/// Grasps of `object` that the robot can reach from near `seed` (IK) without collisions: the
+/// poses of [`box_grasp_poses`] filtered by [`reachable_grasps`].
 ///
 /// `scene` should contain the object itself as `object_name` (it is allowed to touch the
 /// gripper's `touch_links`, nothing else); pass `None` if it is not in the scene. Results are
@@ -164,6 +165,48 @@ pub fn find_grasps<R: PlanningRobot + ?Sized>(
     scene: &CollisionScene,
     object_name: Option<&str>,
     object: &OrientedBox,
+    gripper: &GripperSpec,
+    seed: &[f64],
+    options: CheckerOptions,
+) -> Result<Vec<GraspCandidate>, PlanError> {
+    let mut found = reachable_grasps(
+        robot,
+        scene,
+        object_name,
+        box_grasp_poses(object, gripper),
+        gripper,
+        seed,
+        options,
+    )?;
+    let distance = |q: &[f64]| {
+        q.iter()
+            .zip(seed)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+    };
+    found.sort_by(|a, b| {
+        let rank = |c: &GraspCandidate| u8::from(c.grasp.kind != GraspKind::TopDown);
+        rank(a)
+            .cmp(&rank(b))
+            .then(distance(&a.configuration).total_cmp(&distance(&b.configuration)))
+    });
+    Ok(found)
+}
+
+/// The grasp poses (in the given order) that the robot reaches from near `seed` (IK) without
+/// collisions, with a reachable, collision-free pre-grasp pose if `gripper` asks for one.
+///
+/// `scene` should contain the grasped object as `object_name` (allowed to touch the gripper's
+/// `touch_links`); pass `None` if it is not in the scene.
+///
+/// # Errors
+/// Malformed `seed`, unknown links/objects, bad gripper settings, or
+/// [`PlanError::NoGraspFound`] if no pose passes.
+pub fn reachable_grasps<R: PlanningRobot + ?Sized>(
+    robot: &R,
+    scene: &CollisionScene,
+    object_name: Option<&str>,
+    poses: impl IntoIterator<Item = GraspPose>,
     gripper: &GripperSpec,
     seed: &[f64],
     options: CheckerOptions,
@@ -185,10 +228,10 @@ pub fn find_grasps<R: PlanningRobot + ?Sized>(
         }
     }
     let checker = CollisionChecker::new(robot, &scene, options)?;
-    let poses = box_grasp_poses(object, gripper);
-    let candidates = poses.len();
+    let mut candidates = 0;
     let mut found: Vec<GraspCandidate> = Vec::new();
     for grasp in poses {
+        candidates += 1;
         let Ok(q) = robot.inverse_kinematics(&grasp.pose_base_from_tcp, seed) else {
             continue;
         };
@@ -196,9 +239,7 @@ pub fn find_grasps<R: PlanningRobot + ?Sized>(
             continue;
         }
         let pre_grasp_configuration = if gripper.pre_grasp_distance > 0.0 {
-            let back = Translation3::new(0.0, 0.0, -gripper.pre_grasp_distance);
-            let pre = grasp.pose_base_from_tcp * back;
-            match robot.inverse_kinematics(&pre, &q) {
+            match robot.inverse_kinematics(&grasp.pre_grasp_pose(gripper.pre_grasp_distance), &q) {
                 Ok(qp) if checker.is_valid(&qp) => Some(qp),
                 _ => continue,
             }
@@ -214,19 +255,40 @@ pub fn find_grasps<R: PlanningRobot + ?Sized>(
     if found.is_empty() {
         return Err(PlanError::NoGraspFound { candidates });
     }
-    let distance = |q: &[f64]| {
-        q.iter()
-            .zip(seed)
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum::<f64>()
-    };
-    found.sort_by(|a, b| {
-        let rank = |c: &GraspCandidate| u8::from(c.grasp.kind != GraspKind::TopDown);
-        rank(a)
-            .cmp(&rank(b))
-            .then(distance(&a.configuration).total_cmp(&distance(&b.configuration)))
-    });
     Ok(found)
+}
+
+impl GraspPose {
+    /// The TCP pose backed off `distance` (m) against the approach direction.
+    pub fn pre_grasp_pose(&self, distance: f64) -> Isometry3<f64> {
+        self.pose_base_from_tcp * Translation3::new(0.0, 0.0, -distance)
+    }
+
+    /// The same grasp with the approach direction turned by `angle` (rad) about the closing
+    /// axis through the TCP: the fingers stay on the same two faces. Useful to reach objects at
+    /// the edge of the workspace with a tilted hand. The kind is kept.
+    ///
+    /// ```
+    /// use ms2_plan::{GraspKind, GraspPose};
+    /// use nalgebra::{Isometry3, Vector3};
+    /// let down = GraspPose {
+    ///     pose_base_from_tcp: Isometry3::new(Vector3::new(0.5, 0.0, 0.02), Vector3::new(std::f64::consts::PI, 0.0, 0.0)),
+    ///     kind: GraspKind::TopDown,
+    ///     width: 0.04,
+    /// };
+    /// let tilted = down.tilted_about_closing_axis(0.3);
+    /// let closing = |g: &GraspPose| g.pose_base_from_tcp.rotation * Vector3::y();
+    /// assert!((closing(&tilted) - closing(&down)).norm() < 1e-12);
+    /// assert!((tilted.pose_base_from_tcp.translation.vector - down.pose_base_from_tcp.translation.vector).norm() < 1e-12);
+    /// ```
+    pub fn tilted_about_closing_axis(&self, angle: f64) -> GraspPose {
+        let turn = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), angle);
+        GraspPose {
+            pose_base_from_tcp: self.pose_base_from_tcp
+                * Isometry3::from_parts(Translation3::identity(), turn),
+            ..*self
+        }
+    }
 }
 
 #[cfg(test)]

@@ -6,7 +6,8 @@
 //! - [`plan_screw_path`]: Cartesian motions of the TCP along a screw, through IK.
 //! - [`parameterize`]: time-optimal rest-to-rest timing under joint velocity and acceleration
 //!   limits (TOPP-RA), sampled at the control frequency as a [`JointTrajectory`].
-//! - [`box_grasp_poses`] / [`find_grasps`]: top-down and side grasps of box-like objects,
+//! - [`box_grasp_poses`] / [`find_grasps`] / [`reachable_grasps`]: top-down and side grasps of
+//!   box-like objects (tilted variants: [`GraspPose::tilted_about_closing_axis`]),
 //!   filtered by IK reachability and collisions.
 //! - [`MotionPlanner`]: the facade tying these together, seeded for reproducible plans.
 //!
@@ -54,7 +55,8 @@ pub use checker::{Body, CheckerOptions, CollisionChecker, Contact};
 pub use convert::{pose_from_parry, pose_to_parry, vector_to_parry};
 pub use error::PlanError;
 pub use grasp::{
-    box_grasp_poses, find_grasps, GraspCandidate, GraspKind, GraspPose, GripperSpec, OrientedBox,
+    box_grasp_poses, find_grasps, reachable_grasps, GraspCandidate, GraspKind, GraspPose,
+    GripperSpec, OrientedBox,
 };
 #[cfg(feature = "control")]
 pub use kinematic_robot::{KinematicRobot, PANDA_MAX_ACCELERATIONS};

@@ -1,6 +1,6 @@
 //! `solve_episodes`: runs the motion-planning solutions over seeds in parallel.
 
-use ms2_tasks::demos::solutions::{solution_env_ids as native_solution_env_ids, solve_episode};
+use ms2_tasks::demos::solutions::{solution_env_ids as native_solution_env_ids, DemoSolver};
 use ms2_tasks::demos::{DemoEpisode, DemoError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -35,9 +35,16 @@ pub fn solve_episodes<'py>(
     let results: Vec<Result<DemoEpisode, DemoError>> = py.detach(|| {
         catch_panics(|| {
             in_pool(num_workers, || {
+                // One solver (env + planners) per worker, reused across its seeds.
                 seeds
                     .par_iter()
-                    .map(|&seed| solve_episode(&cfg, seed))
+                    .map_init(
+                        || DemoSolver::new(&cfg),
+                        |solver, &seed| match solver {
+                            Ok(solver) => solver.solve(seed).map(|(episode, _)| episode),
+                            Err(err) => Err(err.clone()),
+                        },
+                    )
                     .collect()
             })
         })

@@ -57,6 +57,16 @@ fn num_threads() -> usize {
     rayon::current_num_threads()
 }
 
+/// The adapter the process-wide renderer draws with, e.g. `"llvmpipe (LLVM 15.0.6, 256 bits)
+/// (Vulkan, Cpu)"`; creates the renderer on first call. `RuntimeError` when no adapter exists.
+#[pyfunction]
+fn render_adapter() -> PyResult<String> {
+    let ctx =
+        ms2_tasks::adapters::RenderContext::shared().map_err(|e| errors::env_error_to_py(&e))?;
+    let a = ctx.renderer().adapter();
+    Ok(format!("{} ({}, {})", a.name, a.backend, a.device_type))
+}
+
 /// The extension module `ms2._native`.
 #[pymodule]
 #[pyo3(name = "_native")]
@@ -66,6 +76,7 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<policy::NativeScriptedPolicy>()?;
     m.add_function(wrap_pyfunction!(env_ids, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(render_adapter, m)?)?;
     m.add_function(wrap_pyfunction!(default_max_episode_steps, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add_function(wrap_pyfunction!(demos_solve::solve_episodes, m)?)?;

@@ -300,4 +300,10 @@ impl NativeVecEnv {
         })?;
         Ok(PyArray1::from_vec(py, env.get_state()))
     }
+
+    /// Triangles drawn per observation camera in the last render (0 before any render).
+    fn triangles_per_camera(&self) -> PyResult<usize> {
+        let state = lock(&self.inner, "vector env")?;
+        Ok(state.envs.envs()[0].triangles_per_camera())
+    }
 }

@@ -58,5 +58,23 @@ def test_python_dash_m_and_bench_smoke():
     assert len(rows) == 2, out
     assert "make_vec(2)" in rows[1]
     for row in rows:
-        steps_per_s, peak_rss = float(row.split()[-4]), float(row.split()[-1])
+        # ... steps/s, x our single, x MS2 single, peak RSS MB, load
+        steps_per_s, peak_rss = float(row.split()[-5]), float(row.split()[-2])
         assert steps_per_s > 0 and peak_rss > 10
+
+
+def test_bench_visual_smoke():
+    out = subprocess.run(
+        [sys.executable, "-m", "ms2", "bench", "--visual", "--steps", "10", "--num-envs", "2"]
+        + ["--obs-modes", "rgbd", "--env-id", "PickCube-v0"],
+        check=True,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    ).stdout
+    rows = [line for line in out.splitlines() if line.startswith("rgbd")]
+    assert len(rows) == 2 and "make_vec(2)" in rows[1], out
+    for row in rows:
+        # ... steps/s, x our single, x MS2 single, peak RSS MB, triangles/cam, load
+        fields = row.split()
+        assert float(fields[-6]) > 0 and float(fields[-3]) > 10 and int(fields[-2]) > 100

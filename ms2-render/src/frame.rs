@@ -41,6 +41,8 @@ fn instance_record(instance: &crate::Instance) -> [u32; 32] {
     }
     words[28] = instance.segmentation.actor;
     words[29] = instance.segmentation.link;
+    // Untextured instances skip the texture fetch in the fragment shader.
+    words[30] = u32::from(instance.material.texture.is_some());
     words
 }
 

@@ -102,7 +102,11 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
     if (!front) {
         n = -n;
     }
-    let albedo = in.base_color.rgb * textureSample(base_texture, base_sampler, in.uv).rgb;
+    var texel = vec3<f32>(1.0);
+    if (in.ids.z != 0u) {
+        texel = textureSampleLevel(base_texture, base_sampler, in.uv, 0.0).rgb;
+    }
+    let albedo = in.base_color.rgb * texel;
     let to_eye = normalize(camera.eye_world.xyz - in.world_position);
     var light = camera.ambient.rgb * albedo;
     let sun = sun_visibility(in.world_position);
@@ -110,7 +114,12 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front: bool) -> FragmentOut {
         let l = -camera.light_direction[i].xyz;
         let lambert = max(dot(n, l), 0.0);
         let h = normalize(l + to_eye);
-        let specular = select(0.0, pow(max(dot(n, h), 0.0), 32.0), lambert > 0.0);
+        let s1 = max(dot(n, h), 0.0);
+        let s2 = s1 * s1;
+        let s4 = s2 * s2;
+        let s8 = s4 * s4;
+        let s16 = s8 * s8;
+        let specular = select(0.0, s16 * s16, lambert > 0.0);
         let visible = select(1.0, sun, i == 0u);
         light = light + visible * camera.light_color[i].rgb * (albedo * lambert + vec3<f32>(0.15 * specular));
     }

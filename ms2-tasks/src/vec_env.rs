@@ -8,8 +8,8 @@ use crate::env::{Env, StepOutput};
 use crate::error::EnvError;
 use crate::info::Info;
 use crate::obs::ObsValue;
-use crate::sensors::batch::BatchItem;
-use crate::sensors::{capture_batch, visual_obs, CameraFrame};
+use crate::sensors::batch::{submit_batch, BatchItem, PendingBatch};
+use crate::sensors::{visual_obs, CameraFrame, VisualLayout};
 
 /// What one env does during [`VecEnv::run`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,10 +29,10 @@ pub enum EnvCommand<'a> {
 /// layer implements gymnasium's).
 ///
 /// In visual obs modes a vector step has three phases: physics (and the poses of every env's
-/// render scene and cameras) of all envs in parallel; one batched render of every camera of
-/// every env (one GPU submission, one readback: [`capture_batch`]); then observation assembly
-/// (point-cloud fusion, robot masks) in parallel. The images equal those of stepping each env
-/// alone.
+/// render scene and cameras) in parallel; batched rendering of every camera (one GPU
+/// submission and one readback per half of the envs, pipelined with the other half's physics:
+/// [`submit_batch`]); then observation assembly (point-cloud fusion, robot masks) in
+/// parallel. The images equal those of stepping each env alone.
 ///
 /// ```
 /// use ms2_tasks::{EnvConfig, VecEnv};
@@ -46,6 +46,8 @@ pub enum EnvCommand<'a> {
 pub struct VecEnv {
     envs: Vec<Env>,
     action_dim: usize,
+    /// Whether visual steps render in two pipelined halves (see [`VecEnv::run`]).
+    pipelined: bool,
 }
 
 impl VecEnv {
@@ -61,7 +63,11 @@ impl VecEnv {
             .map(|_| Env::new(cfg))
             .collect::<Result<Vec<_>, _>>()?;
         let action_dim = envs[0].action_space().size();
-        Ok(VecEnv { envs, action_dim })
+        Ok(VecEnv {
+            envs,
+            action_dim,
+            pipelined: true,
+        })
     }
 
     /// Number of envs.
@@ -77,6 +83,13 @@ impl VecEnv {
     /// The envs, mutably (e.g. to reset one after its episode ended).
     pub fn envs_mut(&mut self) -> &mut [Env] {
         &mut self.envs
+    }
+
+    /// Turns the two-half render pipeline of visual steps on (the default) or off (all envs'
+    /// physics, then one batch of all cameras). The outputs are the same either way; this is
+    /// for measuring the overlap.
+    pub fn set_pipelined_rendering(&mut self, pipelined: bool) {
+        self.pipelined = pipelined;
     }
 
     /// Resets every env; `seeds` has one entry per env (`None` = draw from that env's RNG).
@@ -123,6 +136,11 @@ impl VecEnv {
     /// Runs one command per env in parallel and returns, per env, its step output (`None` for
     /// [`EnvCommand::Keep`]). A reset reports its first observation and info with reward 0
     /// and both flags false (gymnasium's "next step" autoreset convention).
+    ///
+    /// In visual modes the envs run as two halves in a pipeline: the first half's physics,
+    /// then its cameras are submitted in one batch; the second half's physics runs while the
+    /// first half renders, then its batch is submitted; observations are assembled as each
+    /// batch arrives.
     pub fn run(
         &mut self,
         commands: &[EnvCommand<'_>],
@@ -134,64 +152,98 @@ impl VecEnv {
                 commands.len()
             )));
         }
-        let visual = self.envs[0].visual_layout();
-        // Phase 1: physics; visual envs also pose their render scenes and cameras.
-        let phase1: Vec<Option<(StepOutput, Vec<ms2_render::Camera>)>> = self
-            .envs
-            .par_iter_mut()
-            .zip(commands.par_iter())
-            .map(|(env, command)| {
-                let out = match *command {
-                    EnvCommand::Keep => return Ok(None),
-                    EnvCommand::Step(action) => env.step_deferred(action)?,
-                    EnvCommand::Reset { seed } => {
-                        let (obs, info) = env.reset_deferred(seed)?;
-                        StepOutput {
-                            obs,
-                            reward: 0.0,
-                            terminated: false,
-                            truncated: false,
-                            info,
-                        }
-                    }
-                };
-                let cameras = match visual {
-                    Some(_) => env.prepare_cameras()?,
-                    None => Vec::new(),
-                };
-                Ok(Some((out, cameras)))
-            })
-            .collect::<Result<_, EnvError>>()?;
-        let Some((layout, robot_seg)) = visual else {
-            return Ok(phase1.into_iter().map(|p| p.map(|(out, _)| out)).collect());
+        let Some((layout, robot_seg)) = self.envs[0].visual_layout() else {
+            let stepped = simulate(&mut self.envs, commands, false)?;
+            return Ok(stepped.into_iter().map(|s| s.map(|(out, _)| out)).collect());
         };
-        // Phase 2: every camera of every env in one submission.
-        let mut frames = {
-            let items: Vec<BatchItem<'_>> = self
-                .envs
-                .iter_mut()
-                .zip(&phase1)
-                .filter_map(|(env, p)| {
-                    p.as_ref()
-                        .map(|(_, cameras)| env.sensors().map(|s| (s, &cameras[..])))
-                })
-                .collect::<Result<_, EnvError>>()?;
-            capture_batch(&items)?.into_iter()
+        let n = self.envs.len();
+        let split = if n >= 2 && self.pipelined {
+            n.div_ceil(2)
+        } else {
+            n
         };
-        let frames: Vec<Option<CameraFrame>> = phase1
-            .iter()
-            .map(|p| p.as_ref().and_then(|_| frames.next()))
-            .collect();
-        // Phase 3: observations (copies of images, fused point clouds, masks) in parallel.
-        Ok(phase1
-            .into_par_iter()
-            .zip(frames)
-            .map(|(p, frame)| {
-                let (mut out, _) = p?;
-                let state_dict = std::mem::replace(&mut out.obs, ObsValue::Dict(Vec::new()));
-                out.obs = visual_obs::assemble(state_dict, frame?, layout, robot_seg);
-                Some(out)
-            })
-            .collect())
+        let (first_envs, second_envs) = self.envs.split_at_mut(split);
+        let (first_commands, second_commands) = commands.split_at(split);
+        let first = simulate(first_envs, first_commands, true)?;
+        let first_batch = submit(first_envs, &first)?;
+        let second = simulate(second_envs, second_commands, true)?;
+        let second_batch = submit(second_envs, &second)?;
+        let mut outs = assemble(first, first_batch.wait()?, layout, robot_seg);
+        outs.extend(assemble(second, second_batch.wait()?, layout, robot_seg));
+        Ok(outs)
     }
+}
+
+/// An env's step output before its images, and its cameras posed for rendering (`None` for
+/// [`EnvCommand::Keep`]).
+type Simulated = Option<(StepOutput, Vec<ms2_render::Camera>)>;
+
+/// Runs the commands' physics in parallel; with `visual`, also poses each env's render scene
+/// and cameras.
+fn simulate(
+    envs: &mut [Env],
+    commands: &[EnvCommand<'_>],
+    visual: bool,
+) -> Result<Vec<Simulated>, EnvError> {
+    envs.par_iter_mut()
+        .zip(commands.par_iter())
+        .map(|(env, command)| {
+            let out = match *command {
+                EnvCommand::Keep => return Ok(None),
+                EnvCommand::Step(action) => env.step_deferred(action)?,
+                EnvCommand::Reset { seed } => {
+                    let (obs, info) = env.reset_deferred(seed)?;
+                    StepOutput {
+                        obs,
+                        reward: 0.0,
+                        terminated: false,
+                        truncated: false,
+                        info,
+                    }
+                }
+            };
+            let cameras = match visual {
+                true => env.prepare_cameras()?,
+                false => Vec::new(),
+            };
+            Ok(Some((out, cameras)))
+        })
+        .collect()
+}
+
+/// Submits every camera of the simulated envs in one batch.
+fn submit(envs: &mut [Env], simulated: &[Simulated]) -> Result<PendingBatch, EnvError> {
+    let items: Vec<BatchItem<'_>> = envs
+        .iter_mut()
+        .zip(simulated)
+        .filter_map(|(env, s)| {
+            s.as_ref()
+                .map(|(_, cameras)| env.sensors().map(|sensors| (sensors, &cameras[..])))
+        })
+        .collect::<Result<_, EnvError>>()?;
+    submit_batch(&items)
+}
+
+/// The visual observations (image copies, fused point clouds, masks), in parallel.
+fn assemble(
+    simulated: Vec<Simulated>,
+    frames: Vec<CameraFrame>,
+    layout: VisualLayout,
+    robot_seg: bool,
+) -> Vec<Option<StepOutput>> {
+    let mut frames = frames.into_iter();
+    let frames: Vec<Option<CameraFrame>> = simulated
+        .iter()
+        .map(|s| s.as_ref().and_then(|_| frames.next()))
+        .collect();
+    simulated
+        .into_par_iter()
+        .zip(frames)
+        .map(|(s, frame)| {
+            let (mut out, _) = s?;
+            let state_dict = std::mem::replace(&mut out.obs, ObsValue::Dict(Vec::new()));
+            out.obs = visual_obs::assemble(state_dict, frame?, layout, robot_seg);
+            Some(out)
+        })
+        .collect()
 }

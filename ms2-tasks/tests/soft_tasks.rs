@@ -109,7 +109,7 @@ fn unsupported_shapes_are_refused_by_name() {
     ));
 }
 
-use ms2_tasks::tasks::soft::excavate::{ExcavateScene, ScriptedScoop, MAX_SPILLED};
+use ms2_tasks::tasks::soft::excavate::{ExcavateScene, ScriptedScoop};
 
 /// Runs the scripted scoop for `steps` control steps.
 fn run_scoop(scene: &mut ExcavateScene, plan: &ScriptedScoop, from: u32, steps: u32) {
@@ -123,20 +123,35 @@ fn scripted_sweep_collects_clay_in_the_bucket() {
     let mut scene = ExcavateScene::new(7).unwrap();
     let plan = ScriptedScoop::plan(&scene);
     assert_eq!(scene.evaluate().particles_in_bucket, 0);
-    // Lower the bucket onto the floor and slide it into the bed (the first 14 control steps).
-    run_scoop(&mut scene, &plan, 0, 14);
+    // Lower the bucket onto the floor and slide it into the bed (the first 20 control steps).
+    run_scoop(&mut scene, &plan, 0, 20);
     let eval = scene.evaluate();
     assert!(
         eval.particles_in_bucket > 50,
         "only {} particles in the bucket after the sweep",
         eval.particles_in_bucket
     );
-    assert!(
-        eval.spilled < MAX_SPILLED,
-        "{} particles spilled during the sweep",
-        eval.spilled
-    );
     assert!(!eval.success, "clay on the floor cannot be a success");
+}
+
+#[test]
+fn scripted_scoop_lifts_clay_above_the_target_height() {
+    let mut scene = ExcavateScene::new(11).unwrap();
+    let plan = ScriptedScoop::plan(&scene);
+    // Sweep, curl and lift (48 control steps), then 4 steps at rest.
+    run_scoop(&mut scene, &plan, 0, 52);
+    let eval = scene.evaluate();
+    assert!(
+        eval.particles_in_bucket >= 150,
+        "only {} particles lifted in the bucket",
+        eval.particles_in_bucket
+    );
+    assert!(
+        eval.lowest_in_bucket > scene.target_height(),
+        "lowest clay in the bucket at {} m, target height {} m",
+        eval.lowest_in_bucket,
+        scene.target_height()
+    );
 }
 
 #[test]

@@ -2,8 +2,11 @@
 
 Each configuration runs in a fresh Python process (``ms2 bench --worker ...``) so its peak
 resident memory is its own. Actions are uniform random within the action space (pre-drawn, so
-the timing is the env's), observations are ``state``; episodes that end are reset inside the
-timed loop, as a training loop would.
+the timing is the env's); episodes that end are reset inside the timed loop, as a training loop
+would. Observations are ``state`` by default; ``ms2 bench --visual`` measures the visual obs
+modes (``rgbd`` and ``pointcloud``, ManiSkill2's two 128×128 cameras) and also prints the
+triangles drawn per camera and the render adapter. Every row shows the 1-minute load average
+at its start, since other processes on the machine change the figures.
 """
 
 from __future__ import annotations
@@ -22,6 +25,9 @@ import numpy as np
 #: single-env steps/s per control mode, and its peak RSS.
 MANISKILL2_SINGLE_STEPS_PER_S = {"pd_ee_delta_pose": 556.0, "pd_joint_delta_pos": 648.0}
 MANISKILL2_PEAK_RSS_MB = 336.0
+#: ManiSkill2 0.5.3, same machine, PickCube-v0 single env in rgbd / pointcloud (lavapipe, 2
+#: cameras 128×128: base_camera + hand_camera): ~18 steps/s in both.
+MANISKILL2_VISUAL_STEPS_PER_S = 18.0
 
 
 def _peak_rss_mb() -> float:
@@ -34,12 +40,12 @@ def _random_actions(low: np.ndarray, high: np.ndarray, count: int, seed: int) ->
     return rng.uniform(low, high, size=(count, *low.shape)).astype(np.float32)
 
 
-def _run_single(env_id: str, control_mode: str, steps: int) -> dict:
+def _run_single(env_id: str, control_mode: str, obs_mode: str, steps: int) -> dict:
     import gymnasium as gym
 
     import ms2  # noqa: F401  (registers the envs)
 
-    env = gym.make(env_id, obs_mode="state", control_mode=control_mode)
+    env = gym.make(env_id, obs_mode=obs_mode, control_mode=control_mode)
     space = env.action_space
     actions = _random_actions(space.low, space.high, 1024, seed=1)
     env.reset(seed=0)
@@ -52,13 +58,18 @@ def _run_single(env_id: str, control_mode: str, steps: int) -> dict:
         if terminated or truncated:
             env.reset()
     elapsed = time.perf_counter() - started
-    return {"steps_per_s": steps / elapsed, "seconds": elapsed, "env_steps": steps}
+    return {
+        "steps_per_s": steps / elapsed,
+        "seconds": elapsed,
+        "env_steps": steps,
+        "triangles_per_camera": env.unwrapped._native.triangles_per_camera(),
+    }
 
 
-def _run_vec(env_id: str, control_mode: str, num_envs: int, steps: int) -> dict:
+def _run_vec(env_id: str, control_mode: str, obs_mode: str, num_envs: int, steps: int) -> dict:
     import ms2
 
-    envs = ms2.make_vec(env_id, num_envs=num_envs, obs_mode="state", control_mode=control_mode)
+    envs = ms2.make_vec(env_id, num_envs=num_envs, obs_mode=obs_mode, control_mode=control_mode)
     space = envs.single_action_space
     actions = _random_actions(space.low, space.high, 256 * num_envs, seed=1)
     actions = actions.reshape(256, num_envs, *space.shape)
@@ -74,15 +85,19 @@ def _run_vec(env_id: str, control_mode: str, num_envs: int, steps: int) -> dict:
         "steps_per_s": batches * num_envs / elapsed,
         "seconds": elapsed,
         "env_steps": batches * num_envs,
+        "triangles_per_camera": envs._native.triangles_per_camera(),
     }
 
 
 def _worker(args: argparse.Namespace) -> int:
     spec = json.loads(args.worker)
+    obs_mode = spec.get("obs_mode", "state")
     if spec["kind"] == "single":
-        result = _run_single(spec["env_id"], spec["control_mode"], spec["steps"])
+        result = _run_single(spec["env_id"], spec["control_mode"], obs_mode, spec["steps"])
     else:
-        result = _run_vec(spec["env_id"], spec["control_mode"], spec["num_envs"], spec["steps"])
+        result = _run_vec(
+            spec["env_id"], spec["control_mode"], obs_mode, spec["num_envs"], spec["steps"]
+        )
     result["peak_rss_mb"] = _peak_rss_mb()
     print(json.dumps(result))
     return 0
@@ -98,67 +113,158 @@ def _spawn(spec: dict) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def _load() -> float:
+    """The 1-minute load average."""
+    return os.getloadavg()[0]
+
+
+def _configs(num_envs_list: list[int]) -> list[tuple[str, int]]:
+    return [("single", 1)] + [("vec", n) for n in num_envs_list]
+
+
+def _runner_name(kind: str, n: int) -> str:
+    return "gym.make (1 env)" if kind == "single" else f"make_vec({n})"
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     if args.worker:
         return _worker(args)
     num_envs_list = [int(n) for n in args.num_envs.split(",") if n]
-    control_modes = [m for m in args.control_modes.split(",") if m]
+    if args.visual:
+        return _bench_visual(args, num_envs_list)
+    steps = args.steps or 4000
+    given = args.control_modes or "pd_ee_delta_pose,pd_joint_delta_pos"
+    control_modes = [m for m in given.split(",") if m]
     from . import _native
 
     print(
         f"ms2 bench: {args.env_id}, obs_mode=state, random actions, 500 Hz physics / 20 Hz "
         f"control, {os.cpu_count()} cores, vector pool {_native.num_threads()} threads, "
-        f"{args.steps} env steps per row"
+        f"{steps} env steps per row"
     )
     header = (
         f"{'control_mode':<20} {'runner':<18} {'steps/s':>9} {'x our single':>12} "
-        f"{'x MS2 single':>12} {'peak RSS MB':>11}"
+        f"{'x MS2 single':>12} {'peak RSS MB':>11} {'load':>5}"
     )
     print(header)
     print("-" * len(header))
     rows = []
     for control_mode in control_modes:
         single = None
-        configs = [("single", 1)] + [("vec", n) for n in num_envs_list]
-        for kind, n in configs:
+        for kind, n in _configs(num_envs_list):
             spec = {
                 "kind": kind,
                 "env_id": args.env_id,
                 "control_mode": control_mode,
+                "obs_mode": "state",
                 "num_envs": n,
-                "steps": args.steps,
+                "steps": steps,
             }
+            load = _load()
             result = _spawn(spec)
             if kind == "single":
                 single = result["steps_per_s"]
             peer = MANISKILL2_SINGLE_STEPS_PER_S.get(control_mode)
-            runner = "gym.make (1 env)" if kind == "single" else f"make_vec({n})"
             vs_peer = f"{result['steps_per_s'] / peer:.2f}" if peer else "-"
             print(
-                f"{control_mode:<20} {runner:<18} {result['steps_per_s']:>9.0f} "
+                f"{control_mode:<20} {_runner_name(kind, n):<18} {result['steps_per_s']:>9.0f} "
                 f"{result['steps_per_s'] / single:>12.2f} {vs_peer:>12} "
-                f"{result['peak_rss_mb']:>11.0f}",
+                f"{result['peak_rss_mb']:>11.0f} {load:>5.1f}",
                 flush=True,
             )
-            rows.append({**spec, **result})
+            rows.append({**spec, **result, "load_1min": load})
     print(
         "ManiSkill2 0.5.3 on this machine (single env): "
         + ", ".join(f"{m} {v:.0f} steps/s" for m, v in MANISKILL2_SINGLE_STEPS_PER_S.items())
         + f", peak RSS {MANISKILL2_PEAK_RSS_MB:.0f} MB"
     )
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(rows, f, indent=2)
+    _write_json(args.json, rows)
     return 0
+
+
+def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
+    """``ms2 bench --visual``: rgbd / pointcloud steps/s, memory and triangles per camera."""
+    from . import _native
+
+    steps = args.steps or 1000
+    obs_modes = [m for m in args.obs_modes.split(",") if m]
+    control_mode = (args.control_modes or "pd_joint_delta_pos").split(",")[0]
+    print(
+        f"ms2 bench --visual: {args.env_id}, {control_mode}, random actions, 500 Hz physics / "
+        f"20 Hz control, cameras base_camera + hand_camera 128x128, {os.cpu_count()} cores, "
+        f"renderer {_native.render_adapter()}, {steps} env steps per row"
+    )
+    header = (
+        f"{'obs_mode':<11} {'runner':<18} {'steps/s':>9} {'x our single':>12} "
+        f"{'x MS2 single':>12} {'peak RSS MB':>11} {'triangles/cam':>13} {'load':>5}"
+    )
+    print(header)
+    print("-" * len(header))
+    rows = []
+    for obs_mode in obs_modes:
+        single = None
+        for kind, n in _configs(num_envs_list):
+            spec = {
+                "kind": kind,
+                "env_id": args.env_id,
+                "control_mode": control_mode,
+                "obs_mode": obs_mode,
+                "num_envs": n,
+                "steps": steps,
+            }
+            load = _load()
+            result = _spawn(spec)
+            if kind == "single":
+                single = result["steps_per_s"]
+            print(
+                f"{obs_mode:<11} {_runner_name(kind, n):<18} {result['steps_per_s']:>9.0f} "
+                f"{result['steps_per_s'] / single:>12.2f} "
+                f"{result['steps_per_s'] / MANISKILL2_VISUAL_STEPS_PER_S:>12.1f} "
+                f"{result['peak_rss_mb']:>11.0f} {result['triangles_per_camera']:>13} "
+                f"{load:>5.1f}",
+                flush=True,
+            )
+            rows.append({**spec, **result, "load_1min": load})
+    print(
+        f"ManiSkill2 0.5.3 on this machine (single env, lavapipe, same cameras): rgbd and "
+        f"pointcloud ~{MANISKILL2_VISUAL_STEPS_PER_S:.0f} steps/s, peak RSS 336-480 MB; it draws "
+        f"the Panda's full visual meshes, ms2 draws the primitive shapes counted above"
+    )
+    _write_json(args.json, rows)
+    return 0
+
+
+def _write_json(path: str | None, rows: list[dict]) -> None:
+    if path:
+        tmp = f"{path}.tmp"
+        with open(tmp, "w") as f:
+            json.dump(rows, f, indent=2)
+        os.replace(tmp, path)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Adds the ``bench`` subcommand to the ``ms2`` command line."""
     p = sub.add_parser("bench", help="benchmark env steps/s (single env and make_vec) and memory")
     p.add_argument("--env-id", default="PickCube-v0")
-    p.add_argument("--steps", type=int, default=4000, help="env steps per configuration")
+    p.add_argument(
+        "--steps",
+        type=int,
+        default=None,
+        help="env steps per configuration (default 4000; 1000 with --visual)",
+    )
+    p.add_argument(
+        "--visual",
+        action="store_true",
+        help="benchmark the visual obs modes (rgbd, pointcloud) instead of state",
+    )
+    p.add_argument("--obs-modes", default="rgbd,pointcloud", help="visual obs modes (--visual)")
     p.add_argument("--num-envs", default="1,2,4,8,16", help="comma-separated make_vec sizes")
-    p.add_argument("--control-modes", default="pd_ee_delta_pose,pd_joint_delta_pos")
+    p.add_argument(
+        "--control-modes",
+        default=None,
+        help="comma-separated (default pd_ee_delta_pose,pd_joint_delta_pos; --visual: the first "
+        "one given, else pd_joint_delta_pos)",
+    )
     p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     p.add_argument("--worker", default=None, help=argparse.SUPPRESS)
     p.set_defaults(func=_cmd_bench)

@@ -137,12 +137,14 @@ def _cmd_demos_generate(args: argparse.Namespace) -> int:
 
 
 def _cmd_demos_bench(args: argparse.Namespace) -> int:
+    import os
     import tempfile
     from pathlib import Path
 
     from . import demos
 
     targets = args.target_control_modes.split(",")
+    print(f"load average before: {os.getloadavg()[0]:.1f} (2-core machine figures vary with it)")
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / f"{args.env_id}.h5"
         gen = demos.generate(
@@ -154,9 +156,9 @@ def _cmd_demos_bench(args: argparse.Namespace) -> int:
             progress=False,
         )
         print(
-            f"{args.env_id}: {gen.seconds_per_episode:.3f} s per generated demo "
-            f"({args.policy}, {gen.num_episodes} demos, {gen.seeds_tried} seeds, "
-            f"{args.workers} workers)"
+            f"{args.env_id}: {gen.seconds_per_episode:.3f} s per generated demo, "
+            f"{gen.cpu_seconds_per_episode:.3f} CPU-s ({args.policy}, {gen.num_episodes} demos, "
+            f"{gen.seeds_tried} seeds, {args.workers} workers)"
         )
         for target in targets:
             rep = demos.replay(
@@ -169,7 +171,8 @@ def _cmd_demos_bench(args: argparse.Namespace) -> int:
             print(
                 f"  -> {target:<26} {rep.num_succeeded}/{rep.num_episodes} converted "
                 f"successfully ({100 * rep.success_rate:.1f} %), "
-                f"{rep.seconds_per_episode:.3f} s per converted episode"
+                f"{rep.seconds_per_episode:.3f} s per converted episode, "
+                f"{rep.cpu_seconds_per_episode:.3f} CPU-s"
             )
     return 0
 

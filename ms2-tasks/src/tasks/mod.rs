@@ -7,6 +7,6 @@ pub mod pick_cube;
 pub mod soft;
 pub mod stack_cube;
 
-pub use lift_cube::LiftCube;
-pub use pick_cube::PickCube;
+pub use lift_cube::{LiftCube, LiftCubeGoal};
+pub use pick_cube::{PickCube, PickCubeGoal};
 pub use stack_cube::StackCube;

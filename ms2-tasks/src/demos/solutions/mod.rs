@@ -1,20 +1,244 @@
-//! Motion-planning (sense-plan-act, privileged state) solutions that produce `pd_joint_pos`
-//! demonstrations.
+//! Motion-planning solutions: sense–plan–act with privileged state, driving `pd_joint_pos`.
+//!
+//! Each solution reads the true cube poses and goal after reset ([`scene`]), plans with
+//! [ms2-plan](ms2_plan) (a top-down grasp from the cube's bounding box at the yaw closest to the
+//! hand's, screw motions and RRT-Connect, TOPP-RA timing at the control frequency, the ground
+//! and the other cubes as obstacles) and plays the planned joint targets as `pd_joint_pos`
+//! actions, recording the episode ([`recorder`]). The three cube tasks share one
+//! pick-and-place skeleton ([`pick_place`]); a task is a [`CubeTaskSolution`] value.
+//!
+//! ```no_run
+//! use ms2_tasks::demos::solutions::{solution_env_ids, solve_episode};
+//! use ms2_tasks::EnvConfig;
+//! assert!(solution_env_ids().contains(&"PickCube-v0"));
+//! let episode = solve_episode(&EnvConfig::new("PickCube-v0"), 0).unwrap();
+//! assert_eq!(episode.env_states.len(), episode.actions.len() + 1);
+//! println!("success: {:?}", episode.success.last());
+//! ```
 
-use super::{DemoEpisode, DemoError};
-use crate::config::EnvConfig;
+pub mod pick_place;
+pub mod recorder;
+pub mod scene;
+
+use std::sync::OnceLock;
+use std::time::Instant;
+
+use ms2_plan::{KinematicRobot, PlanError, PlanningRobot};
+use nalgebra::Vector3;
+
+use crate::agent::ARM_DOF;
+use crate::config::{EnvConfig, ObsMode};
+use crate::demos::{DemoEpisode, DemoError};
+use crate::env::{make_env, Env};
+use crate::error::EnvError;
+use crate::tasks::common::CUBE_HALF_SIZE;
+use crate::tasks::lift_cube::GOAL_HEIGHT;
+pub use pick_place::{CubeTaskSolution, Finish};
+pub use recorder::{EpisodeRecorder, Gripper, CONTROL_MODE};
+pub use scene::{SensedCube, SensedState};
+
+/// Height (m) LiftCube's cube is carried to above its success height (cube centre at
+/// `GOAL_HEIGHT + half size`), so that it stays above it while the robot settles.
+const LIFT_MARGIN: f64 = 0.03;
+/// Height (m) of the moved cube's bottom above the other cube's top when StackCube releases it.
+const STACK_GAP: f64 = 0.002;
+
+/// The registered solutions.
+const SOLUTIONS: [CubeTaskSolution; 3] = [
+    CubeTaskSolution {
+        env_id: "PickCube-v0",
+        cube: "obj",
+        obstacles: &[],
+        goal_world: |s| {
+            let g = scene::privileged_vector(&s.obs, "extra/goal_pos", 3)?;
+            Ok(Vector3::new(g[0], g[1], g[2]).cast())
+        },
+        finish: Finish::HoldStill,
+    },
+    CubeTaskSolution {
+        env_id: "LiftCube-v0",
+        cube: "obj",
+        obstacles: &[],
+        goal_world: |s| {
+            let cube = s.pose_world_from_base * s.cube("obj")?.pose_base_from_cube;
+            let mut goal = cube.translation.vector;
+            goal.z = f64::from(GOAL_HEIGHT + CUBE_HALF_SIZE) + LIFT_MARGIN;
+            Ok(goal)
+        },
+        finish: Finish::HoldStill,
+    },
+    CubeTaskSolution {
+        env_id: "StackCube-v0",
+        cube: "cubeA",
+        obstacles: &["cubeB"],
+        goal_world: |s| {
+            let b = s.cube("cubeB")?;
+            let on_top = s.pose_world_from_base * b.pose_base_from_cube;
+            Ok(on_top.translation.vector + Vector3::new(0.0, 0.0, 2.0 * b.half_size + STACK_GAP))
+        },
+        finish: Finish::PlaceAndRelease,
+    },
+];
+
+/// Why a solution stopped early (internal; mapped to [`DemoError`] or a failed episode).
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    /// The privileged state lacks something the solution reads.
+    #[error("sensing failed: {0}")]
+    Sensing(String),
+    /// A planning query failed.
+    #[error("{phase} planning failed: {source}")]
+    Plan {
+        /// The phase whose query failed (`grasp`, `reach`, `descend`, `lift`, `carry`, ...).
+        phase: &'static str,
+        /// The planner's error.
+        source: PlanError,
+    },
+    /// The env failed.
+    #[error(transparent)]
+    Env(#[from] EnvError),
+    /// The episode limit was reached before the motion ended.
+    #[error("the episode limit was reached")]
+    OutOfSteps,
+}
+
+/// Where the time of one solved episode went (wall-clock seconds).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SolveTimings {
+    /// Time spent in planning queries (grasp search, screw motions, RRT-Connect, timing).
+    pub planning_seconds: f64,
+    /// Number of planning queries.
+    pub planning_queries: u32,
+    /// Total time of the episode, env reset and simulation included.
+    pub total_seconds: f64,
+}
 
 /// Env ids that have a motion-planning solution.
 pub fn solution_env_ids() -> Vec<&'static str> {
-    Vec::new()
+    SOLUTIONS.iter().map(|s| s.env_id).collect()
 }
 
-/// Runs the sense-plan-act solution for one seed in `pd_joint_pos` (`cfg.control_mode` must be
-/// `None` or `"pd_joint_pos"`; the obs mode is irrelevant). Returns the episode whether it
-/// succeeded or not; `Err` only on planner failure or bad input.
-pub fn solve_episode(cfg: &EnvConfig, _seed: u64) -> Result<DemoEpisode, DemoError> {
-    Err(DemoError::NoSolution {
-        env_id: cfg.env_id.clone(),
-        valid: solution_env_ids().into_iter().map(str::to_owned).collect(),
-    })
+/// ms2's Panda for planning, built once.
+fn planning_panda() -> Result<&'static KinematicRobot, PlanError> {
+    static PANDA: OnceLock<Result<KinematicRobot, PlanError>> = OnceLock::new();
+    PANDA
+        .get_or_init(KinematicRobot::panda)
+        .as_ref()
+        .map_err(Clone::clone)
+}
+
+/// Solves episodes of one env, reusing the env between seeds.
+pub struct DemoSolver {
+    env: Env,
+    solution: CubeTaskSolution,
+    panda: &'static KinematicRobot,
+}
+
+impl DemoSolver {
+    /// A solver for `cfg.env_id`. `cfg.control_mode` must be `None` or `"pd_joint_pos"`; the
+    /// solver's env always observes `state` (the solution reads privileged state directly, so
+    /// `obs_mode` does not matter and images are never rendered).
+    ///
+    /// # Errors
+    /// [`DemoError::NoSolution`] for an env without a solution, [`DemoError::Env`] for a bad
+    /// config, [`DemoError::Planning`] if the planning robot cannot be built.
+    pub fn new(cfg: &EnvConfig) -> Result<Self, DemoError> {
+        let solution = *SOLUTIONS
+            .iter()
+            .find(|s| s.env_id == cfg.env_id)
+            .ok_or_else(|| DemoError::NoSolution {
+                env_id: cfg.env_id.clone(),
+                valid: solution_env_ids().into_iter().map(str::to_owned).collect(),
+            })?;
+        if let Some(mode) = cfg.control_mode.as_deref() {
+            if mode != CONTROL_MODE {
+                return Err(DemoError::Env(EnvError::InvalidConfig(format!(
+                    "motion-planning solutions drive {CONTROL_MODE}, got control_mode {mode:?} \
+                     (convert the episodes afterwards by replay)"
+                ))));
+            }
+        }
+        let env_cfg = EnvConfig {
+            control_mode: Some(CONTROL_MODE.to_owned()),
+            obs_mode: ObsMode::State.as_str().to_owned(),
+            ..cfg.clone()
+        };
+        let env = make_env(&env_cfg)?;
+        let panda = planning_panda().map_err(|e| DemoError::Planning {
+            seed: 0,
+            reason: format!("planning robot: {e}"),
+        })?;
+        check_joint_order(&env, panda)?;
+        Ok(Self {
+            env,
+            solution,
+            panda,
+        })
+    }
+
+    /// Runs the solution for episode `seed`. Returns the episode whether it succeeded or not
+    /// (it succeeded if `episode.success.last() == Some(&true)`).
+    ///
+    /// # Errors
+    /// [`DemoError::Planning`] if a planning query fails, [`DemoError::Env`] if the env fails.
+    pub fn solve(&mut self, seed: u64) -> Result<(DemoEpisode, SolveTimings), DemoError> {
+        let t0 = Instant::now();
+        let mut timings = SolveTimings::default();
+        let mut recorder =
+            EpisodeRecorder::start(&mut self.env, seed).map_err(|e| to_demo(e, seed))?;
+        match self
+            .solution
+            .run(&mut recorder, self.panda, seed, &mut timings)
+        {
+            Ok(()) | Err(SolveError::OutOfSteps) => {}
+            Err(e) => return Err(to_demo(e, seed)),
+        }
+        timings.total_seconds = t0.elapsed().as_secs_f64();
+        Ok((recorder.finish(), timings))
+    }
+}
+
+/// Runs the motion-planning solution of `cfg.env_id` for episode `seed` in `pd_joint_pos`
+/// (`cfg.control_mode` must be `None` or `"pd_joint_pos"`; `obs_mode` is irrelevant).
+/// Returns the episode whether it succeeded or not; the caller keeps successes
+/// (`episode.success.last() == Some(&true)`).
+///
+/// # Errors
+/// As [`DemoSolver::new`] and [`DemoSolver::solve`].
+pub fn solve_episode(cfg: &EnvConfig, seed: u64) -> Result<DemoEpisode, DemoError> {
+    Ok(DemoSolver::new(cfg)?.solve(seed)?.0)
+}
+
+fn to_demo(e: SolveError, seed: u64) -> DemoError {
+    match e {
+        SolveError::Env(e) => DemoError::Env(e),
+        other => DemoError::Planning {
+            seed,
+            reason: other.to_string(),
+        },
+    }
+}
+
+/// The planned joints must be the env robot's first joints, in order (the `pd_joint_pos`
+/// action order).
+fn check_joint_order(env: &Env, panda: &KinematicRobot) -> Result<(), DemoError> {
+    let planned = panda.planned_joint_names();
+    let scene = env.task_scene().ok_or_else(|| DemoError::Planning {
+        seed: 0,
+        reason: "the env has no robot".to_owned(),
+    })?;
+    let names = scene
+        .world
+        .joint_names(scene.agent.articulation)
+        .map_err(|e| DemoError::Env(EnvError::Physics(e.to_string())))?;
+    if planned.len() != ARM_DOF || names.len() < ARM_DOF || planned[..] != names[..ARM_DOF] {
+        return Err(DemoError::Planning {
+            seed: 0,
+            reason: format!(
+                "planned joints {planned:?} are not the robot's first {ARM_DOF} joints {names:?}"
+            ),
+        });
+    }
+    debug_assert_eq!(panda.dof(), ARM_DOF);
+    Ok(())
 }

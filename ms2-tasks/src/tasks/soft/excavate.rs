@@ -1,10 +1,14 @@
 //! The Excavate scene: scoop a target amount of clay with a bucket and lift it.
 //!
-//! A clay bed with a seeded height map lies on the floor; a bucket (an open-front scoop of five
-//! boxes: bottom plate, back wall, two side walls) is moved as a kinematic body of the rigid
+//! A clay bed with a seeded height map lies on a sticky floor (clay sticks to the table); a
+//! bucket (an open-front scoop of four 6 mm thick boxes: bottom plate, back wall, two side
+//! walls) is moved as a kinematic body of the rigid
 //! world and pushes the clay through the two-way coupling. The bucket is commanded once per
 //! control step (20 Hz) with a [`BucketPose`]; the scene interpolates it linearly over the
-//! control step's rigid steps (500 Hz).
+//! control step's rigid steps (500 Hz). The walls are thinner than a grid cell (1 cm); the
+//! solver keeps clay on their two sides apart with its compatibility masks
+//! ([`ms2_mpm::ParticleForces::blocked_nodes`]), without which the bed below and around the
+//! bucket dragged the scooped clay back through the plate.
 //!
 //! Success (the paper's terms): the number of clay particles in the bucket is within ±25 % of
 //! the episode's target; every particle in the bucket is higher than
@@ -17,7 +21,7 @@
 
 use glam::{Vec2, Vec3};
 use ms2_mpm::sampling::{self, HeightMap};
-use ms2_mpm::MpmState;
+use ms2_mpm::{MpmState, WallKind};
 use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
@@ -40,7 +44,13 @@ pub const AMOUNT_TOLERANCE: f32 = 0.25;
 /// Interior half extents of the bucket (m, bucket frame): x towards the opening, z up.
 pub const BUCKET_INNER_HALF: [f32; 3] = [0.04, 0.035, 0.03];
 /// Wall and plate half thickness (m).
-pub const BUCKET_WALL_HALF: f32 = 0.005;
+pub const BUCKET_WALL_HALF: f32 = 0.003;
+/// The scripted scoop's yield, measured on the default bed: about
+/// `SCOOP_BASE_PARTICLES` when the lip travels `SCOOP_BASE_TRAVEL` (m) into the bed, plus
+/// `SCOOP_PARTICLES_PER_METRE` per further metre.
+const SCOOP_BASE_PARTICLES: f32 = 240.0;
+const SCOOP_BASE_TRAVEL: f32 = 0.03;
+const SCOOP_PARTICLES_PER_METRE: f32 = 3900.0;
 
 /// Bed footprint (m, world x and y).
 const BED_MIN: [f32; 2] = [0.12, 0.10];
@@ -49,7 +59,7 @@ const BED_MAX: [f32; 2] = [0.24, 0.22];
 const BED_THICKNESS: f32 = 0.035;
 const BED_AMPLITUDE: f32 = 0.006;
 /// Range of the episode's target amount (particles).
-const TARGET_RANGE: (usize, usize) = (300, 700);
+const TARGET_RANGE: (usize, usize) = (250, 400);
 
 /// Commanded bucket pose: position of the bottom plate's centre (m, world) and pitch (rad,
 /// about world −y: positive raises the opening).
@@ -136,7 +146,9 @@ impl ExcavateScene {
     /// Builds an episode from `seed`: the bed's height map (5 × 5 samples, ±6 mm about a
     /// 3.5 cm thick bed), the bucket's start y (±1 cm) and the target amount.
     pub fn new(seed: u64) -> Result<Self, SoftSceneError> {
-        let config = SoftConfig::default();
+        let mut config = SoftConfig::default();
+        // Clay sticks to the table: the bed stays put while the bucket cuts into it.
+        config.boundary.walls[2][0] = WallKind::Sticky;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let (mut solver, clay) = SoftWorld::solver_for(&config)?;
         let floor_z = solver.usable_domain().0.z;
@@ -388,28 +400,32 @@ impl ScriptedScoop {
     /// Plans the scoop for `scene`'s episode.
     pub fn plan(scene: &ExcavateScene) -> Self {
         let start = scene.bucket_command();
-        let [_, hy, _] = BUCKET_INNER_HALF;
-        let particle_volume = SoftConfig::default().particle_spacing.powi(3);
-        let bed_height = scene.mean_bed_z() - scene.floor_z();
-        // Clay entering the bucket per metre of sweep into the bed.
-        let per_metre = 2.0 * hy * bed_height / particle_volume;
-        let gap_to_bed = BED_MIN[0] - (start.position.x + BUCKET_INNER_HALF[0]);
-        let sweep = gap_to_bed + scene.target_particles() as f32 / per_metre;
-        let plate_z = scene.floor_z() + BUCKET_WALL_HALF + 0.002;
-        let at = |dx: f32, z: f32, pitch: f32| BucketPose {
-            position: Vec3::new(start.position.x + dx, start.position.y, z),
+        let hx = BUCKET_INNER_HALF[0];
+        // Plate just above the table, lip 1 cm in front of the bed.
+        let z = scene.floor_z() + BUCKET_WALL_HALF + 0.002;
+        let x0 = BED_MIN[0] - 0.01 - hx;
+        let travel = (SCOOP_BASE_TRAVEL
+            + (scene.target_particles() as f32 - SCOOP_BASE_PARTICLES) / SCOOP_PARTICLES_PER_METRE)
+            .clamp(0.01, 2.0 * hx - 0.01);
+        let at = |x: f32, z: f32, pitch: f32| BucketPose {
+            position: Vec3::new(x, start.position.y, z),
             pitch,
         };
         let lift_z = scene.target_height() + 0.03;
-        let tilt = 20f32.to_radians();
+        let curl = 25f32.to_radians();
+        let x1 = x0 + 0.01 + travel;
+        // Curl: raise the opening while still moving forward, so the lip cuts up through
+        // the clay ahead instead of pulling the load out of the bucket.
+        let (x2, z2) = (x1 + 0.01, z + 0.005);
         Self {
             waypoints: vec![
                 (0, start),
-                (4, at(0.0, plate_z, 0.0)),
-                (14, at(sweep, plate_z, 0.0)),
-                (18, at(sweep, plate_z + 0.01, tilt)),
-                (30, at(sweep, lift_z, tilt)),
-                (MAX_EPISODE_STEPS, at(sweep, lift_z, tilt)),
+                (4, at(x0, z + 0.03, 0.0)),
+                (8, at(x0, z, 0.0)),
+                (20, at(x1, z, 0.0)),
+                (28, at(x2, z2, curl)),
+                (48, at(x2, lift_z, curl)),
+                (MAX_EPISODE_STEPS, at(x2, lift_z, curl)),
             ],
         }
     }

@@ -20,8 +20,8 @@ pub mod excavate;
 
 use glam::Vec3;
 use ms2_mpm::{
-    Coupling, CouplingParams, GridSpec, Material, MaterialId, MpmError, MpmSolver, MpmState,
-    SolverConfig,
+    Boundary, Coupling, CouplingParams, GridSpec, Material, MaterialId, MpmError, MpmSolver,
+    MpmState, SolverConfig,
 };
 use ms2_physics::{BodyId, World};
 
@@ -56,6 +56,8 @@ pub struct SoftConfig {
     pub substep_dt: f32,
     /// The clay.
     pub clay: Material,
+    /// Domain walls (the floor is the low z face).
+    pub boundary: Boundary,
 }
 
 impl Default for SoftConfig {
@@ -67,6 +69,7 @@ impl Default for SoftConfig {
             particle_spacing: 0.005,
             substep_dt: 1e-3,
             clay: Material::clay(1000.0, 1e4, 0.3, 2e3),
+            boundary: Boundary::default(),
         }
     }
 }
@@ -125,6 +128,7 @@ impl SoftWorld {
         let grid = GridSpec::new(config.grid_origin, config.grid_dx, config.grid_nodes);
         let mut solver_config = SolverConfig::new(grid);
         solver_config.substep_dt = config.substep_dt;
+        solver_config.boundary = config.boundary;
         let mut solver = MpmSolver::new(solver_config)?;
         let clay = solver.add_material(config.clay)?;
         Ok((solver, clay))
@@ -165,6 +169,15 @@ impl SoftWorld {
     /// at the next [`SoftWorld::step`].
     pub fn set_state(&mut self, state: &MpmState) -> Result<(), SoftSceneError> {
         Ok(self.solver.set_state(state)?)
+    }
+
+    /// The force (N) and torque (N·m, about the centre of mass) the clay exerted on coupled
+    /// body `index` over the last rigid step (world frame); zero for an unknown index.
+    pub fn last_wrench(&self, index: usize) -> (Vec3, Vec3) {
+        self.coupling
+            .last_wrenches()
+            .get(index)
+            .map_or((Vec3::ZERO, Vec3::ZERO), |w| (w.force, w.torque))
     }
 
     /// Mean particle speed (m/s).

@@ -1,0 +1,193 @@
+//! Act: stepping the env with `pd_joint_pos` actions (absolute arm joint targets plus the
+//! gripper command) while recording the episode as a [`DemoEpisode`].
+
+use ms2_plan::JointTrajectory;
+
+use super::SolveError;
+use crate::agent::ARM_DOF;
+use crate::demos::DemoEpisode;
+use crate::env::Env;
+
+/// The control mode the solutions drive.
+pub const CONTROL_MODE: &str = "pd_joint_pos";
+
+/// Gripper command of a `pd_joint_pos` action (the normalised `gripper_pd_joint_pos` entry).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Gripper {
+    /// Fingers to 0.04 m each (action +1).
+    Open,
+    /// Fingers to −0.01 m each (action −1): squeezes whatever is between them.
+    Closed,
+}
+
+impl Gripper {
+    /// The normalised action entry.
+    pub fn action(self) -> f32 {
+        match self {
+            Gripper::Open => 1.0,
+            Gripper::Closed => -1.0,
+        }
+    }
+}
+
+/// Steps an env and records actions, states (`get_state` after reset and after every step),
+/// success flags and the last info.
+pub struct EpisodeRecorder<'e> {
+    env: &'e mut Env,
+    episode: DemoEpisode,
+    arm_target: Vec<f64>,
+}
+
+impl<'e> EpisodeRecorder<'e> {
+    /// Resets `env` with `seed` and starts recording; the first arm target is the arm's
+    /// position after reset.
+    ///
+    /// # Errors
+    /// [`SolveError::Env`] if the reset fails, [`SolveError::Sensing`] for an env without a
+    /// Panda arm.
+    pub fn start(env: &'e mut Env, seed: u64) -> Result<Self, SolveError> {
+        let (_, info) = env.reset(Some(seed), false)?;
+        let scene = env
+            .task_scene()
+            .ok_or_else(|| SolveError::Sensing("the env has no robot".to_owned()))?;
+        let qpos = scene.agent.qpos(&scene.world);
+        if qpos.len() < ARM_DOF {
+            return Err(SolveError::Sensing(format!(
+                "the robot has {} joints, expected at least {ARM_DOF}",
+                qpos.len()
+            )));
+        }
+        let arm_target = qpos[..ARM_DOF].iter().map(|&v| f64::from(v)).collect();
+        let episode = DemoEpisode {
+            env_id: env.config().env_id.clone(),
+            episode_seed: seed,
+            control_mode: CONTROL_MODE.to_owned(),
+            actions: Vec::new(),
+            env_states: vec![env.get_state()],
+            success: Vec::new(),
+            elapsed_steps: 0,
+            info,
+        };
+        Ok(Self {
+            env,
+            episode,
+            arm_target,
+        })
+    }
+
+    /// The env being stepped.
+    pub fn env(&self) -> &Env {
+        self.env
+    }
+
+    /// The last commanded arm joint targets (rad), `panda_joint1..7`.
+    pub fn arm_target(&self) -> &[f64] {
+        &self.arm_target
+    }
+
+    /// One env step toward arm targets `arm` (rad) with gripper command `gripper`.
+    ///
+    /// # Errors
+    /// [`SolveError::OutOfSteps`] once the episode limit is reached; [`SolveError::Env`] if
+    /// the env rejects the action.
+    pub fn step(&mut self, arm: &[f64], gripper: Gripper) -> Result<(), SolveError> {
+        if self.env.elapsed_steps() >= self.env.max_episode_steps() {
+            return Err(SolveError::OutOfSteps);
+        }
+        let mut action: Vec<f32> = arm.iter().map(|&q| q as f32).collect();
+        action.push(gripper.action());
+        let out = self.env.step(&action)?;
+        self.arm_target = arm.to_vec();
+        self.episode.actions.push(action);
+        self.episode.env_states.push(self.env.get_state());
+        self.episode.success.push(out.terminated);
+        self.episode.elapsed_steps += 1;
+        self.episode.info = out.info;
+        Ok(())
+    }
+
+    /// Follows `trajectory` (its first sample is the current target and is skipped).
+    ///
+    /// # Errors
+    /// As [`EpisodeRecorder::step`].
+    pub fn follow(
+        &mut self,
+        trajectory: &JointTrajectory,
+        gripper: Gripper,
+    ) -> Result<(), SolveError> {
+        for q in trajectory.positions.iter().skip(1) {
+            self.step(q, gripper)?;
+        }
+        Ok(())
+    }
+
+    /// Keeps the arm target for `steps` env steps.
+    ///
+    /// # Errors
+    /// As [`EpisodeRecorder::step`].
+    pub fn hold(&mut self, steps: u32, gripper: Gripper) -> Result<(), SolveError> {
+        let target = self.arm_target.clone();
+        for _ in 0..steps {
+            self.step(&target, gripper)?;
+        }
+        Ok(())
+    }
+
+    /// Keeps the arm target until every arm joint is within `tolerance` (rad) of it, for at
+    /// most `max_steps` steps.
+    ///
+    /// # Errors
+    /// As [`EpisodeRecorder::step`].
+    pub fn settle(
+        &mut self,
+        tolerance: f64,
+        max_steps: u32,
+        gripper: Gripper,
+    ) -> Result<(), SolveError> {
+        for _ in 0..max_steps {
+            if self.tracking_error() <= tolerance {
+                return Ok(());
+            }
+            self.hold(1, gripper)?;
+        }
+        Ok(())
+    }
+
+    /// Keeps the arm target until the task has reported success for `consecutive` steps in a
+    /// row (or the episode limit ends the episode).
+    ///
+    /// # Errors
+    /// [`SolveError::OutOfSteps`] if success is not reached in time; [`SolveError::Env`].
+    pub fn hold_until_success(
+        &mut self,
+        consecutive: usize,
+        gripper: Gripper,
+    ) -> Result<(), SolveError> {
+        loop {
+            let s = &self.episode.success;
+            if s.len() >= consecutive && s[s.len() - consecutive..].iter().all(|&v| v) {
+                return Ok(());
+            }
+            self.hold(1, gripper)?;
+        }
+    }
+
+    /// Largest distance (rad) of an arm joint from its target.
+    pub fn tracking_error(&self) -> f64 {
+        let Some(scene) = self.env.task_scene() else {
+            return 0.0;
+        };
+        scene
+            .agent
+            .qpos(&scene.world)
+            .iter()
+            .zip(&self.arm_target)
+            .map(|(&q, &t)| (f64::from(q) - t).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// The recorded episode.
+    pub fn finish(self) -> DemoEpisode {
+        self.episode
+    }
+}

@@ -1,0 +1,116 @@
+//! The motion-planning solutions solve their tasks in `pd_joint_pos`, and their recorded
+//! episodes are consistent: every recorded state is reproduced by restoring the previous one
+//! and stepping the recorded action.
+
+use ms2_tasks::demos::solutions::{solution_env_ids, solve_episode, DemoSolver};
+use ms2_tasks::demos::{DemoEpisode, DemoError};
+use ms2_tasks::{make_env, EnvConfig};
+
+/// Seeds per task (the 200-seed rates are measured by `examples/mp_solution_rates.rs`).
+const SEEDS: [u64; 3] = [0, 1, 2];
+
+fn solve_all(env_id: &str) -> Vec<DemoEpisode> {
+    let mut solver = DemoSolver::new(&EnvConfig::new(env_id)).unwrap();
+    SEEDS
+        .iter()
+        .map(|&seed| solver.solve(seed).unwrap().0)
+        .collect()
+}
+
+fn assert_solved_and_consistent(env_id: &str) {
+    let episodes = solve_all(env_id);
+    for episode in &episodes {
+        let t = episode.actions.len();
+        assert_eq!(episode.env_id, env_id);
+        assert_eq!(episode.control_mode, "pd_joint_pos");
+        assert_eq!(episode.elapsed_steps as usize, t);
+        assert_eq!(episode.env_states.len(), t + 1);
+        assert_eq!(episode.success.len(), t);
+        assert!(
+            episode.success.last() == Some(&true),
+            "{env_id} seed {} failed after {t} steps: info {:?}",
+            episode.episode_seed,
+            episode.info
+        );
+        assert!(
+            t <= 200,
+            "{env_id} seed {}: {t} steps",
+            episode.episode_seed
+        );
+        assert!(episode.actions.iter().all(|a| a.len() == 8));
+    }
+    assert_replays(env_id, &episodes[0]);
+}
+
+/// Restoring state t and stepping action t reproduces state t + 1 exactly, for every step.
+fn assert_replays(env_id: &str, episode: &DemoEpisode) {
+    let cfg = EnvConfig {
+        control_mode: Some("pd_joint_pos".to_owned()),
+        ..EnvConfig::new(env_id)
+    };
+    let mut env = make_env(&cfg).unwrap();
+    env.reset(Some(episode.episode_seed), false).unwrap();
+    assert_eq!(
+        env.get_state(),
+        episode.env_states[0],
+        "reset state differs"
+    );
+    for (t, action) in episode.actions.iter().enumerate() {
+        env.set_state(&episode.env_states[t]).unwrap();
+        let out = env.step(action).unwrap();
+        let state = env.get_state();
+        assert_eq!(
+            state,
+            episode.env_states[t + 1],
+            "{env_id} step {t}: the replayed state differs"
+        );
+        assert_eq!(out.terminated, episode.success[t], "{env_id} step {t}");
+    }
+}
+
+#[test]
+fn pick_cube_is_solved() {
+    assert_solved_and_consistent("PickCube-v0");
+}
+
+#[test]
+fn lift_cube_is_solved() {
+    assert_solved_and_consistent("LiftCube-v0");
+}
+
+#[test]
+fn stack_cube_is_solved() {
+    assert_solved_and_consistent("StackCube-v0");
+}
+
+#[test]
+fn the_same_seed_gives_the_same_episode_on_a_reused_solver() {
+    let cfg = EnvConfig::new("StackCube-v0");
+    let fresh = solve_episode(&cfg, 7).unwrap();
+    let mut solver = DemoSolver::new(&cfg).unwrap();
+    let other = solver.solve(3).unwrap().0;
+    let reused = solver.solve(7).unwrap().0;
+    assert_ne!(other.env_states[0], fresh.env_states[0]);
+    assert_eq!(reused, fresh);
+}
+
+#[test]
+fn bad_requests_are_typed_errors() {
+    assert_eq!(
+        solution_env_ids(),
+        vec!["PickCube-v0", "LiftCube-v0", "StackCube-v0"]
+    );
+    match solve_episode(&EnvConfig::new("Dummy-v0"), 0) {
+        Err(DemoError::NoSolution { env_id, valid }) => {
+            assert_eq!(env_id, "Dummy-v0");
+            assert_eq!(valid, solution_env_ids());
+        }
+        other => panic!("expected NoSolution, got {other:?}"),
+    }
+    let cfg = EnvConfig {
+        control_mode: Some("pd_ee_delta_pose".to_owned()),
+        ..EnvConfig::new("PickCube-v0")
+    };
+    let err = solve_episode(&cfg, 0).unwrap_err();
+    assert!(err.to_string().contains("pd_ee_delta_pose"), "{err}");
+}
