@@ -264,25 +264,11 @@ def test_interrupted_writer_keeps_the_last_commit(tmp_path):
     assert {p.name for p in tmp_path.iterdir()} == {"partial.h5", "partial.json"}
 
 
-def test_killed_generate_leaves_a_valid_file_of_finished_episodes(tmp_path):
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT])
+def test_interrupted_generate_leaves_a_valid_file_of_finished_episodes(tmp_path, sig):
     path = tmp_path / "killed.h5"
-    cmd = [
-        sys.executable,
-        "-m",
-        "ms2",
-        "demos",
-        "generate",
-        ENV_ID,
-        "-n",
-        "400",
-        "-o",
-        str(path),
-        "--workers",
-        "1",
-        "--policy",
-        "scripted",
-        "-q",
-    ]
+    cmd = [sys.executable, "-m", "ms2", "demos", "generate", ENV_ID, "-n", "400", "-o",
+           str(path), "--workers", "1", "--policy", "scripted", "-q"]  # fmt: skip
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 120
     try:
@@ -292,10 +278,15 @@ def test_killed_generate_leaves_a_valid_file_of_finished_episodes(tmp_path):
                 break
             assert proc.poll() is None, proc.stderr.read().decode()
             time.sleep(0.05)
-        os.kill(proc.pid, signal.SIGKILL)
+        os.kill(proc.pid, sig)
+        proc.wait(timeout=60)
     finally:
+        proc.kill()
         proc.wait()
-    assert proc.returncode == -signal.SIGKILL  # killed mid-run, not finished
+    # Interrupted mid-run, not finished: SIGKILL kills it, Ctrl-C (SIGINT) ends it with 130.
+    assert proc.returncode == (-signal.SIGKILL if sig == signal.SIGKILL else 130)
+    if sig == signal.SIGINT:
+        assert "interrupted" in proc.stderr.read().decode()
     with open_trajectory(path) as traj:
         assert 4 <= len(traj) < 400
         for i in range(len(traj)):
