@@ -8,8 +8,7 @@ use std::time::Instant;
 
 use criterion::{criterion_group, Criterion};
 use ms2_control::{
-    ControlMode, DlsIk, IkOptions, KinematicChain, KinematicModel, PerfectTrackingArticulation,
-    QpIk, QpIkOptions,
+    ControlMode, DlsIk, IkOptions, KinematicChain, PerfectTrackingArticulation, QpIk, QpIkOptions,
 };
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
@@ -19,13 +18,6 @@ mod common;
 use common::REST;
 
 const ENV_STEP_S: f64 = 1.0 / 900.0;
-
-fn chain() -> KinematicChain {
-    KinematicModel::from_urdf_str(ms2_assets::PANDA_URDF)
-        .unwrap()
-        .chain_to("panda_hand_tcp")
-        .unwrap()
-}
 
 /// A typical per-step target: 1 cm and 0.02 rad away from the current TCP pose.
 fn small_move(chain: &KinematicChain) -> Isometry3<f64> {
@@ -37,7 +29,7 @@ fn small_move(chain: &KinematicChain) -> Isometry3<f64> {
 }
 
 fn kinematics(c: &mut Criterion) {
-    let chain = chain();
+    let chain = common::panda_chain();
     let q = &REST[..7];
     let target = small_move(&chain);
     c.bench_function("panda_fk_tcp", |b| {
@@ -147,7 +139,7 @@ fn report_per_action_cost() {
         costs[0].1 / costs[1].1
     );
     // The failure path: a target 2 m away, where IK gives up (and the arm holds still).
-    let chain = chain();
+    let chain = common::panda_chain();
     let far = Isometry3::translation(2.0, 0.0, 0.5);
     let dls = DlsIk::default();
     let reps = 200;

@@ -7,12 +7,9 @@ use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-fn panda_chain() -> KinematicChain {
-    KinematicModel::from_urdf_str(ms2_assets::PANDA_URDF)
-        .unwrap()
-        .chain_to("panda_hand_tcp")
-        .unwrap()
-}
+mod common;
+
+use common::panda_chain;
 
 fn random_q(chain: &KinematicChain, rng: &mut ChaCha8Rng) -> Vec<f64> {
     chain

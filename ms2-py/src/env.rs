@@ -148,6 +148,12 @@ impl NativeEnv {
         self.read(|env| env.elapsed_steps())
     }
 
+    /// Seed of the current episode (the one `reset(seed=...)` was given, or the one the env's
+    /// generator drew for `reset()`): `reset(seed=episode_seed)` replays the episode.
+    fn episode_seed(&self) -> PyResult<u64> {
+        self.read(|env| env.episode_seed())
+    }
+
     /// Episode length limit in env steps.
     fn max_episode_steps(&self) -> PyResult<u32> {
         self.read(|env| env.max_episode_steps())

@@ -207,3 +207,43 @@ fn bad_replay_requests_are_refused_with_typed_errors() {
         "{err}"
     );
 }
+
+#[test]
+fn failed_conversions_of_successful_sources_are_retried() {
+    let full = oracle_episode("PickCube-v0", "pd_joint_pos", 7);
+    let converted = replay(
+        &full,
+        ReplayOptions {
+            target_control_mode: Some("pd_ee_delta_pose".to_owned()),
+            max_retry: 2,
+            ..ReplayOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(converted.episode.succeeded());
+    assert_eq!(converted.attempts, 1);
+
+    // The first 5 steps cannot solve the task; labelled successful, the conversion is retried
+    // (then given up); labelled failed, it is not.
+    let mut head = full.clone();
+    head.actions.truncate(5);
+    head.success.truncate(5);
+    head.env_states.truncate(6);
+    head.elapsed_steps = 5;
+    let opts = ReplayOptions {
+        target_control_mode: Some("pd_ee_delta_pose".to_owned()),
+        max_retry: 2,
+        ..ReplayOptions::default()
+    };
+    let failed = replay(&head, opts.clone()).unwrap();
+    assert!(!failed.episode.succeeded());
+    assert_eq!(failed.attempts, 1);
+    // 1-4 target steps per source step, no settle steps after a failed source.
+    assert!((5..=20).contains(&failed.episode.actions.len()));
+    head.success[4] = true;
+    let retried = replay(&head, opts).unwrap();
+    assert!(!retried.episode.succeeded());
+    assert_eq!(retried.attempts, 3);
+    // 10 settle steps after a successful source.
+    assert!((5 + 10..=20 + 10).contains(&retried.episode.actions.len()));
+}

@@ -2,11 +2,20 @@
 #![allow(dead_code)]
 
 use ms2_control::{
-    CombinedController, ControlMode, ControlTiming, PerfectTrackingArticulation, RobotConfig,
+    CombinedController, ControlMode, ControlTiming, KinematicChain, KinematicModel,
+    PerfectTrackingArticulation, RobotConfig,
 };
 
 /// The Panda's rest joint positions (7 arm joints in rad, 2 fingers in m), dof order.
 pub const REST: [f64; 9] = ms2_assets::PANDA_REST_QPOS;
+
+/// The Panda's chain from its base to the TCP link (`panda_hand_tcp`).
+pub fn panda_chain() -> KinematicChain {
+    KinematicModel::from_urdf_str(ms2_assets::PANDA_URDF)
+        .unwrap()
+        .chain_to(ms2_assets::PANDA_TCP_LINK)
+        .unwrap()
+}
 
 /// The Panda at [`REST`] on a perfect-tracking mock, driven by the combined controller of `mode`
 /// at ManiSkill2's rates, reset.

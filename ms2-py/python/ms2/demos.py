@@ -58,11 +58,17 @@ class GenerateResult:
     planner_errors: int
     seconds: float
     failed_seeds: list[int] = field(default_factory=list)
+    cpu_seconds: float = 0.0
 
     @property
     def seconds_per_episode(self) -> float:
         """Wall-clock seconds per kept episode."""
         return self.seconds / max(self.num_episodes, 1)
+
+    @property
+    def cpu_seconds_per_episode(self) -> float:
+        """CPU seconds (all threads of the process) per kept episode."""
+        return self.cpu_seconds / max(self.num_episodes, 1)
 
 
 def generate(
@@ -109,7 +115,7 @@ def generate(
         "max_episode_steps": int(_native.default_max_episode_steps(env_id)),
         "env_kwargs": {**env_kwargs, "sim_freq": 500.0, "control_freq": 20.0},
     }
-    started = time.perf_counter()
+    started, cpu_started = time.perf_counter(), time.process_time()
     result = GenerateResult(Path(output), 0, 0, 0, 0.0)
     with (
         TrajectoryWriter(output, env_info) as writer,
@@ -139,6 +145,7 @@ def generate(
             writer.commit()
             bar.set_postfix(seeds=result.seeds_tried)
     result.seconds = time.perf_counter() - started
+    result.cpu_seconds = time.process_time() - cpu_started
     if result.num_episodes < num_episodes:
         raise RuntimeError(
             f"only {result.num_episodes} of {num_episodes} {env_id} episodes succeeded within "
@@ -167,6 +174,7 @@ class ReplayResult:
     attempts: int
     failed_episode_ids: list[int] = field(default_factory=list)
     videos: list[Path] = field(default_factory=list)
+    cpu_seconds: float = 0.0
 
     @property
     def success_rate(self) -> float:
@@ -174,7 +182,13 @@ class ReplayResult:
 
     @property
     def seconds_per_episode(self) -> float:
+        """Wall-clock seconds per replayed episode."""
         return self.seconds / max(self.num_episodes, 1)
+
+    @property
+    def cpu_seconds_per_episode(self) -> float:
+        """CPU seconds (all threads of the process) per replayed episode."""
+        return self.cpu_seconds / max(self.num_episodes, 1)
 
 
 def _write_video(env_id: str, env_kwargs: dict[str, Any], episode: dict[str, Any], path: Path):
@@ -229,7 +243,7 @@ def replay(
         raise ValueError(f"num_workers must be at least 1, got {num_workers}")
     if max_retry < 0:
         raise ValueError(f"max_retry must be non-negative, got {max_retry}")
-    started = time.perf_counter()
+    started, cpu_started = time.perf_counter(), time.process_time()
     with open_trajectory(traj_path) as traj:
         episodes_meta = traj.episodes[: count if count is not None else len(traj.episodes)]
         env_kwargs = dict(traj.env_info.get("env_kwargs") or {})
@@ -258,6 +272,8 @@ def replay(
             "env_kwargs": {**env_kwargs, "obs_mode": obs_mode or "none", "control_mode": out_mode},
         }
         writer = TrajectoryWriter(output, out_info) if save_traj else None
+        if writer is not None:
+            writer.commit()  # a valid (empty) output from the start
         result = ReplayResult(0, 0, 0.0, output if save_traj else None, 0)
         indices = list(range(len(episodes_meta)))
         try:
@@ -298,6 +314,7 @@ def replay(
             if writer is not None:
                 writer.close()
     result.seconds = time.perf_counter() - started
+    result.cpu_seconds = time.process_time() - cpu_started
     return result
 
 

@@ -150,6 +150,11 @@ class Ms2Env(gym.Env):
         return self._native.elapsed_steps()
 
     @property
+    def episode_seed(self) -> int:
+        """Seed of the current episode: ``reset(seed=env.episode_seed)`` replays it."""
+        return self._native.episode_seed()
+
+    @property
     def max_episode_steps(self) -> int:
         """The native episode limit in env steps."""
         return self._native.max_episode_steps()

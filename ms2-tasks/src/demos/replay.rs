@@ -19,6 +19,10 @@ pub const MAX_EXTRA_STEPS_PER_SOURCE_STEP: u32 = 3;
 /// episode whose successful source it trails to reach success too.
 pub const MAX_SETTLE_STEPS: u32 = 10;
 
+/// TCP distance (m) from the recorded TCP above which the first retry takes an extra target
+/// step toward the same source targets (see [`ReplayOptions::max_retry`]).
+pub const TRAILING_TOLERANCE_M: f32 = 0.01;
+
 /// How [`replay_episode`] replays an episode.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct ReplayOptions {
@@ -29,8 +33,10 @@ pub struct ReplayOptions {
     pub use_env_states: bool,
     /// Collect the observations (in `cfg.obs_mode`) after reset and after every step.
     pub record_obs: bool,
-    /// Further attempts after a converted episode fails; each retry lets the converter take
-    /// extra target steps per source step while the target robot trails the recorded one.
+    /// Further attempts after the conversion of a successful source episode fails. Retry `k`
+    /// also takes extra target steps per source step while the target TCP is more than
+    /// [`TRAILING_TOLERANCE_M`]` / k` away from the recorded one (trading the source's timing
+    /// for its path).
     pub max_retry: u32,
 }
 
@@ -57,7 +63,8 @@ pub struct ReplayedEpisode {
 ///   `T_a = T⁻¹ · FK(q̄_src)` for `pd_ee_delta_pose`). When the action saturates or IK fails,
 ///   more target steps toward the same `q̄_src(t)` follow (at most
 ///   [`MAX_EXTRA_STEPS_PER_SOURCE_STEP`]). A failed converted episode is retried up to
-///   `opts.max_retry` times with a stricter "reached" test (see [`ReplayOptions::max_retry`]).
+///   `opts.max_retry` times with a stricter "reached" test (see [`ReplayOptions::max_retry`]);
+///   failed sources are not retried.
 ///
 /// Returns the last attempt whether it succeeded or not (check `episode.succeeded()`).
 pub fn replay_episode(
@@ -106,10 +113,16 @@ pub fn replay_episode(
     }
     let mut attempt = 0;
     loop {
-        let strict = attempt > 0;
-        let (episode, obs) = convert_once(&env_cfg, &mut env, source, opts.record_obs, strict)?;
+        let trailing_tolerance = (attempt > 0).then(|| TRAILING_TOLERANCE_M / attempt as f32);
+        let (episode, obs) = convert_once(
+            &env_cfg,
+            &mut env,
+            source,
+            opts.record_obs,
+            trailing_tolerance,
+        )?;
         attempt += 1;
-        if episode.succeeded() || attempt > opts.max_retry {
+        if episode.succeeded() || !source.succeeded() || attempt > opts.max_retry {
             return Ok(ReplayedEpisode {
                 episode,
                 obs,
@@ -168,14 +181,15 @@ fn replay_same_mode(
     Ok((recorder.finish(), obs.0))
 }
 
-/// One closed-loop conversion of `source` into `env`'s control mode. `strict` also takes extra
-/// target steps while the arm trails the recorded arm by more than [`TRAILING_TOLERANCE_RAD`].
+/// One closed-loop conversion of `source` into `env`'s control mode. With
+/// `trailing_tolerance = Some(d)`, extra target steps are also taken while the TCP is more than
+/// `d` metres from the TCP recorded after the source step.
 fn convert_once(
     cfg: &EnvConfig,
     env: &mut Env,
     source: &DemoEpisode,
     record_obs: bool,
-    strict: bool,
+    trailing_tolerance: Option<f32>,
 ) -> Result<(DemoEpisode, Option<Vec<ObsValue>>), DemoError> {
     let (mut recorder, first_obs) = EpisodeRecorder::reset(env, source.episode_seed)?;
     let mut obs = ObsLog::new(record_obs, first_obs);
@@ -187,8 +201,15 @@ fn convert_once(
         debug_assert_eq!(desired.len(), dof);
         for extra in 0..=MAX_EXTRA_STEPS_PER_SOURCE_STEP {
             let reached = step_toward(env, &mut recorder, &mut obs, &desired, source, t)?;
-            let _ = strict;
-            if reached || extra == MAX_EXTRA_STEPS_PER_SOURCE_STEP {
+            let trailing = match trailing_tolerance {
+                Some(tol) => {
+                    tcp_position(env)?
+                        .metric_distance(&targets.recorded_tcp_position(source, t + 1)?)
+                        > tol
+                }
+                None => false,
+            };
+            if (reached && !trailing) || extra == MAX_EXTRA_STEPS_PER_SOURCE_STEP {
                 break;
             }
         }
@@ -205,6 +226,14 @@ fn convert_once(
         }
     }
     Ok((recorder.finish(), obs.0))
+}
+
+/// The world position (m) of `env`'s TCP.
+fn tcp_position(env: &Env) -> Result<nalgebra::Vector3<f32>, DemoError> {
+    let scene = env
+        .task_scene()
+        .expect("checked by SourceJointTargets::new");
+    Ok(scene.agent.tcp_pose(&scene.world).translation.vector)
 }
 
 /// One target step with the action that makes the target controller's drive targets reproduce

@@ -18,7 +18,11 @@ use crate::error::EnvError;
 /// state into a private env to read the joint positions it held.
 pub(crate) struct SourceJointTargets {
     controller: CombinedController,
-    /// Env that holds the recorded states (`None` when the mode needs no state).
+    /// Whether the source mode's targets depend on the recorded joint positions.
+    needs_state: bool,
+    /// Config of the env that holds recorded states.
+    state_cfg: EnvConfig,
+    /// Env that holds the recorded states (made on first use).
     state_env: Option<Env>,
     articulation: ms2_control::PerfectTrackingArticulation,
     action_f64: Vec<f64>,
@@ -39,18 +43,11 @@ impl SourceJointTargets {
             })
         })?;
         let needs_state = mode != ControlMode::PdJointPos;
-        let state_env = if needs_state {
-            let state_cfg = EnvConfig {
-                obs_mode: "state".to_owned(),
-                control_mode: Some(source.control_mode.clone()),
-                render_mode: None,
-                ..cfg.clone()
-            };
-            let mut env = make_env(&state_cfg)?;
-            env.reset(Some(source.episode_seed), false)?;
-            Some(env)
-        } else {
-            None
+        let state_cfg = EnvConfig {
+            obs_mode: "state".to_owned(),
+            control_mode: Some(source.control_mode.clone()),
+            render_mode: None,
+            ..cfg.clone()
         };
         let scene = target_env
             .task_scene()
@@ -68,7 +65,9 @@ impl SourceJointTargets {
         let action_f64 = vec![0.0; controller.action_dim()];
         let mut this = Self {
             controller,
-            state_env,
+            needs_state,
+            state_cfg,
+            state_env: None,
             articulation,
             action_f64,
         };
@@ -77,17 +76,45 @@ impl SourceJointTargets {
         Ok(this)
     }
 
-    /// Puts the articulation at the joint positions recorded before step `t`.
-    fn place_at(&mut self, source: &DemoEpisode, t: usize) -> Result<(), DemoError> {
-        let Some(env) = &mut self.state_env else {
-            return Ok(());
+    /// The env holding recorded state `t` of `source`.
+    fn recorded_state(&mut self, source: &DemoEpisode, t: usize) -> Result<&Env, DemoError> {
+        let env = match &mut self.state_env {
+            Some(env) => env,
+            slot @ None => {
+                let mut env = make_env(&self.state_cfg)?;
+                env.reset(Some(source.episode_seed), false)?;
+                slot.insert(env)
+            }
         };
         env.set_state(&source.env_states[t])?;
+        Ok(env)
+    }
+
+    /// Puts the articulation at the joint positions recorded before step `t` (when the source
+    /// mode needs them).
+    fn place_at(&mut self, source: &DemoEpisode, t: usize) -> Result<(), DemoError> {
+        if !self.needs_state {
+            return Ok(());
+        }
+        let env = self.recorded_state(source, t)?;
         let scene = env
             .task_scene()
             .expect("state env was made like the target env");
         self.articulation = snapshot_articulation(&scene.world, scene.agent.articulation);
         Ok(())
+    }
+
+    /// The world position (m) of the TCP in recorded state `t`.
+    pub(crate) fn recorded_tcp_position(
+        &mut self,
+        source: &DemoEpisode,
+        t: usize,
+    ) -> Result<nalgebra::Vector3<f32>, DemoError> {
+        let env = self.recorded_state(source, t)?;
+        let scene = env
+            .task_scene()
+            .expect("state env was made like the target env");
+        Ok(scene.agent.tcp_pose(&scene.world).translation.vector)
     }
 
     /// The joint targets (articulation dof order: 7 arm joints in rad, 2 fingers in m) that

@@ -13,7 +13,7 @@
 //!   [`crate::adapters::render_scene`]), 2 and 3 = 0 (as in ManiSkill2).
 //! - `extra` keeps only what a real robot would know: [`NON_PRIVILEGED_EXTRA_KEYS`].
 
-use ms2_render::{CameraOutput, FusedPointCloud};
+use ms2_render::CameraOutput;
 
 use crate::obs::{Array, ArrayData, ObsValue};
 
@@ -122,16 +122,24 @@ pub fn assemble(
             root.push(("image".to_owned(), ObsValue::Dict(images)));
         }
         VisualLayout::PointCloud => {
-            let fused = FusedPointCloud::from_cameras(&frame.outputs);
-            let n = fused.len();
-            let xyzw = fused.xyzw.iter().flatten().copied().collect();
-            let rgb = fused.rgb.iter().flatten().copied().collect();
-            let seg = fused
-                .segmentation_actor
-                .iter()
-                .zip(&fused.segmentation_link)
-                .flat_map(|(&visual, &link)| [visual, link, 0, 0])
-                .collect();
+            // Cameras fused in order straight into the flat arrays (no intermediate cloud).
+            let n: usize = frame.outputs.iter().map(|o| o.depth_m.len()).sum();
+            let mut xyzw = Vec::with_capacity(4 * n);
+            let mut rgb = Vec::with_capacity(3 * n);
+            let mut seg = Vec::with_capacity(4 * n);
+            let mut mask = Vec::with_capacity(if robot_seg { n } else { 0 });
+            for out in &frame.outputs {
+                for point in out.point_cloud_world() {
+                    xyzw.extend_from_slice(&point);
+                }
+                rgb.extend_from_slice(&out.rgb);
+                for (&visual, &link) in out.segmentation_actor.iter().zip(&out.segmentation_link) {
+                    seg.extend_from_slice(&[visual, link, 0, 0]);
+                }
+                if robot_seg {
+                    mask.extend(out.segmentation_link.iter().map(is_robot));
+                }
+            }
             let mut cloud = vec![
                 ("xyzw".to_owned(), array(vec![n, 4], ArrayData::F32(xyzw))),
                 ("rgb".to_owned(), array(vec![n, 3], ArrayData::U8(rgb))),
@@ -141,7 +149,6 @@ pub fn assemble(
                 ),
             ];
             if robot_seg {
-                let mask = fused.segmentation_link.iter().map(is_robot).collect();
                 cloud.push((
                     "robot_seg".to_owned(),
                     array(vec![n, 1], ArrayData::Bool(mask)),
