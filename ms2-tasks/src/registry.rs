@@ -40,6 +40,16 @@ const REGISTRY: &[Registration] = &[
         },
     },
     Registration {
+        id: "Fill-v0",
+        make: |cfg, substeps| {
+            Ok(Box::new(TaskEnv::new(
+                cfg,
+                substeps,
+                crate::tasks::soft::fill::Fill::default(),
+            )?))
+        },
+    },
+    Registration {
         id: "Dummy-v0",
         make: |cfg, substeps| Ok(Box::new(DummyEnv::new(cfg, substeps)?)),
     },

@@ -206,7 +206,7 @@ fn kinematic_plate_lifts_a_clay_block() {
                 })),
         )
         .unwrap();
-    let mut soft = SoftWorld::new(solver, &mut world, vec![plate]).unwrap();
+    let mut soft = SoftWorld::new(solver, &world, vec![plate]).unwrap();
     // Settle for 0.2 s, then lift at 0.1 m/s for 0.5 s (5 cm).
     for step in 0..350 {
         if step >= 100 {
@@ -234,7 +234,7 @@ fn kinematic_plate_lifts_a_clay_block() {
     );
 }
 
-mod excavate_env {
+mod soft_envs {
     use ms2_tasks::{info_get, make_env, make_scripted_policy, EnvConfig, EnvError, InfoValue};
 
     fn env(obs_mode: &str) -> ms2_tasks::Env {
@@ -257,7 +257,17 @@ mod excavate_env {
 
     #[test]
     fn particles_obs_mode_state_round_trip_and_determinism() {
-        assert!(ms2_tasks::env_ids().contains(&"Excavate-v0"));
+        round_trip("Excavate-v0", 2000);
+        round_trip("Fill-v0", 500);
+    }
+
+    fn round_trip(env_id: &str, min_particles: usize) {
+        assert!(ms2_tasks::env_ids().contains(&env_id));
+        let env = |obs_mode: &str| {
+            let mut cfg = EnvConfig::new(env_id);
+            cfg.obs_mode = obs_mode.to_owned();
+            make_env(&cfg).unwrap()
+        };
         let mut a = env("particles");
         assert!(a.obs_modes().contains(&"particles".to_owned()));
         assert_eq!(a.max_episode_steps(), 250);
@@ -267,8 +277,8 @@ mod excavate_env {
             panic!("particles/x is not an array");
         };
         assert_eq!(arr.shape[1], 3);
-        assert!(arr.shape[0] > 2000, "{} particles", arr.shape[0]);
-        assert!(obs.get("extra/target_particles").is_some());
+        assert!(arr.shape[0] > min_particles, "{} particles", arr.shape[0]);
+        assert!(obs.get("extra/bucket_pose").is_some());
         let zero = vec![0.0; a.action_space().size()];
         for _ in 0..2 {
             a.step(&zero).unwrap();
@@ -297,6 +307,35 @@ mod excavate_env {
                 );
             }
         }
+    }
+
+    #[test]
+    fn scripted_fill_episode_pours_the_clay_into_the_beaker() {
+        let mut env = env_of("Fill-v0");
+        let mut policy = make_scripted_policy(&env).unwrap();
+        env.reset(Some(3), false).unwrap();
+        policy.reset(&env);
+        let mut info = Vec::new();
+        for _ in 0..80 {
+            let out = env.step(&policy.act(&env)).unwrap();
+            info = out.info;
+            if out.terminated {
+                break;
+            }
+        }
+        let Some(InfoValue::F64(inside)) = info_get(&info, "fraction_inside") else {
+            panic!("no fraction_inside in {info:?}");
+        };
+        assert!(inside > 0.9, "{info:?}");
+        assert_eq!(
+            info_get(&info, "success"),
+            Some(InfoValue::Bool(true)),
+            "{info:?}"
+        );
+    }
+
+    fn env_of(env_id: &str) -> ms2_tasks::Env {
+        make_env(&EnvConfig::new(env_id)).unwrap()
     }
 
     #[test]

@@ -314,7 +314,7 @@ impl ExcavateScene {
                     .with_shape(ShapeSpec::new(bucket_shape())),
             )
             .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
-        let soft = SoftWorld::new(solver, &mut world, vec![bucket])?;
+        let soft = SoftWorld::new(solver, &world, vec![bucket])?;
         let rigid_steps_per_control =
             (1.0 / (CONTROL_FREQ_HZ as f32 * world.timestep())).round() as usize;
         Ok(Self {
@@ -506,13 +506,20 @@ impl ScriptedScoop {
 
     /// The command for control step `step` (0-based: the pose to reach at its end).
     pub fn command(&self, step: u32) -> BucketPose {
-        let s = step + 1;
-        for pair in self.waypoints.windows(2) {
-            let ((s0, p0), (s1, p1)) = (pair[0], pair[1]);
-            if s <= s1 {
-                return p0.lerp(&p1, (s.saturating_sub(s0)) as f32 / (s1 - s0) as f32);
-            }
-        }
-        self.waypoints[self.waypoints.len() - 1].1
+        interpolate_waypoints(&self.waypoints, step)
     }
+}
+
+/// The pose to reach at the end of control step `step` (0-based) along `(step, pose)`
+/// waypoints (ascending steps, the first at 0), linearly interpolated; the last pose after
+/// the last waypoint.
+pub(crate) fn interpolate_waypoints(waypoints: &[(u32, BucketPose)], step: u32) -> BucketPose {
+    let s = step + 1;
+    for pair in waypoints.windows(2) {
+        let ((s0, p0), (s1, p1)) = (pair[0], pair[1]);
+        if s <= s1 {
+            return p0.lerp(&p1, (s.saturating_sub(s0)) as f32 / (s1 - s0) as f32);
+        }
+    }
+    waypoints[waypoints.len() - 1].1
 }

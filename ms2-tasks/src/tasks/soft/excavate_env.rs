@@ -20,23 +20,21 @@
 
 use std::any::Any;
 
-use glam::{Mat3, Vec2, Vec3};
-use ms2_mpm::MpmState;
-use ms2_physics::{BodyId, World};
-use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use glam::Vec3;
+use ms2_physics::World;
 use rand::Rng;
 
+use super::bucket_arm::{soft_err, tcp_for_bucket, BucketArm, FLOATS_PER_PARTICLE};
 use super::excavate::{
-    excavate_soft_config, in_bucket_local, BucketPose, ExcavateBed, ExcavateEvaluation,
-    ScriptedScoop, MAX_EPISODE_STEPS,
+    excavate_soft_config, in_bucket_local, ExcavateBed, ExcavateEvaluation, ScriptedScoop,
+    MAX_EPISODE_STEPS,
 };
-use super::{SoftSceneError, SoftWorld};
 use crate::adapters::mpm_rigid::pose_to_glam;
 use crate::env::Env;
 use crate::error::EnvError;
-use crate::geometry::{vectorize_pose, Pose3};
+use crate::geometry::vectorize_pose;
 use crate::info::{Evaluation, InfoValue};
-use crate::obs::{Array, ArrayData, DictBuilder, ObsValue};
+use crate::obs::{DictBuilder, ObsValue};
 use crate::scripted::oracle::{TcpOracle, GRIPPER_OPEN};
 use crate::scripted::ScriptedPolicy;
 use crate::seeding::EpisodeRng;
@@ -50,36 +48,14 @@ pub const GRID_ORIGIN: Vec3 = Vec3::new(-0.18, -0.16, -0.03);
 /// the bed's near edge.
 const APPROACH_STEPS: u32 = 14;
 
-/// Floats of task state per particle: position 3, velocity 3, F 9, C 9.
-const FLOATS_PER_PARTICLE: usize = 24;
 /// Floats of task state before the particles.
 const STATE_HEADER: usize = 6;
-
-fn soft_err(e: SoftSceneError) -> EnvError {
-    EnvError::Physics(format!("soft body: {e}"))
-}
-
-/// Pose of the bucket frame in the hand frame (`ms2_assets::PANDA_BUCKET_IN_HAND`).
-fn hand_from_bucket() -> Isometry3<f32> {
-    let ([x, y, z], [r, p, w]) = ms2_assets::PANDA_BUCKET_IN_HAND;
-    Isometry3::from_parts(
-        Translation3::new(x as f32, y as f32, z as f32),
-        UnitQuaternion::from_euler_angles(r as f32, p as f32, w as f32),
-    )
-}
-
-/// The TCP pose that puts the bucket at `bucket` (world).
-pub fn tcp_for_bucket(bucket: &BucketPose) -> Pose3 {
-    let hand_from_tcp = Isometry3::translation(0.0, 0.0, 0.1034);
-    bucket.to_pose() * hand_from_bucket().inverse() * hand_from_tcp
-}
 
 /// The `Excavate-v0` task (see the [module docs](self)).
 #[derive(Default)]
 pub struct Excavate {
-    soft: Option<SoftWorld>,
+    arm: BucketArm,
     bed: Option<ExcavateBed>,
-    hand: Option<(ms2_physics::ArticulationId, usize, BodyId)>,
 }
 
 impl Excavate {
@@ -88,31 +64,14 @@ impl Excavate {
         self.bed.as_ref()
     }
 
-    /// World pose of the bucket frame.
-    pub fn bucket_pose(&self, world: &World) -> Pose3 {
-        let Some((art, link, _)) = self.hand else {
-            return Pose3::identity();
-        };
-        let hand = world
-            .link_pose(art, link)
-            .unwrap_or_else(|_| Pose3::identity());
-        hand * hand_from_bucket()
-    }
-
-    /// The bucket's position (plate centre, m) and pitch (rad; positive raises the opening).
-    pub fn bucket_command_pose(&self, world: &World) -> BucketPose {
-        let pose = self.bucket_pose(world);
-        let (p, q) = pose_to_glam(&pose);
-        let x = q * Vec3::X;
-        BucketPose {
-            position: p,
-            pitch: x.z.atan2(Vec2::new(x.x, x.y).length()),
-        }
+    /// The bucket-carrying arm and its clay.
+    pub fn arm(&self) -> &BucketArm {
+        &self.arm
     }
 
     fn excavate_eval(&self, world: &World) -> Option<ExcavateEvaluation> {
-        let (soft, bed) = (self.soft.as_ref()?, self.bed.as_ref()?);
-        let (pos, rot) = pose_to_glam(&self.bucket_pose(world));
+        let (soft, bed) = (self.arm.soft()?, self.bed.as_ref()?);
+        let (pos, rot) = pose_to_glam(&self.arm.bucket_pose(world));
         let inv = rot.inverse();
         Some(
             bed.evaluate(soft.solver().positions(), soft.mean_speed(), |p| {
@@ -137,8 +96,7 @@ impl Task for Excavate {
 
     fn build_scene(&mut self, _world: &mut World, _rng: &mut EpisodeRng) -> Result<(), EnvError> {
         // The table is the world's ground; the clay is built per episode.
-        self.soft = None;
-        self.hand = None;
+        self.arm.clear();
         Ok(())
     }
 
@@ -147,33 +105,22 @@ impl Task for Excavate {
         scene: &mut TaskScene,
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
-        let world = &mut scene.world;
-        let art = scene.agent.articulation;
-        let link = world
-            .link_index(art, "panda_hand")
-            .map_err(|e| EnvError::Physics(e.to_string()))?;
-        let body = world
-            .link_body(art, link)
-            .map_err(|e| EnvError::Physics(e.to_string()))?;
-        self.hand = Some((art, link, body));
+        self.arm.locate_hand(scene)?;
         let (solver, bed) = ExcavateBed::sample(&excavate_soft_config(GRID_ORIGIN), rng.random())
             .map_err(soft_err)?;
-        self.soft = Some(SoftWorld::new(solver, world, vec![body]).map_err(soft_err)?);
+        self.arm.couple(solver, &scene.world, &[])?;
         self.bed = Some(bed);
         Ok(())
     }
 
     fn after_physics_step(&mut self, world: &mut World) -> Result<(), EnvError> {
-        match &mut self.soft {
-            Some(soft) => soft.after_rigid_step(world).map_err(soft_err),
-            None => Ok(()),
-        }
+        self.arm.after_physics_step(world)
     }
 
     fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
         let world = &scene.world;
         extra.push_vector("tcp_pose", &vectorize_pose(&scene.agent.tcp_pose(world)));
-        extra.push_vector("bucket_pose", &vectorize_pose(&self.bucket_pose(world)));
+        extra.push_vector("bucket_pose", &vectorize_pose(&self.arm.bucket_pose(world)));
         let bed = self.bed.as_ref();
         extra.push_vector(
             "target_particles",
@@ -223,11 +170,10 @@ impl Task for Excavate {
     }
 
     fn task_state(&self) -> Vec<f32> {
-        let (Some(soft), Some(bed)) = (&self.soft, &self.bed) else {
+        let Some(bed) = &self.bed else {
             return vec![0.0; STATE_HEADER];
         };
-        let s = soft.solver();
-        let n = s.particle_count();
+        let n = self.arm.particle_count();
         let mut out = Vec::with_capacity(STATE_HEADER + FLOATS_PER_PARTICLE * n);
         out.extend([
             bed.target_particles as f32,
@@ -237,57 +183,24 @@ impl Task for Excavate {
             n as f32,
             0.0,
         ]);
-        for i in 0..n {
-            out.extend(s.positions()[i].to_array());
-            out.extend(s.velocities()[i].to_array());
-            out.extend(s.deformation_gradients()[i].to_cols_array());
-            out.extend(s.affine_velocities()[i].to_cols_array());
-        }
+        self.arm.push_particle_state(&mut out);
         out
     }
 
     fn task_state_len(&self) -> usize {
-        STATE_HEADER
-            + FLOATS_PER_PARTICLE
-                * self
-                    .soft
-                    .as_ref()
-                    .map_or(0, |s| s.solver().particle_count())
+        STATE_HEADER + FLOATS_PER_PARTICLE * self.arm.particle_count()
     }
 
     fn set_task_state(&mut self, state: &[f32]) {
-        let (Some(soft), Some(bed)) = (&mut self.soft, &mut self.bed) else {
-            return;
-        };
-        bed.target_particles = state[0] as usize;
-        (bed.floor_z, bed.bed_top_z, bed.mean_bed_z) = (state[1], state[2], state[3]);
-        let mut full: MpmState = soft.state();
-        for (i, chunk) in state[STATE_HEADER..]
-            .chunks_exact(FLOATS_PER_PARTICLE)
-            .enumerate()
-        {
-            full.positions[i] = Vec3::from_slice(&chunk[0..3]);
-            full.velocities[i] = Vec3::from_slice(&chunk[3..6]);
-            full.deformation_gradients[i] = Mat3::from_cols_slice(&chunk[6..15]);
-            full.affine_velocities[i] = Mat3::from_cols_slice(&chunk[15..24]);
+        if let Some(bed) = &mut self.bed {
+            bed.target_particles = state[0] as usize;
+            (bed.floor_z, bed.bed_top_z, bed.mean_bed_z) = (state[1], state[2], state[3]);
         }
-        // Lengths were checked by the runtime and values are finite; a position outside the
-        // soft domain is the only refusal left, and then the soft state is kept.
-        let _ = soft.set_state(&full);
+        self.arm.set_particle_state(&state[STATE_HEADER..]);
     }
 
     fn particles_obs(&self) -> Option<ObsValue> {
-        let soft = self.soft.as_ref()?;
-        let x = soft.solver().positions();
-        let mut particles = DictBuilder::new();
-        particles.push(
-            "x",
-            ObsValue::Array(Array {
-                shape: vec![x.len(), 3],
-                data: ArrayData::F32(x.iter().flat_map(|p| p.to_array()).collect()),
-            }),
-        );
-        Some(particles.build())
+        self.arm.particles_obs()
     }
 
     fn as_any(&self) -> &dyn Any {
@@ -315,7 +228,7 @@ impl ScriptedPolicy for ExcavatePolicy {
         let task = env.task_any().and_then(|t| t.downcast_ref::<Excavate>());
         self.plan = match (task, env.task_scene()) {
             (Some(task), Some(scene)) => task.bed().map(|bed| {
-                let mut start = task.bucket_command_pose(&scene.world);
+                let mut start = task.arm().bucket_command_pose(&scene.world);
                 start.pitch = 0.0;
                 ScriptedScoop::plan_from(start, bed, APPROACH_STEPS)
             }),

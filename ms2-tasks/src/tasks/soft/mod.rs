@@ -18,8 +18,10 @@
 //! rules and the scripted scoop); [`excavate_env`] is `Excavate-v0`, the same task with the
 //! bucket on the Panda's hand, on the shared robot-task runtime.
 
+pub mod bucket_arm;
 pub mod excavate;
 pub mod excavate_env;
+pub mod fill;
 
 use glam::Vec3;
 use ms2_mpm::{
@@ -28,7 +30,9 @@ use ms2_mpm::{
 };
 use ms2_physics::{BodyId, World};
 
-use crate::adapters::mpm_rigid::{CoupledBodies, MpmAdapterError, MpmRigidWorld};
+use crate::adapters::mpm_rigid::{
+    CoupledBodies, MpmAdapterError, MpmRigidWorld, MpmRigidWorldView,
+};
 
 /// Why a soft scene failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -100,7 +104,7 @@ impl SoftWorld {
     /// must divide the world's time step into a whole number of substeps.
     pub fn new(
         solver: MpmSolver,
-        world: &mut World,
+        world: &World,
         bodies: Vec<BodyId>,
     ) -> Result<Self, SoftSceneError> {
         let dt = solver.config().substep_dt;
@@ -115,7 +119,7 @@ impl SoftWorld {
         }
         let bodies = CoupledBodies::new(world, bodies)?;
         let coupling = Coupling::new(
-            &MpmRigidWorld::new(world, &bodies),
+            &MpmRigidWorldView::new(world, &bodies),
             CouplingParams::for_substep(dt),
         )?;
         Ok(Self {

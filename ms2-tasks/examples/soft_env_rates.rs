@@ -1,7 +1,7 @@
-//! Runs the scripted solution of `Excavate-v0` over seeds and prints the success rate and
-//! env steps/s.
+//! Runs the scripted solution of a soft-body env (`Excavate-v0`, `Fill-v0`) over seeds and
+//! prints each episode's final info, the success rate and env steps/s.
 //!
-//! `cargo run --release -p ms2-tasks --example excavate_env_rates -- [seeds] [control_mode]`
+//! `cargo run --release -p ms2-tasks --example soft_env_rates -- <env_id> [seeds] [control_mode]`
 //! (defaults: 50 seeds, pd_joint_delta_pos).
 
 use std::time::Instant;
@@ -10,9 +10,10 @@ use ms2_tasks::{info_get, make_env, make_scripted_policy, EnvConfig, InfoValue};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let seeds: u64 = args.get(1).map(|s| s.parse()).transpose()?.unwrap_or(50);
-    let mut cfg = EnvConfig::new("Excavate-v0");
-    if let Some(mode) = args.get(2) {
+    let env_id = args.get(1).map_or("Excavate-v0", String::as_str);
+    let seeds: u64 = args.get(2).map(|s| s.parse()).transpose()?.unwrap_or(50);
+    let mut cfg = EnvConfig::new(env_id);
+    if let Some(mode) = args.get(3) {
         cfg.control_mode = Some(mode.clone());
     }
     let mut env = make_env(&cfg)?;
@@ -38,7 +39,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("seed {seed}: {info:?}");
     }
     println!(
-        "Excavate-v0 scripted ({}): {successes}/{seeds} successes, {:.2} env steps/s",
+        "{env_id} scripted ({}): {successes}/{seeds} successes, {:.2} env steps/s",
         env.control_mode(),
         steps as f64 / t0.elapsed().as_secs_f64()
     );
