@@ -50,3 +50,27 @@ pub const PANDA_REST_QPOS: [f64; 9] = [
     0.04,
     0.04,
 ];
+
+/// URDF of the Panda with a bucket fixed to `panda_hand` (link `bucket`, joint `bucket_joint`),
+/// the tool of the soft-body tasks (Excavate). Generated from [`PANDA_URDF`] by
+/// `tools/gen_panda_bucket_urdf.py`; the arm and hand are unchanged, so the TCP chain and the
+/// controllers are those of the Panda.
+///
+/// ```
+/// assert!(ms2_assets::PANDA_BUCKET_URDF.contains("bucket_joint"));
+/// ```
+pub const PANDA_BUCKET_URDF: &str = include_str!("../robots/panda/panda_bucket.urdf");
+
+/// The bucket's frame in the `panda_hand` frame: translation (m) and roll-pitch-yaw (rad).
+/// Bucket frame: origin at the centre of the bottom plate, x towards the open front, z up out
+/// of the plate. With the hand pointing down (top-down TCP) the plate is level, 20 cm below
+/// the hand (about 10 cm below the TCP), opening along the hand's x axis.
+pub const PANDA_BUCKET_IN_HAND: ([f64; 3], [f64; 3]) =
+    ([0.0, 0.0, 0.2], [std::f64::consts::PI, 0.0, 0.0]);
+
+/// Interior half extents of the bucket (m, bucket frame): length along x, width along y,
+/// height of the walls above the plate's centre along z is twice the last value.
+pub const PANDA_BUCKET_INNER_HALF: [f64; 3] = [0.04, 0.035, 0.04];
+
+/// Half thickness (m) of the bucket's plate and walls.
+pub const PANDA_BUCKET_WALL_HALF: f64 = 0.003;

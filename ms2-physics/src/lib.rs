@@ -54,7 +54,7 @@ pub use contact::{ContactPoint, ContactReport};
 pub use error::{PhysicsError, Result, UrdfError};
 pub use math::Pose3;
 pub use mesh::MeshCollision;
-pub use panda::{add_panda, PandaOptions, PANDA_FINGER_FRICTION};
+pub use panda::{add_panda, add_panda_from_urdf, PandaOptions, PANDA_FINGER_FRICTION};
 pub use shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
 pub use urdf::{parse_urdf_file, parse_urdf_str, UrdfLoadOptions};
 pub use world::{ActorDesc, ActorKind, BodyId, BodyKind, World};

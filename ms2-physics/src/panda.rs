@@ -44,10 +44,27 @@ impl Default for PandaOptions {
 /// Adds the Panda (9 degrees of freedom: `panda_joint1..7`, `panda_finger_joint1/2`) with
 /// gravity-compensated links, PD drives and finger friction; drive targets start at `qpos`.
 pub fn add_panda(world: &mut World, options: &PandaOptions) -> Result<ArticulationId> {
-    let desc = parse_urdf_str(
+    add_panda_from_urdf(
+        world,
+        options,
         ms2_assets::PANDA_URDF,
-        std::path::Path::new("."),
         "ms2-assets/robots/panda/panda.urdf",
+    )
+}
+
+/// [`add_panda`] from another description of the same robot: `urdf` must have the Panda's
+/// joints and finger links (e.g. `ms2_assets::PANDA_BUCKET_URDF`, the Panda with a tool fixed
+/// to its hand); `source` names it in errors.
+pub fn add_panda_from_urdf(
+    world: &mut World,
+    options: &PandaOptions,
+    urdf: &str,
+    source: &str,
+) -> Result<ArticulationId> {
+    let desc = parse_urdf_str(
+        urdf,
+        std::path::Path::new("."),
+        source,
         &UrdfLoadOptions::default(),
     )?;
     let art_options = ArticulationOptions {
@@ -61,8 +78,7 @@ pub fn add_panda(world: &mut World, options: &PandaOptions) -> Result<Articulati
         ],
         initial_qpos: Some(options.qpos.to_vec()),
     };
-    let art =
-        world.add_articulation_from(&desc, &art_options, "ms2-assets/robots/panda/panda.urdf")?;
+    let art = world.add_articulation_from(&desc, &art_options, source)?;
     for i in 0..7 {
         world.set_drive(art, i, options.arm_drive)?;
     }

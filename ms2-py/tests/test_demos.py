@@ -165,6 +165,11 @@ def test_converted_trajectories_succeed(demo_file, target, capsys):
             assert ep["actions"].shape[1] == width
             assert ep["success"][-1] and ep["info"]["success"]
             assert np.all(np.abs(ep["actions"]) <= 1.0 + 1e-6)  # normalised target space
+    if target == "pd_joint_delta_pos":
+        # ... and back: pd_joint_delta_pos -> pd_joint_pos.
+        back = replay(out, target_control_mode="pd_joint_pos", save_traj=True, progress=False)
+        assert back.num_succeeded == NUM_DEMOS
+        assert back.output.name == f"PickCube-v0.none.{target}.none.pd_joint_pos.h5"
 
 
 def test_replayed_state_dict_observations_are_nested_groups(demo_file):
@@ -222,6 +227,17 @@ def test_missing_truncated_and_foreign_files_give_clear_errors(demo_file, tmp_pa
     with pytest.raises(TrajectoryFileError, match="not a trajectory metadata file"):
         open_trajectory(other_json)
 
+    soft = tmp_path / "soft.h5"
+    with h5py.File(soft, "w") as f:
+        f.create_dataset("traj_0/actions", data=np.zeros((2, 8), np.float32))
+        f.create_dataset("traj_0/success", data=np.zeros(2, bool))
+        f.create_dataset("traj_0/env_init_state", data=np.zeros(5, np.float32))
+    soft_meta = json.loads(text_json)
+    soft_meta["episodes"] = soft_meta["episodes"][:1]
+    soft.with_suffix(".json").write_text(json.dumps(soft_meta))
+    with open_trajectory(soft) as traj, pytest.raises(TrajectoryFileError, match="soft-body"):
+        traj.read_episode(0)
+
     fewer = tmp_path / "fewer.h5"
     with h5py.File(demo_file, "r") as src, h5py.File(fewer, "w") as dst:
         src.copy("traj_0", dst)
@@ -232,6 +248,7 @@ def test_missing_truncated_and_foreign_files_give_clear_errors(demo_file, tmp_pa
 
 def test_interrupted_writer_keeps_the_last_commit(tmp_path):
     path = tmp_path / "partial.h5"
+    path.write_bytes(b"an older file of the same name")
     info = {"env_id": ENV_ID, "max_episode_steps": 200, "env_kwargs": {}}
     episodes = _native.scripted_episodes(ENV_ID, [0, 1, 2], {}, 2)
     with pytest.raises(KeyboardInterrupt):
@@ -247,25 +264,11 @@ def test_interrupted_writer_keeps_the_last_commit(tmp_path):
     assert {p.name for p in tmp_path.iterdir()} == {"partial.h5", "partial.json"}
 
 
-def test_killed_generate_leaves_a_valid_file_of_finished_episodes(tmp_path):
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT])
+def test_interrupted_generate_leaves_a_valid_file_of_finished_episodes(tmp_path, sig):
     path = tmp_path / "killed.h5"
-    cmd = [
-        sys.executable,
-        "-m",
-        "ms2",
-        "demos",
-        "generate",
-        ENV_ID,
-        "-n",
-        "400",
-        "-o",
-        str(path),
-        "--workers",
-        "1",
-        "--policy",
-        "scripted",
-        "-q",
-    ]
+    cmd = [sys.executable, "-m", "ms2", "demos", "generate", ENV_ID, "-n", "400", "-o",
+           str(path), "--workers", "1", "--policy", "scripted", "-q"]  # fmt: skip
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 120
     try:
@@ -275,10 +278,15 @@ def test_killed_generate_leaves_a_valid_file_of_finished_episodes(tmp_path):
                 break
             assert proc.poll() is None, proc.stderr.read().decode()
             time.sleep(0.05)
-        os.kill(proc.pid, signal.SIGKILL)
+        os.kill(proc.pid, sig)
+        proc.wait(timeout=60)
     finally:
+        proc.kill()
         proc.wait()
-    assert proc.returncode == -signal.SIGKILL  # killed mid-run, not finished
+    # Interrupted mid-run, not finished: SIGKILL kills it, Ctrl-C (SIGINT) ends it with 130.
+    assert proc.returncode == (-signal.SIGKILL if sig == signal.SIGKILL else 130)
+    if sig == signal.SIGINT:
+        assert "interrupted" in proc.stderr.read().decode()
     with open_trajectory(path) as traj:
         assert 4 <= len(traj) < 400
         for i in range(len(traj)):
@@ -319,3 +327,15 @@ def test_replay_saves_one_video_per_episode(demo_file):
     assert [v.name for v in result.videos] == ["traj_0.mp4"]
     assert result.videos[0].parent.name == "PickCube-v0.none.pd_joint_pos.videos"
     assert result.videos[0].stat().st_size > 1000
+
+
+def test_a_new_writer_replaces_an_older_file_from_its_first_commit(demo_file, tmp_path):
+    path = tmp_path / "again.h5"
+    path.write_bytes(demo_file.read_bytes())
+    path.with_suffix(".json").write_text(demo_file.with_suffix(".json").read_text())
+    info = {"env_id": ENV_ID, "max_episode_steps": 200, "env_kwargs": {}}
+    with TrajectoryWriter(path, info) as writer:
+        writer.commit()
+    with open_trajectory(path) as traj:
+        assert len(traj) == 0
+        assert list(traj.h5.keys()) == []

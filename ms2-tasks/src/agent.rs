@@ -2,7 +2,7 @@
 //! controller (ms2-control) for one control mode.
 
 use ms2_control::{CombinedController, ControlMode, ControlTiming, RobotConfig};
-use ms2_physics::{add_panda, ArticulationId, BodyId, PandaOptions, World};
+use ms2_physics::{add_panda_from_urdf, ArticulationId, BodyId, PandaOptions, World};
 use nalgebra::Vector3;
 use rand_distr::{Distribution, Normal};
 
@@ -58,9 +58,22 @@ impl PandaAgent {
         mode: ControlMode,
         timing: ControlTiming,
     ) -> Result<Self, EnvError> {
+        Self::build_from_urdf(world, robot, mode, timing, ms2_assets::PANDA_URDF)
+    }
+
+    /// [`PandaAgent::build`] from another description of the Panda (the same joints and
+    /// links plus, e.g., a tool fixed to the hand: `ms2_assets::PANDA_BUCKET_URDF`).
+    pub fn build_from_urdf(
+        world: &mut World,
+        robot: &RobotConfig,
+        mode: ControlMode,
+        timing: ControlTiming,
+        urdf: &str,
+    ) -> Result<Self, EnvError> {
         let options = PandaOptions::default();
         let base_pose = options.base_pose;
-        let art = add_panda(world, &options).map_err(physics_err)?;
+        let art = add_panda_from_urdf(world, &options, urdf, "robot URDF of the task")
+            .map_err(physics_err)?;
         let controller = {
             let view = PhysicsArticulation::new(world, art);
             robot

@@ -36,6 +36,10 @@ pub(crate) trait EnvBackend: Send {
     fn observe_state_dict(&self) -> ObsValue;
     /// Success and evaluation terms of the current state.
     fn evaluate(&self) -> Evaluation;
+    /// The `particles` entry of the `particles` obs mode; `None` for envs without particles.
+    fn observe_particles(&self) -> Option<ObsValue> {
+        None
+    }
     /// Dense reward of the current state after `action`.
     fn dense_reward(&self, eval: &Evaluation, action: &[f32]) -> f64;
     /// Length of the flat state vector.

@@ -102,17 +102,20 @@ pub enum ObsMode {
     RgbdRobotSeg,
     /// `pointcloud` plus a boolean robot mask per point.
     PointCloudRobotSeg,
+    /// `state_dict` plus `particles` (soft-body envs: `{"x": [N, 3]}` particle positions).
+    Particles,
 }
 
 impl ObsMode {
     /// All supported modes.
-    pub const ALL: [ObsMode; 6] = [
+    pub const ALL: [ObsMode; 7] = [
         ObsMode::StateDict,
         ObsMode::State,
         ObsMode::Rgbd,
         ObsMode::PointCloud,
         ObsMode::RgbdRobotSeg,
         ObsMode::PointCloudRobotSeg,
+        ObsMode::Particles,
     ];
 
     /// The mode's name as used in configs (`"state_dict"`, `"state"`, `"rgbd"`, …).
@@ -124,13 +127,14 @@ impl ObsMode {
             ObsMode::PointCloud => "pointcloud",
             ObsMode::RgbdRobotSeg => "rgbd_robot_seg",
             ObsMode::PointCloudRobotSeg => "pointcloud_robot_seg",
+            ObsMode::Particles => "particles",
         }
     }
 
     /// The visual layout and whether a robot mask is added; `None` for the state modes.
     pub fn visual(self) -> Option<(VisualLayout, bool)> {
         match self {
-            ObsMode::StateDict | ObsMode::State => None,
+            ObsMode::StateDict | ObsMode::State | ObsMode::Particles => None,
             ObsMode::Rgbd => Some((VisualLayout::Rgbd, false)),
             ObsMode::PointCloud => Some((VisualLayout::PointCloud, false)),
             ObsMode::RgbdRobotSeg => Some((VisualLayout::Rgbd, true)),

@@ -108,6 +108,16 @@ impl Env {
         // The backend built its scene when it was made; sample a first episode.
         let mut rng = episode_rng(CONSTRUCTION_SEED);
         env.backend.initialize_episode(&mut rng)?;
+        if obs_mode == ObsMode::Particles && env.backend.observe_particles().is_none() {
+            return Err(EnvError::UnknownObsMode {
+                got: env.cfg.obs_mode.clone(),
+                valid: ObsMode::ALL
+                    .iter()
+                    .filter(|m| **m != ObsMode::Particles)
+                    .map(|m| m.as_str().to_owned())
+                    .collect(),
+            });
+        }
         env.observation_space = Space::unbounded_like(&env.try_observe()?);
         Ok(env)
     }
@@ -276,6 +286,13 @@ impl Env {
                 ObsValue::Dict(crate::sensors::visual_obs::non_privileged_state(dict))
             }
             ObsMode::StateDict => dict,
+            ObsMode::Particles => match (dict, self.backend.observe_particles()) {
+                (ObsValue::Dict(mut entries), Some(particles)) => {
+                    entries.push(("particles".to_owned(), particles));
+                    ObsValue::Dict(entries)
+                }
+                (dict, _) => dict,
+            },
             ObsMode::State => {
                 let mut flat = Vec::with_capacity(64);
                 dict.flatten_f32_into(&mut flat);
@@ -359,12 +376,15 @@ impl Env {
         self.backend.control_modes()
     }
 
-    /// Supported observation modes (visual modes only for envs with a 3D scene).
+    /// Supported observation modes (visual modes only for envs with a 3D scene, `particles`
+    /// only for soft-body envs).
     pub fn obs_modes(&self) -> Vec<String> {
         let renderable = self.backend.task_scene().is_some();
+        let has_particles = self.backend.observe_particles().is_some();
         ObsMode::ALL
             .iter()
             .filter(|m| renderable || m.visual().is_none())
+            .filter(|m| has_particles || **m != ObsMode::Particles)
             .map(|m| m.as_str().to_owned())
             .collect()
     }

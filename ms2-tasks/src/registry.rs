@@ -30,6 +30,26 @@ const REGISTRY: &[Registration] = &[
         make: |cfg, substeps| Ok(Box::new(TaskEnv::new(cfg, substeps, StackCube::default())?)),
     },
     Registration {
+        id: "Excavate-v0",
+        make: |cfg, substeps| {
+            Ok(Box::new(TaskEnv::new(
+                cfg,
+                substeps,
+                crate::tasks::soft::excavate_env::Excavate::default(),
+            )?))
+        },
+    },
+    Registration {
+        id: "Fill-v0",
+        make: |cfg, substeps| {
+            Ok(Box::new(TaskEnv::new(
+                cfg,
+                substeps,
+                crate::tasks::soft::fill::Fill::default(),
+            )?))
+        },
+    },
+    Registration {
         id: "Dummy-v0",
         make: |cfg, substeps| Ok(Box::new(DummyEnv::new(cfg, substeps)?)),
     },

@@ -8,6 +8,7 @@
 //! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
 //! | every reset, in this order | [`Task::initialize_actors`], robot reset (rest qpos + noise), [`Task::initialize_task`] |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
+//! | after every physics step | [`Task::after_physics_step`] (e.g. soft-body substeps) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
 
@@ -18,7 +19,7 @@ use ms2_physics::World;
 use crate::agent::PandaAgent;
 use crate::error::EnvError;
 use crate::info::Evaluation;
-use crate::obs::DictBuilder;
+use crate::obs::{DictBuilder, ObsValue};
 use crate::seeding::EpisodeRng;
 
 /// What a task's hooks see: the physics world and the robot.
@@ -81,6 +82,24 @@ pub trait Task: Send + 'static {
     /// Length of [`Task::task_state`].
     fn task_state_len(&self) -> usize {
         0
+    }
+
+    /// URDF of the robot (the Panda, or the Panda with a tool such as
+    /// `ms2_assets::PANDA_BUCKET_URDF`).
+    fn robot_urdf(&self) -> &'static str {
+        ms2_assets::PANDA_URDF
+    }
+
+    /// Runs after each physics step of the world (500 Hz): soft-body tasks advance their
+    /// coupled MPM solver here.
+    fn after_physics_step(&mut self, _world: &mut World) -> Result<(), EnvError> {
+        Ok(())
+    }
+
+    /// The `particles` entry of the `particles` observation mode (soft-body tasks:
+    /// `{"x": [N, 3] positions (m, world)}`); `None` for tasks without particles.
+    fn particles_obs(&self) -> Option<ObsValue> {
+        None
     }
 
     /// The task as `Any`, for scripted policies that read task data.

@@ -150,7 +150,7 @@ fn build_scene<T: Task>(
     rng: &mut EpisodeRng,
 ) -> Result<TaskScene, EnvError> {
     let mut world = World::new(world_config.clone()).map_err(physics_err)?;
-    let agent = PandaAgent::build(&mut world, robot, mode, timing)?;
+    let agent = PandaAgent::build_from_urdf(&mut world, robot, mode, timing, task.robot_urdf())?;
     task.build_scene(&mut world, rng)?;
     Ok(TaskScene { world, agent })
 }
@@ -211,6 +211,7 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
         for _ in 0..self.substeps {
             agent.before_substep(world);
             world.step();
+            self.task.after_physics_step(world)?;
         }
         Ok(())
     }
@@ -246,6 +247,10 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
 
     fn evaluate(&self) -> Evaluation {
         self.task.evaluate(&self.scene)
+    }
+
+    fn observe_particles(&self) -> Option<ObsValue> {
+        self.task.particles_obs()
     }
 
     fn dense_reward(&self, eval: &Evaluation, _action: &[f32]) -> f64 {

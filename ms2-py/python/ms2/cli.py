@@ -275,6 +275,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))
+    except KeyboardInterrupt:
+        # Trajectory files are committed chunk by chunk: what is on disk is complete.
+        print(f"ms2 {args.command}: interrupted", file=sys.stderr)
+        return 130
     except (ValueError, RuntimeError, FileNotFoundError) as err:
         print(f"ms2 {args.command}: error: {err}", file=sys.stderr)
         return 2

@@ -272,6 +272,8 @@ def replay(
             "env_kwargs": {**env_kwargs, "obs_mode": obs_mode or "none", "control_mode": out_mode},
         }
         writer = TrajectoryWriter(output, out_info) if save_traj else None
+        if writer is not None:
+            writer.commit()  # a valid (empty) output from the start
         result = ReplayResult(0, 0, 0.0, output if save_traj else None, 0)
         indices = list(range(len(episodes_meta)))
         try:

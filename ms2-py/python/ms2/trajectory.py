@@ -200,13 +200,12 @@ class TrajectoryWriter:
     def commit(self) -> None:
         """Makes every appended episode durable: ``X.h5`` is replaced by the working copy, then
         ``X.json`` (also written to a temporary file and renamed)."""
+        if self._file is None and self._committed == 0:
+            self._working_file()  # the first commit always writes a fresh (maybe empty) file
         if self._file is not None:
             self._file.flush()
             self._file.close()
             self._file = None
-            os.replace(self._tmp, self.path)
-        elif not self.path.exists():
-            _h5py().File(self._tmp, "w").close()
             os.replace(self._tmp, self.path)
         meta = {"env_info": self.env_info, "episodes": self.episodes}
         tmp_json = self.json_path.with_name(f".{self.json_path.name}.{os.getpid()}.tmp")
@@ -263,6 +262,11 @@ class Trajectory:
         meta = self.episodes[index]
         name = f"traj_{meta['episode_id']}"
         group = self.h5[name]
+        if "env_states" not in group and "env_init_state" in group:
+            raise TrajectoryFileError(
+                f"{self.path}: {name} stores only env_init_state (a soft-body trajectory); ms2 "
+                "reads rigid-body trajectories with per-step env_states"
+            )
         try:
             out = dict(meta)
             out["actions"] = np.asarray(group["actions"][()], dtype=np.float32)

@@ -140,8 +140,52 @@ impl RigidBackend for MpmRigidWorld<'_> {
     }
 
     fn body_state(&self, body: usize) -> BodyState {
+        body_state(self.world, self.bodies, body)
+    }
+
+    fn apply_coupling_wrench(&mut self, body: usize, force: Vec3, torque: Vec3) {
         let id = self.bodies.bodies[body];
-        let w = &*self.world;
+        // Only dynamic actors and links accept forces; the others are refused by the world
+        // and are moved by the task, so their wrench is dropped on purpose.
+        if self.world.apply_force(id, &vec_to_na(force)).is_ok() {
+            let _ = self.world.apply_torque(id, &vec_to_na(torque));
+        }
+    }
+}
+
+/// A read-only [`RigidBackend`] view of the world, for setting up a [`ms2_mpm::Coupling`]
+/// (which reads shapes and poses only); wrenches handed to it are dropped.
+pub struct MpmRigidWorldView<'a> {
+    world: &'a World,
+    bodies: &'a CoupledBodies,
+}
+
+impl<'a> MpmRigidWorldView<'a> {
+    /// Views `world`; `bodies` must come from the same world.
+    pub fn new(world: &'a World, bodies: &'a CoupledBodies) -> Self {
+        Self { world, bodies }
+    }
+}
+
+impl RigidBackend for MpmRigidWorldView<'_> {
+    fn body_count(&self) -> usize {
+        self.bodies.bodies.len()
+    }
+
+    fn collision_shapes(&self, body: usize) -> Vec<CollisionShape> {
+        self.bodies.shapes.get(body).cloned().unwrap_or_default()
+    }
+
+    fn body_state(&self, body: usize) -> BodyState {
+        body_state(self.world, self.bodies, body)
+    }
+
+    fn apply_coupling_wrench(&mut self, _body: usize, _force: Vec3, _torque: Vec3) {}
+}
+
+fn body_state(w: &World, bodies: &CoupledBodies, body: usize) -> BodyState {
+    {
+        let id = bodies.bodies[body];
         // Ids were checked in `CoupledBodies::new`; bodies are never removed from a world.
         let pose = w.body_pose(id).unwrap_or_else(|_| Pose3::identity());
         let lin = w
@@ -160,15 +204,6 @@ impl RigidBackend for MpmRigidWorld<'_> {
             linear_velocity: vec_to_glam(&lin),
             angular_velocity: vec_to_glam(&ang),
             center_of_mass: vec_to_glam(&com.coords),
-        }
-    }
-
-    fn apply_coupling_wrench(&mut self, body: usize, force: Vec3, torque: Vec3) {
-        let id = self.bodies.bodies[body];
-        // Only dynamic actors and links accept forces; the others are refused by the world
-        // and are moved by the task, so their wrench is dropped on purpose.
-        if self.world.apply_force(id, &vec_to_na(force)).is_ok() {
-            let _ = self.world.apply_torque(id, &vec_to_na(torque));
         }
     }
 }

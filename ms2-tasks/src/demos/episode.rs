@@ -97,7 +97,8 @@ fn check_rows(name: &str, rows: &[Vec<f32>]) -> Result<(), String> {
 /// use ms2_tasks::{make_env, EnvConfig};
 /// let mut env = make_env(&EnvConfig::new("Dummy-v0")).unwrap();
 /// let (mut rec, _obs) = EpisodeRecorder::reset(&mut env, 7).unwrap();
-/// rec.step(&mut env, &vec![0.0; env.action_space().size()]).unwrap();
+/// let action = vec![0.0; env.action_space().size()];
+/// rec.step(&mut env, &action).unwrap();
 /// let episode = rec.finish();
 /// assert_eq!((episode.elapsed_steps, episode.env_states.len()), (1, 2));
 /// episode.validate().unwrap();

@@ -14,8 +14,13 @@ use crate::scripted::make_scripted_policy;
 /// ```
 /// use ms2_tasks::demos::scripted_episode;
 /// use ms2_tasks::EnvConfig;
-/// let ep = scripted_episode(&EnvConfig::new("Dummy-v0"), 0).unwrap();
+/// let cfg = EnvConfig {
+///     control_mode: Some("pd_joint_delta_pos".to_owned()),
+///     ..EnvConfig::new("Dummy-v0")
+/// };
+/// let ep = scripted_episode(&cfg, 0).unwrap();
 /// assert!(ep.succeeded());
+/// assert_eq!(ep.env_states.len(), ep.actions.len() + 1);
 /// ```
 pub fn scripted_episode(cfg: &EnvConfig, seed: u64) -> Result<DemoEpisode, DemoError> {
     let cfg = EnvConfig {

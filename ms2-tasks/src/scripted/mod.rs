@@ -27,6 +27,19 @@ pub fn make_scripted_policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvErr
         control_mode: env.control_mode().to_owned(),
         reason: reason.to_owned(),
     };
+    if env_id == "Excavate-v0" || env_id == "Fill-v0" {
+        if !oracle::SUPPORTED_MODES.contains(&env.control_mode()) {
+            return Err(unsupported("the oracle drives position-based modes only"));
+        }
+        let oracle = oracle::TcpOracle::new(env).map_err(|e| unsupported(&e))?;
+        return Ok(if env_id == "Fill-v0" {
+            Box::new(crate::tasks::soft::fill::FillPolicy::new(oracle))
+        } else {
+            Box::new(crate::tasks::soft::excavate_env::ExcavatePolicy::new(
+                oracle,
+            ))
+        });
+    }
     let plan = match env_id {
         "Dummy-v0" => return Ok(Box::new(crate::tasks::dummy::DummyReachPolicy)),
         "PickCube-v0" => pick_place::Plan::PickToGoal,

@@ -4,7 +4,7 @@
 //! [ms2-plan](ms2_plan) (a top-down grasp from the cube's bounding box at the yaw closest to the
 //! hand's, screw motions and RRT-Connect, TOPP-RA timing at the control frequency, the ground
 //! and the other cubes as obstacles) and plays the planned joint targets as `pd_joint_pos`
-//! actions, recording the episode ([`recorder`]). The three cube tasks share one
+//! actions, recording the episode ([`driver`]). The three cube tasks share one
 //! pick-and-place skeleton ([`pick_place`]); a task is a [`CubeTaskSolution`] value.
 //!
 //! ```no_run
@@ -16,8 +16,8 @@
 //! println!("success: {:?}", episode.success.last());
 //! ```
 
+pub mod driver;
 pub mod pick_place;
-pub mod recorder;
 pub mod scene;
 
 use std::sync::OnceLock;
@@ -33,8 +33,8 @@ use crate::env::{make_env, Env};
 use crate::error::EnvError;
 use crate::tasks::common::CUBE_HALF_SIZE;
 use crate::tasks::lift_cube::GOAL_HEIGHT;
+pub use driver::{Gripper, JointTargetDriver, CONTROL_MODE};
 pub use pick_place::{CubeTaskSolution, Finish};
-pub use recorder::{EpisodeRecorder, Gripper, CONTROL_MODE};
 pub use scene::{SensedCube, SensedState};
 
 /// Height (m) LiftCube's cube is carried to above its success height (cube centre at
@@ -42,6 +42,11 @@ pub use scene::{SensedCube, SensedState};
 const LIFT_MARGIN: f64 = 0.03;
 /// Height (m) of the moved cube's bottom above the other cube's top when StackCube releases it.
 const STACK_GAP: f64 = 0.002;
+
+/// How far (m) PickCube's cube may be carried short of the goal when the upright hand cannot
+/// reach it (success needs 0.025 m; an upright hand keeps the episode convertible to
+/// `pd_ee_delta_pos`, whose hand orientation is fixed).
+const PICK_GOAL_TOLERANCE: f64 = 0.02;
 
 /// The registered solutions.
 const SOLUTIONS: [CubeTaskSolution; 3] = [
@@ -53,6 +58,7 @@ const SOLUTIONS: [CubeTaskSolution; 3] = [
             let g = scene::privileged_vector(&s.obs, "extra/goal_pos", 3)?;
             Ok(Vector3::new(g[0], g[1], g[2]).cast())
         },
+        goal_tolerance: PICK_GOAL_TOLERANCE,
         finish: Finish::HoldStill,
     },
     CubeTaskSolution {
@@ -65,6 +71,7 @@ const SOLUTIONS: [CubeTaskSolution; 3] = [
             goal.z = f64::from(GOAL_HEIGHT + CUBE_HALF_SIZE) + LIFT_MARGIN;
             Ok(goal)
         },
+        goal_tolerance: 0.0,
         finish: Finish::HoldStill,
     },
     CubeTaskSolution {
@@ -76,6 +83,7 @@ const SOLUTIONS: [CubeTaskSolution; 3] = [
             let on_top = s.pose_world_from_base * b.pose_base_from_cube;
             Ok(on_top.translation.vector + Vector3::new(0.0, 0.0, 2.0 * b.half_size + STACK_GAP))
         },
+        goal_tolerance: 0.0,
         finish: Finish::PlaceAndRelease,
     },
 ];
@@ -94,9 +102,9 @@ pub enum SolveError {
         /// The planner's error.
         source: PlanError,
     },
-    /// The env failed.
+    /// The env failed while stepping or resetting.
     #[error(transparent)]
-    Env(#[from] EnvError),
+    Demo(#[from] DemoError),
     /// The episode limit was reached before the motion ended.
     #[error("the episode limit was reached")]
     OutOfSteps,
@@ -184,17 +192,17 @@ impl DemoSolver {
     pub fn solve(&mut self, seed: u64) -> Result<(DemoEpisode, SolveTimings), DemoError> {
         let t0 = Instant::now();
         let mut timings = SolveTimings::default();
-        let mut recorder =
-            EpisodeRecorder::start(&mut self.env, seed).map_err(|e| to_demo(e, seed))?;
+        let mut driver =
+            JointTargetDriver::start(&mut self.env, seed).map_err(|e| to_demo(e, seed))?;
         match self
             .solution
-            .run(&mut recorder, self.panda, seed, &mut timings)
+            .run(&mut driver, self.panda, seed, &mut timings)
         {
             Ok(()) | Err(SolveError::OutOfSteps) => {}
             Err(e) => return Err(to_demo(e, seed)),
         }
         timings.total_seconds = t0.elapsed().as_secs_f64();
-        Ok((recorder.finish(), timings))
+        Ok((driver.finish(), timings))
     }
 }
 
@@ -211,7 +219,7 @@ pub fn solve_episode(cfg: &EnvConfig, seed: u64) -> Result<DemoEpisode, DemoErro
 
 fn to_demo(e: SolveError, seed: u64) -> DemoError {
     match e {
-        SolveError::Env(e) => DemoError::Env(e),
+        SolveError::Demo(e) => e,
         other => DemoError::Planning {
             seed,
             reason: other.to_string(),

@@ -14,7 +14,7 @@ use ms2_plan::{
 };
 use nalgebra::{Isometry3, Translation3, Vector3};
 
-use super::recorder::{EpisodeRecorder, Gripper};
+use super::driver::{Gripper, JointTargetDriver};
 use super::scene::SensedState;
 use super::{SolveError, SolveTimings};
 
@@ -40,6 +40,10 @@ pub struct CubeTaskSolution {
     /// Where the moved cube's centre must end up (world frame, m), from the state sensed after
     /// reset.
     pub goal_world: fn(&SensedState) -> Result<Vector3<f64>, SolveError>,
+    /// How far (m) the cube may end from the goal and still succeed with margin; when the
+    /// upright hand cannot bring the cube to the goal, points up to this far toward the robot's
+    /// shoulder are tried before tilting the hand (0 = the goal exactly).
+    pub goal_tolerance: f64,
     /// How the motion ends.
     pub finish: Finish,
 }
@@ -60,6 +64,10 @@ const RETREAT_HEIGHT: f64 = 0.05;
 const SETTLE_TOLERANCE: f64 = 0.005;
 /// Most env steps spent waiting for the arm to settle.
 const SETTLE_MAX_STEPS: u32 = 10;
+/// Env steps the arm holds still at the grasp / place pose after settling, before the gripper
+/// moves: a replay converting the episode to another control mode lags the recorded arm
+/// slightly and catches up here.
+const PAUSE_STEPS: u32 = 3;
 /// Consecutive successful steps that end an episode.
 const SUCCESS_STEPS: usize = 3;
 /// How much (m) the carried cube's collision box is shrunk: it rests on the ground (or is
@@ -69,21 +77,21 @@ const CARRIED_SHRINK: f64 = 0.003;
 const SPEED_SCALE: f64 = 0.5;
 
 impl CubeTaskSolution {
-    /// Runs the solution on `recorder`'s freshly reset env. `seed` seeds the planners.
+    /// Runs the solution on `driver`'s freshly reset env. `seed` seeds the planners.
     ///
     /// # Errors
     /// [`SolveError::OutOfSteps`] when the episode limit ends the motion, planning and env
     /// errors otherwise.
     pub fn run(
         &self,
-        recorder: &mut EpisodeRecorder<'_>,
+        driver: &mut JointTargetDriver<'_>,
         panda: &KinematicRobot,
         seed: u64,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
         let mut names = vec![self.cube];
         names.extend_from_slice(self.obstacles);
-        let sensed = SensedState::read(recorder.env(), &names)?;
+        let sensed = SensedState::read(driver.env(), &names)?;
         let goal_world = (self.goal_world)(&sensed)?;
         let goal_base = sensed.world_point_in_base(&goal_world);
         let gripper = GripperSpec {
@@ -99,7 +107,7 @@ impl CubeTaskSolution {
 
         // Grasp: top-down, at the cube's yaw symmetry closest to the hand's yaw.
         let scene = sensed.collision_scene().map_err(plan_error("scene"))?;
-        let start = recorder.arm_target().to_vec();
+        let start = driver.arm_target().to_vec();
         let cube = sensed.cube(self.cube)?.oriented_box();
         let grasp = timings.time(|| {
             let candidates = top_down_grasps(&cube, &gripper, &panda.tcp_pose(&start));
@@ -128,7 +136,7 @@ impl CubeTaskSolution {
                 })
                 .map_err(plan_error("reach"))
         })?;
-        recorder.follow(&reach.trajectory, Gripper::Open)?;
+        driver.follow(&reach.trajectory, Gripper::Open)?;
 
         // Screw down to the grasp (the fingers may touch the cube) and close.
         let mut approach_scene = scene.clone();
@@ -139,23 +147,24 @@ impl CubeTaskSolution {
             planner
                 .plan_screw(
                     &approach_scene,
-                    recorder.arm_target(),
+                    driver.arm_target(),
                     &grasp.grasp.pose_base_from_tcp,
                 )
                 .map_err(plan_error("descend"))
         })?;
-        recorder.follow(&descend.trajectory, Gripper::Open)?;
-        recorder.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Open)?;
-        recorder.hold(CLOSE_STEPS, Gripper::Closed)?;
+        driver.follow(&descend.trajectory, Gripper::Open)?;
+        driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Open)?;
+        driver.hold(PAUSE_STEPS, Gripper::Open)?;
+        driver.hold(CLOSE_STEPS, Gripper::Closed)?;
 
         // Carry: the cube rides on the hand; the planner sees the fingers closed on it.
-        let grasped = SensedState::read(recorder.env(), &names)?;
+        let grasped = SensedState::read(driver.env(), &names)?;
         let cube_now = grasped.cube(self.cube)?.clone();
         let mut holding = panda.clone();
         holding
             .set_panda_finger_opening(cube_now.half_size)
             .map_err(plan_error("carry"))?;
-        let grasp_q = recorder.arm_target().to_vec();
+        let grasp_q = driver.arm_target().to_vec();
         let carry_scene = scene_carrying(&grasped, &holding, &grasp_q, self.cube, &gripper)?;
         let mut carry_planner =
             MotionPlanner::new(&holding, config(1)).map_err(plan_error("config"))?;
@@ -172,20 +181,35 @@ impl CubeTaskSolution {
         } else {
             goal_base
         };
-        if carry_target.z < cube_z + LIFT_CLEARANCE {
-            let lifted = cube_now.pose_base_from_cube.translation.vector
-                + Vector3::new(0.0, 0.0, LIFT_CLEARANCE);
+        // Lift straight up first: by LIFT_CLEARANCE for a low goal, and to the carry height
+        // when other cubes stand around (a slanted carry could clip them: the arm lags its
+        // targets by a few centimetres).
+        let lift_z = if self.obstacles.is_empty() {
+            cube_z + LIFT_CLEARANCE
+        } else {
+            carry_target.z.max(cube_z + LIFT_CLEARANCE)
+        };
+        if carry_target.z < cube_z + LIFT_CLEARANCE || !self.obstacles.is_empty() {
+            let mut lifted = cube_now.pose_base_from_cube.translation.vector;
+            lifted.z = lift_z;
             let lift = timings.time(|| {
                 carry_planner
                     .plan_screw(&carry_scene, &grasp_q, &tcp_for_cube(&lifted))
                     .map_err(plan_error("lift"))
             })?;
-            recorder.follow(&lift.trajectory, Gripper::Closed)?;
+            driver.follow(&lift.trajectory, Gripper::Closed)?;
         }
         let carry = timings.time(|| {
-            let start = recorder.arm_target();
+            let start = driver.arm_target();
             let mut last = None;
-            for tcp in tilted_about(&tcp_for_cube(&carry_target), &carry_target) {
+            let toward_shoulder = (Vector3::new(0.0, 0.0, SHOULDER_HEIGHT) - carry_target)
+                .try_normalize(1e-9)
+                .unwrap_or_else(Vector3::zeros);
+            let upright_near_goal = GOAL_SLACK_FRACTIONS.iter().map(|f| {
+                tcp_for_cube(&(carry_target + toward_shoulder * (f * self.goal_tolerance)))
+            });
+            let poses = tilted_about(&tcp_for_cube(&carry_target), &carry_target);
+            for tcp in upright_near_goal.chain(poses.skip(1)) {
                 match move_to_pose(&mut carry_planner, &carry_scene, start, &tcp) {
                     Ok(motion) => return Ok(motion),
                     Err(e) => last = Some(e),
@@ -195,25 +219,22 @@ impl CubeTaskSolution {
                 last.unwrap_or(PlanError::NoPathFound { iterations: 0 }),
             ))
         })?;
-        recorder.follow(&carry.trajectory, Gripper::Closed)?;
+        driver.follow(&carry.trajectory, Gripper::Closed)?;
 
         match self.finish {
-            Finish::HoldStill => recorder.hold_until_success(SUCCESS_STEPS, Gripper::Closed),
+            Finish::HoldStill => driver.hold_until_success(SUCCESS_STEPS, Gripper::Closed),
             Finish::PlaceAndRelease => {
                 let lower = timings.time(|| {
                     carry_planner
-                        .plan_screw(
-                            &carry_scene,
-                            recorder.arm_target(),
-                            &tcp_for_cube(&goal_base),
-                        )
+                        .plan_screw(&carry_scene, driver.arm_target(), &tcp_for_cube(&goal_base))
                         .map_err(plan_error("lower"))
                 })?;
-                recorder.follow(&lower.trajectory, Gripper::Closed)?;
-                recorder.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Closed)?;
-                recorder.hold(OPEN_STEPS, Gripper::Open)?;
-                self.retreat(recorder, panda, &names, &gripper, config(2), timings)?;
-                recorder.hold_until_success(SUCCESS_STEPS, Gripper::Open)
+                driver.follow(&lower.trajectory, Gripper::Closed)?;
+                driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Closed)?;
+                driver.hold(PAUSE_STEPS, Gripper::Closed)?;
+                driver.hold(OPEN_STEPS, Gripper::Open)?;
+                self.retreat(driver, panda, &names, &gripper, config(2), timings)?;
+                driver.hold_until_success(SUCCESS_STEPS, Gripper::Open)
             }
         }
     }
@@ -222,19 +243,19 @@ impl CubeTaskSolution {
     /// released cube).
     fn retreat(
         &self,
-        recorder: &mut EpisodeRecorder<'_>,
+        driver: &mut JointTargetDriver<'_>,
         panda: &KinematicRobot,
         names: &[&str],
         gripper: &GripperSpec,
         config: PlannerConfig,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
-        let released = SensedState::read(recorder.env(), names)?;
+        let released = SensedState::read(driver.env(), names)?;
         let mut scene = released.collision_scene().map_err(plan_error("retreat"))?;
         for finger in &gripper.touch_links {
             scene.allow_collision(finger.clone(), self.cube);
         }
-        let start = recorder.arm_target().to_vec();
+        let start = driver.arm_target().to_vec();
         let up = Translation3::new(0.0, 0.0, RETREAT_HEIGHT) * panda.tcp_pose(&start);
         let mut planner = MotionPlanner::new(panda, config).map_err(plan_error("config"))?;
         let motion = timings.time(|| {
@@ -242,7 +263,7 @@ impl CubeTaskSolution {
                 .plan_screw(&scene, &start, &up)
                 .map_err(plan_error("retreat"))
         })?;
-        recorder.follow(&motion.trajectory, Gripper::Open)
+        driver.follow(&motion.trajectory, Gripper::Open)
     }
 }
 
@@ -284,6 +305,12 @@ fn move_to_pose(
         .plan_screw(scene, start, pose_base_from_tcp)
         .or_else(|_| planner.plan_to_pose(scene, start, pose_base_from_tcp))
 }
+
+/// Height (m) of the Panda's shoulder (joint 2) above its base: the centre of its reach.
+const SHOULDER_HEIGHT: f64 = 0.333;
+/// Fractions of [`CubeTaskSolution::goal_tolerance`] by which the carried cube's target is
+/// moved toward the shoulder, tried in order with an upright hand (0 = the goal itself).
+const GOAL_SLACK_FRACTIONS: [f64; 4] = [0.0, 0.4, 0.7, 1.0];
 
 /// Tilts (rad) of the carrying hand's approach axis away from the robot, tried in order when
 /// the cube's goal cannot be reached with the grasp orientation (high, far goals are reachable

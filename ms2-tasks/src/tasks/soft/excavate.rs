@@ -13,7 +13,7 @@
 //! Success (the paper's terms): the number of clay particles in the bucket is within ±25 % of
 //! the episode's target; every particle in the bucket is higher than
 //! [`ExcavateScene::target_height`]; fewer than 20 particles are spilled (outside the bucket
-//! and either outside the bed's footprint by more than 2 cm, or more than 4 cm above the bed's
+//! and either outside the bed's footprint by more than 4 cm, or more than 4 cm above the bed's
 //! highest initial point); mean soft-body speed below 0.05 m/s.
 //!
 //! Not yet the `Excavate-v0` environment: the Panda arm carrying the bucket and the task
@@ -21,7 +21,7 @@
 
 use glam::{Vec2, Vec3};
 use ms2_mpm::sampling::{self, HeightMap};
-use ms2_mpm::{MpmState, WallKind};
+use ms2_mpm::{MpmSolver, MpmState, WallKind};
 use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
@@ -41,25 +41,34 @@ pub const MAX_SOFT_SPEED: f32 = 0.05;
 /// Relative tolerance on the scooped amount.
 pub const AMOUNT_TOLERANCE: f32 = 0.25;
 
-/// Interior half extents of the bucket (m, bucket frame): x towards the opening, z up.
-pub const BUCKET_INNER_HALF: [f32; 3] = [0.04, 0.035, 0.03];
+/// Interior half extents of the bucket (m, bucket frame): x towards the opening, z up (the
+/// bucket of `ms2_assets::PANDA_BUCKET_URDF`).
+pub const BUCKET_INNER_HALF: [f32; 3] = [
+    ms2_assets::PANDA_BUCKET_INNER_HALF[0] as f32,
+    ms2_assets::PANDA_BUCKET_INNER_HALF[1] as f32,
+    ms2_assets::PANDA_BUCKET_INNER_HALF[2] as f32,
+];
 /// Wall and plate half thickness (m).
-pub const BUCKET_WALL_HALF: f32 = 0.003;
+pub const BUCKET_WALL_HALF: f32 = ms2_assets::PANDA_BUCKET_WALL_HALF as f32;
 /// The scripted scoop's yield, measured on the default bed: about
 /// `SCOOP_BASE_PARTICLES` when the lip travels `SCOOP_BASE_TRAVEL` (m) into the bed, plus
 /// `SCOOP_PARTICLES_PER_METRE` per further metre.
-const SCOOP_BASE_PARTICLES: f32 = 240.0;
+const SCOOP_BASE_PARTICLES: f32 = 165.0;
 const SCOOP_BASE_TRAVEL: f32 = 0.03;
-const SCOOP_PARTICLES_PER_METRE: f32 = 3900.0;
+const SCOOP_PARTICLES_PER_METRE: f32 = 4400.0;
 
-/// Bed footprint (m, world x and y).
+/// Bed footprint (m, x and y relative to the soft grid's origin).
 const BED_MIN: [f32; 2] = [0.12, 0.10];
 const BED_MAX: [f32; 2] = [0.24, 0.22];
 /// Mean bed thickness (m) and the seeded height map's amplitude (m).
 const BED_THICKNESS: f32 = 0.035;
 const BED_AMPLITUDE: f32 = 0.006;
+/// Clay outside the bucket counts as spilled when it lies more than this (m) outside the
+/// bed's footprint or above the bed's highest initial point. The bed itself deforms as the
+/// bucket pushes into it (its far side bulges by 2-3 cm), which is not spilling.
+const SPILL_MARGIN: f32 = 0.04;
 /// Range of the episode's target amount (particles).
-const TARGET_RANGE: (usize, usize) = (250, 400);
+const TARGET_RANGE: (usize, usize) = (200, 340);
 
 /// Commanded bucket pose: position of the bottom plate's centre (m, world) and pitch (rad,
 /// about world −y: positive raises the opening).
@@ -88,6 +97,149 @@ impl BucketPose {
     }
 }
 
+/// The episode's clay bed and goal, shared by the kinematic scene ([`ExcavateScene`]) and the
+/// `Excavate-v0` environment: footprint, heights, target amount, and the success rules.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExcavateBed {
+    /// Footprint corners (m, world x and y).
+    pub footprint: [Vec2; 2],
+    /// Soft floor height (m, world z).
+    pub floor_z: f32,
+    /// Highest initial bed surface point (m, world z).
+    pub bed_top_z: f32,
+    /// Mean initial bed surface height (m, world z).
+    pub mean_bed_z: f32,
+    /// Episode target (particles in the bucket).
+    pub target_particles: usize,
+}
+
+/// The soft-world settings of the Excavate scenes: [`SoftConfig::default`] on a grid starting
+/// at `grid_origin` (m, world), with a sticky floor (clay sticks to the table, so the bed stays
+/// put while the bucket cuts into it).
+pub fn excavate_soft_config(grid_origin: Vec3) -> SoftConfig {
+    let mut config = SoftConfig {
+        grid_origin,
+        ..SoftConfig::default()
+    };
+    config.boundary.walls[2][0] = WallKind::Sticky;
+    config
+}
+
+impl ExcavateBed {
+    /// Samples an episode from `seed`: the bed's height map (5 × 5 samples, ±6 mm about a
+    /// 3.5 cm thick bed) filled with clay particles in a new solver for `config`, and the
+    /// target amount.
+    pub fn sample(config: &SoftConfig, seed: u64) -> Result<(MpmSolver, Self), SoftSceneError> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let (mut solver, clay) = SoftWorld::solver_for(config)?;
+        let floor_z = solver.usable_domain().0.z;
+        let origin = config.grid_origin.truncate();
+        let footprint = [origin + Vec2::from(BED_MIN), origin + Vec2::from(BED_MAX)];
+        let (nx, ny) = (5, 5);
+        let cell = (BED_MAX[0] - BED_MIN[0]) / (nx - 1) as f32;
+        let heights: Vec<f32> = (0..nx * ny)
+            .map(|_| floor_z + BED_THICKNESS + rng.random_range(-BED_AMPLITUDE..BED_AMPLITUDE))
+            .collect();
+        let bed_top_z = heights.iter().copied().fold(f32::MIN, f32::max);
+        let mean_bed_z = heights.iter().sum::<f32>() / heights.len() as f32;
+        let map = HeightMap {
+            origin: footprint[0],
+            cell_size: cell,
+            nx,
+            ny,
+            heights,
+        };
+        let spacing = config.particle_spacing;
+        let mut points = sampling::sample_heightmap(&map, floor_z, spacing)?;
+        sampling::jitter(&mut points, 0.1 * spacing, seed);
+        solver.add_particles(&points, clay, spacing.powi(3), Vec3::ZERO)?;
+        let target_particles = rng.random_range(TARGET_RANGE.0..=TARGET_RANGE.1);
+        let bed = Self {
+            footprint,
+            floor_z,
+            bed_top_z,
+            mean_bed_z,
+            target_particles,
+        };
+        Ok((solver, bed))
+    }
+
+    /// Height (m, world z) the scooped clay must be above: 5 cm over the bed's highest point.
+    pub fn target_height(&self) -> f32 {
+        self.bed_top_z + 0.05
+    }
+
+    /// Success terms for particles at `positions` (m, world) moving at `mean_soft_speed`
+    /// (m/s), with `in_bucket` telling which points are inside the bucket.
+    pub fn evaluate(
+        &self,
+        positions: &[Vec3],
+        mean_soft_speed: f32,
+        in_bucket: impl Fn(Vec3) -> bool,
+    ) -> ExcavateEvaluation {
+        let mut inside = 0;
+        let mut lowest = f32::INFINITY;
+        let mut spilled = 0;
+        let m = SPILL_MARGIN;
+        let [lo, hi] = self.footprint;
+        for &p in positions {
+            if in_bucket(p) {
+                inside += 1;
+                lowest = lowest.min(p.z);
+            } else {
+                let outside = p.x < lo.x - m || p.x > hi.x + m || p.y < lo.y - m || p.y > hi.y + m;
+                if outside || p.z > self.bed_top_z + m {
+                    spilled += 1;
+                }
+            }
+        }
+        if inside == 0 {
+            lowest = f32::NEG_INFINITY;
+        }
+        let target = self.target_particles as f32;
+        let amount_ok = (inside as f32 - target).abs() <= AMOUNT_TOLERANCE * target;
+        ExcavateEvaluation {
+            particles_in_bucket: inside,
+            target_particles: self.target_particles,
+            lowest_in_bucket: lowest,
+            spilled,
+            mean_soft_speed,
+            success: amount_ok
+                && lowest > self.target_height()
+                && spilled < MAX_SPILLED
+                && mean_soft_speed < MAX_SOFT_SPEED,
+        }
+    }
+
+    /// Dense reward in [0, 1] of an evaluation: approach the amount, then the height, then
+    /// come to rest; 1 on success.
+    pub fn dense_reward(&self, eval: &ExcavateEvaluation) -> f64 {
+        if eval.success {
+            return 1.0;
+        }
+        let target = eval.target_particles as f64;
+        let amount = 1.0 - ((eval.particles_in_bucket as f64 - target).abs() / target).min(1.0);
+        let height = if eval.particles_in_bucket == 0 {
+            0.0
+        } else {
+            let gap = f64::from(self.target_height() - eval.lowest_in_bucket).max(0.0);
+            1.0 - (10.0 * gap).tanh()
+        };
+        let rest = 1.0 - f64::from(10.0 * eval.mean_soft_speed).tanh();
+        0.9 * (0.4 * amount + 0.4 * height + 0.2 * rest)
+    }
+}
+
+/// Whether a point at `local` (m, bucket frame) is inside the bucket: over the plate, between
+/// the walls, up to 2 cm above them.
+pub fn in_bucket_local(local: Vec3) -> bool {
+    let [hx, hy, hz] = BUCKET_INNER_HALF;
+    local.x.abs() <= hx + 0.005
+        && local.y.abs() <= hy
+        && local.z >= 0.0
+        && local.z <= 2.0 * hz + 0.02
+}
+
 /// Evaluation of the current state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ExcavateEvaluation {
@@ -114,10 +266,8 @@ pub struct ExcavateState {
     pub soft: MpmState,
     /// Last commanded bucket pose.
     pub bucket_command: BucketPose,
-    /// Episode target (particles).
-    pub target_particles: usize,
-    /// Highest and mean initial bed surface (m, world z).
-    pub bed_top_and_mean_z: [f32; 2],
+    /// The episode's bed and goal.
+    pub bed: ExcavateBed,
 }
 
 /// The Excavate scene (see the [module docs](self)).
@@ -126,10 +276,7 @@ pub struct ExcavateScene {
     soft: SoftWorld,
     bucket: BodyId,
     command: BucketPose,
-    target_particles: usize,
-    floor_z: f32,
-    bed_top_z: f32,
-    mean_bed_z: f32,
+    bed: ExcavateBed,
     rigid_steps_per_control: usize,
 }
 
@@ -137,7 +284,7 @@ impl std::fmt::Debug for ExcavateScene {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("ExcavateScene")
             .field("soft", &self.soft)
-            .field("target_particles", &self.target_particles)
+            .field("bed", &self.bed)
             .finish_non_exhaustive()
     }
 }
@@ -146,40 +293,17 @@ impl ExcavateScene {
     /// Builds an episode from `seed`: the bed's height map (5 × 5 samples, ±6 mm about a
     /// 3.5 cm thick bed), the bucket's start y (±1 cm) and the target amount.
     pub fn new(seed: u64) -> Result<Self, SoftSceneError> {
-        let mut config = SoftConfig::default();
-        // Clay sticks to the table: the bed stays put while the bucket cuts into it.
-        config.boundary.walls[2][0] = WallKind::Sticky;
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let (mut solver, clay) = SoftWorld::solver_for(&config)?;
-        let floor_z = solver.usable_domain().0.z;
-        let (nx, ny) = (5, 5);
-        let cell = (BED_MAX[0] - BED_MIN[0]) / (nx - 1) as f32;
-        let heights: Vec<f32> = (0..nx * ny)
-            .map(|_| floor_z + BED_THICKNESS + rng.random_range(-BED_AMPLITUDE..BED_AMPLITUDE))
-            .collect();
-        let bed_top_z = heights.iter().copied().fold(f32::MIN, f32::max);
-        let mean_bed_z = heights.iter().sum::<f32>() / heights.len() as f32;
-        let map = HeightMap {
-            origin: Vec2::from(BED_MIN),
-            cell_size: cell,
-            nx,
-            ny,
-            heights,
-        };
-        let spacing = config.particle_spacing;
-        let mut points = sampling::sample_heightmap(&map, floor_z, spacing)?;
-        sampling::jitter(&mut points, 0.1 * spacing, seed);
-        solver.add_particles(&points, clay, spacing.powi(3), Vec3::ZERO)?;
-        let target_particles = rng.random_range(TARGET_RANGE.0..=TARGET_RANGE.1);
+        let (solver, bed) = ExcavateBed::sample(&excavate_soft_config(Vec3::ZERO), seed)?;
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5eed_b0c7);
         let start_y = 0.16 + rng.random_range(-0.01..0.01);
 
         let mut world = World::new(WorldConfig::default())
             .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
         let command = BucketPose {
             position: Vec3::new(
-                BED_MIN[0] - BUCKET_INNER_HALF[0] - 0.01,
+                bed.footprint[0].x - BUCKET_INNER_HALF[0] - 0.01,
                 start_y,
-                bed_top_z + 0.03,
+                bed.bed_top_z + 0.03,
             ),
             pitch: 0.0,
         };
@@ -190,7 +314,7 @@ impl ExcavateScene {
                     .with_shape(ShapeSpec::new(bucket_shape())),
             )
             .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
-        let soft = SoftWorld::new(solver, &mut world, vec![bucket])?;
+        let soft = SoftWorld::new(solver, &world, vec![bucket])?;
         let rigid_steps_per_control =
             (1.0 / (CONTROL_FREQ_HZ as f32 * world.timestep())).round() as usize;
         Ok(Self {
@@ -198,10 +322,7 @@ impl ExcavateScene {
             soft,
             bucket,
             command,
-            target_particles,
-            floor_z,
-            bed_top_z,
-            mean_bed_z,
+            bed,
             rigid_steps_per_control,
         })
     }
@@ -232,24 +353,19 @@ impl ExcavateScene {
         self.command
     }
 
+    /// The episode's bed and goal.
+    pub fn bed(&self) -> &ExcavateBed {
+        &self.bed
+    }
+
     /// Episode target (particles).
     pub fn target_particles(&self) -> usize {
-        self.target_particles
+        self.bed.target_particles
     }
 
-    /// Mean initial bed surface height (m, world z).
-    pub fn mean_bed_z(&self) -> f32 {
-        self.mean_bed_z
-    }
-
-    /// MPM floor height (m, world z).
-    pub fn floor_z(&self) -> f32 {
-        self.floor_z
-    }
-
-    /// Height (m, world z) the scooped clay must be above: 5 cm over the bed's highest point.
+    /// Height (m, world z) the scooped clay must be above (see [`ExcavateBed::target_height`]).
     pub fn target_height(&self) -> f32 {
-        self.bed_top_z + 0.05
+        self.bed.target_height()
     }
 
     /// The coupled soft world.
@@ -275,68 +391,20 @@ impl ExcavateScene {
                 .body_pose(self.bucket)
                 .unwrap_or_else(|_| self.command.to_pose()),
         );
-        let local = rot.inverse() * (p - pos);
-        let [hx, hy, hz] = BUCKET_INNER_HALF;
-        local.x.abs() <= hx + 0.005
-            && local.y.abs() <= hy
-            && local.z >= 0.0
-            && local.z <= 2.0 * hz + 0.02
+        in_bucket_local(rot.inverse() * (p - pos))
     }
 
     /// Success terms of the current state (see the [module docs](self)).
     pub fn evaluate(&self) -> ExcavateEvaluation {
-        let mut in_bucket = 0;
-        let mut lowest = f32::INFINITY;
-        let mut spilled = 0;
-        for &p in self.particle_positions() {
-            if self.in_bucket(p) {
-                in_bucket += 1;
-                lowest = lowest.min(p.z);
-            } else {
-                let outside = p.x < BED_MIN[0] - 0.02
-                    || p.x > BED_MAX[0] + 0.02
-                    || p.y < BED_MIN[1] - 0.02
-                    || p.y > BED_MAX[1] + 0.02;
-                if outside || p.z > self.bed_top_z + 0.04 {
-                    spilled += 1;
-                }
-            }
-        }
-        if in_bucket == 0 {
-            lowest = f32::NEG_INFINITY;
-        }
-        let mean_soft_speed = self.soft.mean_speed();
-        let target = self.target_particles as f32;
-        let amount_ok = (in_bucket as f32 - target).abs() <= AMOUNT_TOLERANCE * target;
-        ExcavateEvaluation {
-            particles_in_bucket: in_bucket,
-            target_particles: self.target_particles,
-            lowest_in_bucket: lowest,
-            spilled,
-            mean_soft_speed,
-            success: amount_ok
-                && lowest > self.target_height()
-                && spilled < MAX_SPILLED
-                && mean_soft_speed < MAX_SOFT_SPEED,
-        }
+        self.bed
+            .evaluate(self.particle_positions(), self.soft.mean_speed(), |p| {
+                self.in_bucket(p)
+            })
     }
 
-    /// Dense reward in [0, 1] of an evaluation: approach the amount, then the height, then
-    /// come to rest; 1 on success.
+    /// Dense reward in [0, 1] of an evaluation (see [`ExcavateBed::dense_reward`]).
     pub fn dense_reward(&self, eval: &ExcavateEvaluation) -> f64 {
-        if eval.success {
-            return 1.0;
-        }
-        let target = eval.target_particles as f64;
-        let amount = 1.0 - ((eval.particles_in_bucket as f64 - target).abs() / target).min(1.0);
-        let height = if eval.particles_in_bucket == 0 {
-            0.0
-        } else {
-            let gap = f64::from(self.target_height() - eval.lowest_in_bucket).max(0.0);
-            1.0 - (10.0 * gap).tanh()
-        };
-        let rest = 1.0 - f64::from(10.0 * eval.mean_soft_speed).tanh();
-        0.9 * (0.4 * amount + 0.4 * height + 0.2 * rest)
+        self.bed.dense_reward(eval)
     }
 
     /// The full state.
@@ -345,8 +413,7 @@ impl ExcavateScene {
             world: self.world.get_state(),
             soft: self.soft.state(),
             bucket_command: self.command,
-            target_particles: self.target_particles,
-            bed_top_and_mean_z: [self.bed_top_z, self.mean_bed_z],
+            bed: self.bed.clone(),
         }
     }
 
@@ -357,8 +424,7 @@ impl ExcavateScene {
             .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
         self.soft.set_state(&state.soft)?;
         self.command = state.bucket_command;
-        self.target_particles = state.target_particles;
-        [self.bed_top_z, self.mean_bed_z] = state.bed_top_and_mean_z;
+        self.bed = state.bed.clone();
         Ok(())
     }
 }
@@ -399,32 +465,40 @@ pub struct ScriptedScoop {
 impl ScriptedScoop {
     /// Plans the scoop for `scene`'s episode.
     pub fn plan(scene: &ExcavateScene) -> Self {
-        let start = scene.bucket_command();
+        Self::plan_from(scene.bucket_command(), scene.bed(), 4)
+    }
+
+    /// Plans the scoop of `bed` for a bucket starting at `start`, which gets `approach_steps`
+    /// control steps to reach its place above the bed's near edge (a robot needs more than
+    /// the kinematic bucket).
+    pub fn plan_from(start: BucketPose, bed: &ExcavateBed, approach_steps: u32) -> Self {
         let hx = BUCKET_INNER_HALF[0];
-        // Plate just above the table, lip 1 cm in front of the bed.
-        let z = scene.floor_z() + BUCKET_WALL_HALF + 0.002;
-        let x0 = BED_MIN[0] - 0.01 - hx;
+        // Plate 6 mm above the table (the bottom layer of clay stays stuck to it), lip 1 cm in
+        // front of the bed.
+        let z = bed.floor_z + BUCKET_WALL_HALF + 0.006;
+        let x0 = bed.footprint[0].x - 0.01 - hx;
         let travel = (SCOOP_BASE_TRAVEL
-            + (scene.target_particles() as f32 - SCOOP_BASE_PARTICLES) / SCOOP_PARTICLES_PER_METRE)
+            + (bed.target_particles as f32 - SCOOP_BASE_PARTICLES) / SCOOP_PARTICLES_PER_METRE)
             .clamp(0.01, 2.0 * hx - 0.01);
         let at = |x: f32, z: f32, pitch: f32| BucketPose {
             position: Vec3::new(x, start.position.y, z),
             pitch,
         };
-        let lift_z = scene.target_height() + 0.03;
-        let curl = 25f32.to_radians();
+        let lift_z = bed.target_height() + 0.04;
+        let curl = 15f32.to_radians();
         let x1 = x0 + 0.01 + travel;
         // Curl: raise the opening while still moving forward, so the lip cuts up through
         // the clay ahead instead of pulling the load out of the bucket.
         let (x2, z2) = (x1 + 0.01, z + 0.005);
+        let a = approach_steps.max(1);
         Self {
             waypoints: vec![
                 (0, start),
-                (4, at(x0, z + 0.03, 0.0)),
-                (8, at(x0, z, 0.0)),
-                (20, at(x1, z, 0.0)),
-                (28, at(x2, z2, curl)),
-                (48, at(x2, lift_z, curl)),
+                (a, at(x0, z + 0.03, 0.0)),
+                (a + 4, at(x0, z, 0.0)),
+                (a + 16, at(x1, z, 0.0)),
+                (a + 24, at(x2, z2, curl)),
+                (a + 44, at(x2, lift_z, curl)),
                 (MAX_EPISODE_STEPS, at(x2, lift_z, curl)),
             ],
         }
@@ -432,13 +506,20 @@ impl ScriptedScoop {
 
     /// The command for control step `step` (0-based: the pose to reach at its end).
     pub fn command(&self, step: u32) -> BucketPose {
-        let s = step + 1;
-        for pair in self.waypoints.windows(2) {
-            let ((s0, p0), (s1, p1)) = (pair[0], pair[1]);
-            if s <= s1 {
-                return p0.lerp(&p1, (s.saturating_sub(s0)) as f32 / (s1 - s0) as f32);
-            }
-        }
-        self.waypoints[self.waypoints.len() - 1].1
+        interpolate_waypoints(&self.waypoints, step)
     }
+}
+
+/// The pose to reach at the end of control step `step` (0-based) along `(step, pose)`
+/// waypoints (ascending steps, the first at 0), linearly interpolated; the last pose after
+/// the last waypoint.
+pub(crate) fn interpolate_waypoints(waypoints: &[(u32, BucketPose)], step: u32) -> BucketPose {
+    let s = step + 1;
+    for pair in waypoints.windows(2) {
+        let ((s0, p0), (s1, p1)) = (pair[0], pair[1]);
+        if s <= s1 {
+            return p0.lerp(&p1, (s.saturating_sub(s0)) as f32 / (s1 - s0) as f32);
+        }
+    }
+    waypoints[waypoints.len() - 1].1
 }

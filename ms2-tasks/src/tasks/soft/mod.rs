@@ -14,9 +14,14 @@
 //! (CFL < 1); tools move below 0.5 m/s (0.05 cell per substep). The coupling's penalty
 //! stiffness follows the substep ([`CouplingParams::for_substep`]).
 //!
-//! [`excavate`] is the Excavate scene with a scripted bucket.
+//! [`excavate`] is the Excavate scene with a scripted kinematic bucket (bed, goal, success
+//! rules and the scripted scoop); [`excavate_env`] is `Excavate-v0`, the same task with the
+//! bucket on the Panda's hand, on the shared robot-task runtime.
 
+pub mod bucket_arm;
 pub mod excavate;
+pub mod excavate_env;
+pub mod fill;
 
 use glam::Vec3;
 use ms2_mpm::{
@@ -25,7 +30,9 @@ use ms2_mpm::{
 };
 use ms2_physics::{BodyId, World};
 
-use crate::adapters::mpm_rigid::{CoupledBodies, MpmAdapterError, MpmRigidWorld};
+use crate::adapters::mpm_rigid::{
+    CoupledBodies, MpmAdapterError, MpmRigidWorld, MpmRigidWorldView,
+};
 
 /// Why a soft scene failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -97,7 +104,7 @@ impl SoftWorld {
     /// must divide the world's time step into a whole number of substeps.
     pub fn new(
         solver: MpmSolver,
-        world: &mut World,
+        world: &World,
         bodies: Vec<BodyId>,
     ) -> Result<Self, SoftSceneError> {
         let dt = solver.config().substep_dt;
@@ -112,7 +119,7 @@ impl SoftWorld {
         }
         let bodies = CoupledBodies::new(world, bodies)?;
         let coupling = Coupling::new(
-            &MpmRigidWorld::new(world, &bodies),
+            &MpmRigidWorldView::new(world, &bodies),
             CouplingParams::for_substep(dt),
         )?;
         Ok(Self {
@@ -137,6 +144,12 @@ impl SoftWorld {
     /// One rigid step of `world` followed by the coupled soft substeps.
     pub fn step(&mut self, world: &mut World) -> Result<(), SoftSceneError> {
         world.step();
+        self.after_rigid_step(world)
+    }
+
+    /// The coupled soft substeps that follow a rigid step of `world` (which the caller took):
+    /// sync the bodies, run the substeps, hand the reaction wrenches to the world.
+    pub fn after_rigid_step(&mut self, world: &mut World) -> Result<(), SoftSceneError> {
         self.coupling.advance(
             &mut self.solver,
             &mut MpmRigidWorld::new(world, &self.bodies),

@@ -1,11 +1,11 @@
 //! Act: stepping the env with `pd_joint_pos` actions (absolute arm joint targets plus the
-//! gripper command) while recording the episode as a [`DemoEpisode`].
+//! gripper command) while an [`EpisodeRecorder`] records the episode.
 
 use ms2_plan::JointTrajectory;
 
 use super::SolveError;
 use crate::agent::ARM_DOF;
-use crate::demos::DemoEpisode;
+use crate::demos::{DemoEpisode, EpisodeRecorder};
 use crate::env::Env;
 
 /// The control mode the solutions drive.
@@ -30,23 +30,28 @@ impl Gripper {
     }
 }
 
-/// Steps an env and records actions, states (`get_state` after reset and after every step),
-/// success flags and the last info.
-pub struct EpisodeRecorder<'e> {
+/// Drives an env in `pd_joint_pos` toward arm joint targets, recording every step.
+pub struct JointTargetDriver<'e> {
     env: &'e mut Env,
-    episode: DemoEpisode,
+    recorder: EpisodeRecorder,
     arm_target: Vec<f64>,
 }
 
-impl<'e> EpisodeRecorder<'e> {
-    /// Resets `env` with `seed` and starts recording; the first arm target is the arm's
-    /// position after reset.
+impl<'e> JointTargetDriver<'e> {
+    /// Resets `env` (which must be in `pd_joint_pos`) with `seed` and starts recording; the
+    /// first arm target is the arm's position after reset.
     ///
     /// # Errors
-    /// [`SolveError::Env`] if the reset fails, [`SolveError::Sensing`] for an env without a
-    /// Panda arm.
+    /// [`SolveError::Demo`] if the reset fails, [`SolveError::Sensing`] for an env without a
+    /// Panda arm or in another control mode.
     pub fn start(env: &'e mut Env, seed: u64) -> Result<Self, SolveError> {
-        let (_, info) = env.reset(Some(seed), false)?;
+        if env.control_mode() != CONTROL_MODE {
+            return Err(SolveError::Sensing(format!(
+                "the env is in control mode {:?}, expected {CONTROL_MODE}",
+                env.control_mode()
+            )));
+        }
+        let (recorder, _) = EpisodeRecorder::reset(env, seed)?;
         let scene = env
             .task_scene()
             .ok_or_else(|| SolveError::Sensing("the env has no robot".to_owned()))?;
@@ -58,19 +63,9 @@ impl<'e> EpisodeRecorder<'e> {
             )));
         }
         let arm_target = qpos[..ARM_DOF].iter().map(|&v| f64::from(v)).collect();
-        let episode = DemoEpisode {
-            env_id: env.config().env_id.clone(),
-            episode_seed: seed,
-            control_mode: CONTROL_MODE.to_owned(),
-            actions: Vec::new(),
-            env_states: vec![env.get_state()],
-            success: Vec::new(),
-            elapsed_steps: 0,
-            info,
-        };
         Ok(Self {
             env,
-            episode,
+            recorder,
             arm_target,
         })
     }
@@ -88,7 +83,7 @@ impl<'e> EpisodeRecorder<'e> {
     /// One env step toward arm targets `arm` (rad) with gripper command `gripper`.
     ///
     /// # Errors
-    /// [`SolveError::OutOfSteps`] once the episode limit is reached; [`SolveError::Env`] if
+    /// [`SolveError::OutOfSteps`] once the episode limit is reached; [`SolveError::Demo`] if
     /// the env rejects the action.
     pub fn step(&mut self, arm: &[f64], gripper: Gripper) -> Result<(), SolveError> {
         if self.env.elapsed_steps() >= self.env.max_episode_steps() {
@@ -96,20 +91,15 @@ impl<'e> EpisodeRecorder<'e> {
         }
         let mut action: Vec<f32> = arm.iter().map(|&q| q as f32).collect();
         action.push(gripper.action());
-        let out = self.env.step(&action)?;
+        self.recorder.step(self.env, &action)?;
         self.arm_target = arm.to_vec();
-        self.episode.actions.push(action);
-        self.episode.env_states.push(self.env.get_state());
-        self.episode.success.push(out.terminated);
-        self.episode.elapsed_steps += 1;
-        self.episode.info = out.info;
         Ok(())
     }
 
     /// Follows `trajectory` (its first sample is the current target and is skipped).
     ///
     /// # Errors
-    /// As [`EpisodeRecorder::step`].
+    /// As [`JointTargetDriver::step`].
     pub fn follow(
         &mut self,
         trajectory: &JointTrajectory,
@@ -124,7 +114,7 @@ impl<'e> EpisodeRecorder<'e> {
     /// Keeps the arm target for `steps` env steps.
     ///
     /// # Errors
-    /// As [`EpisodeRecorder::step`].
+    /// As [`JointTargetDriver::step`].
     pub fn hold(&mut self, steps: u32, gripper: Gripper) -> Result<(), SolveError> {
         let target = self.arm_target.clone();
         for _ in 0..steps {
@@ -137,7 +127,7 @@ impl<'e> EpisodeRecorder<'e> {
     /// most `max_steps` steps.
     ///
     /// # Errors
-    /// As [`EpisodeRecorder::step`].
+    /// As [`JointTargetDriver::step`].
     pub fn settle(
         &mut self,
         tolerance: f64,
@@ -157,14 +147,14 @@ impl<'e> EpisodeRecorder<'e> {
     /// row (or the episode limit ends the episode).
     ///
     /// # Errors
-    /// [`SolveError::OutOfSteps`] if success is not reached in time; [`SolveError::Env`].
+    /// [`SolveError::OutOfSteps`] if success is not reached in time; [`SolveError::Demo`].
     pub fn hold_until_success(
         &mut self,
         consecutive: usize,
         gripper: Gripper,
     ) -> Result<(), SolveError> {
         loop {
-            let s = &self.episode.success;
+            let s = &self.recorder.episode().success;
             if s.len() >= consecutive && s[s.len() - consecutive..].iter().all(|&v| v) {
                 return Ok(());
             }
@@ -188,6 +178,6 @@ impl<'e> EpisodeRecorder<'e> {
 
     /// The recorded episode.
     pub fn finish(self) -> DemoEpisode {
-        self.episode
+        self.recorder.finish()
     }
 }

@@ -1,0 +1,171 @@
+//! The base of the soft-body tasks on the robot runtime: the Panda carrying the bucket
+//! (`ms2_assets::PANDA_BUCKET_URDF`) and a clay solver coupled to its hand and to the task's
+//! other bodies.
+//!
+//! [`BucketArm`] holds what `Excavate-v0` and `Fill-v0` share: the coupled [`SoftWorld`],
+//! the bucket's pose, the soft substeps after each physics step, the `particles` observation
+//! and the particle part of the task state. A task is then its episode data plus hooks.
+
+use glam::{Mat3, Vec2, Vec3};
+use ms2_mpm::{MpmSolver, MpmState};
+use ms2_physics::{ArticulationId, BodyId, World};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+use super::excavate::BucketPose;
+use super::{SoftSceneError, SoftWorld};
+use crate::adapters::mpm_rigid::pose_to_glam;
+use crate::error::EnvError;
+use crate::geometry::Pose3;
+use crate::obs::{Array, ArrayData, DictBuilder, ObsValue};
+use crate::task::TaskScene;
+
+/// Floats of task state per particle: position 3, velocity 3, F 9, C 9 (column-major).
+pub const FLOATS_PER_PARTICLE: usize = 24;
+
+/// A soft-scene error as an env error.
+pub fn soft_err(e: SoftSceneError) -> EnvError {
+    EnvError::Physics(format!("soft body: {e}"))
+}
+
+/// Pose of the bucket frame in the hand frame (`ms2_assets::PANDA_BUCKET_IN_HAND`).
+pub fn hand_from_bucket() -> Isometry3<f32> {
+    let ([x, y, z], [r, p, w]) = ms2_assets::PANDA_BUCKET_IN_HAND;
+    Isometry3::from_parts(
+        Translation3::new(x as f32, y as f32, z as f32),
+        UnitQuaternion::from_euler_angles(r as f32, p as f32, w as f32),
+    )
+}
+
+/// The TCP pose (world) that puts the bucket at `bucket`.
+pub fn tcp_for_bucket(bucket: &BucketPose) -> Pose3 {
+    let hand_from_tcp = Isometry3::translation(0.0, 0.0, 0.1034);
+    bucket.to_pose() * hand_from_bucket().inverse() * hand_from_tcp
+}
+
+/// The bucket-carrying Panda and its coupled clay (see the [module docs](self)).
+#[derive(Default)]
+pub struct BucketArm {
+    soft: Option<SoftWorld>,
+    hand: Option<(ArticulationId, usize, BodyId)>,
+}
+
+impl BucketArm {
+    /// Forgets the previous scene's hand and clay (at scene build).
+    pub fn clear(&mut self) {
+        self.soft = None;
+        self.hand = None;
+    }
+
+    /// Finds the hand of `scene`'s robot; returns its rigid body.
+    pub fn locate_hand(&mut self, scene: &TaskScene) -> Result<BodyId, EnvError> {
+        let (world, art) = (&scene.world, scene.agent.articulation);
+        let link = world
+            .link_index(art, "panda_hand")
+            .map_err(|e| EnvError::Physics(e.to_string()))?;
+        let body = world
+            .link_body(art, link)
+            .map_err(|e| EnvError::Physics(e.to_string()))?;
+        self.hand = Some((art, link, body));
+        Ok(body)
+    }
+
+    /// Couples `solver` (its clay already added) to the hand and to `others` of `world`.
+    pub fn couple(
+        &mut self,
+        solver: MpmSolver,
+        world: &World,
+        others: &[BodyId],
+    ) -> Result<(), EnvError> {
+        let Some((_, _, hand)) = self.hand else {
+            return Err(EnvError::Physics(
+                "soft body: the robot's hand was not located".to_owned(),
+            ));
+        };
+        let mut bodies = vec![hand];
+        bodies.extend_from_slice(others);
+        self.soft = Some(SoftWorld::new(solver, world, bodies).map_err(soft_err)?);
+        Ok(())
+    }
+
+    /// The coupled soft world, once an episode started.
+    pub fn soft(&self) -> Option<&SoftWorld> {
+        self.soft.as_ref()
+    }
+
+    /// World pose of the bucket frame (identity before the hand is located).
+    pub fn bucket_pose(&self, world: &World) -> Pose3 {
+        let Some((art, link, _)) = self.hand else {
+            return Pose3::identity();
+        };
+        let hand = world
+            .link_pose(art, link)
+            .unwrap_or_else(|_| Pose3::identity());
+        hand * hand_from_bucket()
+    }
+
+    /// The bucket's plate centre (m) and pitch (rad; positive raises the opening).
+    pub fn bucket_command_pose(&self, world: &World) -> BucketPose {
+        let (p, q) = pose_to_glam(&self.bucket_pose(world));
+        let x = q * Vec3::X;
+        BucketPose {
+            position: p,
+            pitch: x.z.atan2(Vec2::new(x.x, x.y).length()),
+        }
+    }
+
+    /// The soft substeps that follow a physics step.
+    pub fn after_physics_step(&mut self, world: &mut World) -> Result<(), EnvError> {
+        match &mut self.soft {
+            Some(soft) => soft.after_rigid_step(world).map_err(soft_err),
+            None => Ok(()),
+        }
+    }
+
+    /// `{"x": [N, 3]}` particle positions (m, world).
+    pub fn particles_obs(&self) -> Option<ObsValue> {
+        let x = self.soft.as_ref()?.solver().positions();
+        let mut particles = DictBuilder::new();
+        particles.push(
+            "x",
+            ObsValue::Array(Array {
+                shape: vec![x.len(), 3],
+                data: ArrayData::F32(x.iter().flat_map(|p| p.to_array()).collect()),
+            }),
+        );
+        Some(particles.build())
+    }
+
+    /// Number of particles (0 before the first episode).
+    pub fn particle_count(&self) -> usize {
+        self.soft
+            .as_ref()
+            .map_or(0, |s| s.solver().particle_count())
+    }
+
+    /// Appends the particle state ([`FLOATS_PER_PARTICLE`] floats per particle).
+    pub fn push_particle_state(&self, out: &mut Vec<f32>) {
+        let Some(soft) = &self.soft else { return };
+        let s = soft.solver();
+        for i in 0..s.particle_count() {
+            out.extend(s.positions()[i].to_array());
+            out.extend(s.velocities()[i].to_array());
+            out.extend(s.deformation_gradients()[i].to_cols_array());
+            out.extend(s.affine_velocities()[i].to_cols_array());
+        }
+    }
+
+    /// Restores a particle state from [`Self::push_particle_state`] (same particle count;
+    /// the runtime checked the length and finiteness). A position outside the soft domain is
+    /// refused by the solver, which then keeps its state.
+    pub fn set_particle_state(&mut self, state: &[f32]) {
+        let Some(soft) = &mut self.soft else { return };
+        let mut full: MpmState = soft.state();
+        for (i, c) in state.chunks_exact(FLOATS_PER_PARTICLE).enumerate() {
+            full.positions[i] = Vec3::from_slice(&c[0..3]);
+            full.velocities[i] = Vec3::from_slice(&c[3..6]);
+            full.deformation_gradients[i] = Mat3::from_cols_slice(&c[6..15]);
+            full.affine_velocities[i] = Mat3::from_cols_slice(&c[15..24]);
+        }
+        let _ = soft.set_state(&full);
+    }
+}

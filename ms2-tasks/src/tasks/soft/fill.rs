@@ -1,0 +1,367 @@
+//! `Fill-v0`: pour the clay in the Panda's bucket into a beaker.
+//!
+//! The episode starts with a lump of clay (6.5 × 6 × 2.5 cm, about 800 particles) resting in
+//! the bucket of `ms2_assets::PANDA_BUCKET_URDF` at the robot's rest pose (the runtime's joint
+//! noise varies the bucket's initial pose); a beaker (four 6 mm walls around a 9 cm square, 6 cm
+//! tall, standing on the table, which is its bottom) is placed at a seeded position in front of
+//! the robot. The clay is coupled to the hand and to the beaker ([`BucketArm`]).
+//!
+//! - Success (the paper's terms): more than 90 % of the particles inside the beaker and mean
+//!   soft-body speed below 0.05 m/s.
+//! - Dense reward in [0, 1]: 1 on success; otherwise 0.9 × (0.2 · closeness of the bucket's
+//!   lip to the pour point above the beaker + 0.6 · fraction inside + 0.2 · rest).
+//! - `extra` observation: `tcp_pose` (7), `bucket_pose` (7), `beaker_pos` (3, m).
+//!   The `particles` obs mode adds `particles/x`.
+//! - Task state: beaker x, y (m), particle count, 0, then the particle state.
+
+use std::any::Any;
+
+use glam::{Vec2, Vec3};
+use ms2_mpm::sampling;
+use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, World};
+use nalgebra::Vector3;
+use rand::Rng;
+
+use super::bucket_arm::{soft_err, tcp_for_bucket, BucketArm, FLOATS_PER_PARTICLE};
+use super::excavate::{BucketPose, BUCKET_INNER_HALF, BUCKET_WALL_HALF, MAX_SOFT_SPEED};
+use super::{SoftConfig, SoftWorld};
+use crate::adapters::mpm_rigid::pose_to_glam;
+use crate::env::Env;
+use crate::error::EnvError;
+use crate::geometry::vectorize_pose;
+use crate::info::{Evaluation, InfoValue};
+use crate::obs::{DictBuilder, ObsValue};
+use crate::scripted::oracle::{TcpOracle, GRIPPER_OPEN};
+use crate::scripted::ScriptedPolicy;
+use crate::seeding::EpisodeRng;
+use crate::task::{Task, TaskScene};
+
+/// Episode limit, as ManiSkill2's Fill.
+pub const MAX_EPISODE_STEPS: u32 = 250;
+/// Smallest fraction of the clay inside the beaker of a successful episode.
+pub const MIN_FRACTION_INSIDE: f32 = 0.9;
+/// Interior half width (m) of the square beaker.
+pub const BEAKER_INNER_HALF: f32 = 0.045;
+/// Wall height (m) of the beaker.
+pub const BEAKER_HEIGHT: f32 = 0.06;
+/// World position (m) of the soft grid's node (0, 0, 0); the soft floor is the table.
+pub const GRID_ORIGIN: Vec3 = Vec3::new(-0.14, -0.16, -0.03);
+/// Range of the beaker centre (m, world x then y).
+const BEAKER_X: (f32, f32) = (0.07, 0.10);
+const BEAKER_Y: (f32, f32) = (-0.05, 0.05);
+/// The pour point is this far (m) above the beaker's rim, over its centre.
+const POUR_HEIGHT: f32 = 0.04;
+/// Floats of task state before the particles.
+const STATE_HEADER: usize = 4;
+
+/// The `Fill-v0` task (see the [module docs](self)).
+#[derive(Default)]
+pub struct Fill {
+    arm: BucketArm,
+    beaker: Option<BodyId>,
+    beaker_xy: Vec2,
+    setup_error: Option<String>,
+}
+
+/// Evaluation terms of `Fill-v0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FillEvaluation {
+    /// Fraction of the particles inside the beaker.
+    pub fraction_inside: f32,
+    /// Mean soft-body speed (m/s).
+    pub mean_soft_speed: f32,
+    /// Distance (m) from the bucket's lip to the pour point.
+    pub lip_to_pour_point: f32,
+    /// Both success terms hold.
+    pub success: bool,
+}
+
+impl Fill {
+    /// The bucket-carrying arm and its clay.
+    pub fn arm(&self) -> &BucketArm {
+        &self.arm
+    }
+
+    /// The point (m, world) above the beaker's centre the scripted pour puts the lip at.
+    pub fn pour_point(&self) -> Vec3 {
+        self.beaker_xy.extend(BEAKER_HEIGHT + POUR_HEIGHT)
+    }
+
+    /// Whether world point `p` (m) is inside the beaker (up to 2 cm above its rim).
+    pub fn in_beaker(&self, p: Vec3) -> bool {
+        let d = p.truncate() - self.beaker_xy;
+        d.x.abs() < BEAKER_INNER_HALF && d.y.abs() < BEAKER_INNER_HALF && p.z < BEAKER_HEIGHT + 0.02
+    }
+
+    /// The evaluation terms of the current state.
+    pub fn fill_eval(&self, world: &World) -> Option<FillEvaluation> {
+        let soft = self.arm.soft()?;
+        let x = soft.solver().positions();
+        let inside = x.iter().filter(|p| self.in_beaker(**p)).count();
+        let fraction_inside = inside as f32 / x.len().max(1) as f32;
+        let mean_soft_speed = soft.mean_speed();
+        let (pos, rot) = pose_to_glam(&self.arm.bucket_pose(world));
+        let lip = pos + rot * Vec3::new(BUCKET_INNER_HALF[0], 0.0, 0.0);
+        Some(FillEvaluation {
+            fraction_inside,
+            mean_soft_speed,
+            lip_to_pour_point: lip.distance(self.pour_point()),
+            success: fraction_inside > MIN_FRACTION_INSIDE && mean_soft_speed < MAX_SOFT_SPEED,
+        })
+    }
+
+    /// Clay filling the bucket's interior at its current pose (bucket frame lattice).
+    fn clay_in_bucket(&self, world: &World, spacing: f32) -> Vec<Vec3> {
+        let [hx, hy, _] = BUCKET_INNER_HALF;
+        let w = BUCKET_WALL_HALF;
+        let (pos, rot) = pose_to_glam(&self.arm.bucket_pose(world));
+        sampling::sample_box(
+            Vec3::new(-hx + 0.005, -hy + 0.005, w + 0.004),
+            Vec3::new(hx - 0.015, hy - 0.005, w + 0.029),
+            spacing,
+        )
+        .into_iter()
+        .map(|local| pos + rot * local)
+        .collect()
+    }
+}
+
+/// The beaker: four walls around the origin (its frame's origin is on the table at its
+/// centre).
+fn beaker_shape() -> ShapeDesc {
+    let (h, w, z) = (BEAKER_INNER_HALF, BUCKET_WALL_HALF, BEAKER_HEIGHT / 2.0);
+    let wall = |x: f32, y: f32, half: [f32; 3]| {
+        (
+            Pose3::translation(x, y, z),
+            ShapeDesc::Box {
+                half_extents: Vector3::from(half),
+            },
+        )
+    };
+    ShapeDesc::Compound {
+        parts: vec![
+            wall(h + w, 0.0, [w, h + 2.0 * w, z]),
+            wall(-h - w, 0.0, [w, h + 2.0 * w, z]),
+            wall(0.0, h + w, [h, w, z]),
+            wall(0.0, -h - w, [h, w, z]),
+        ],
+    }
+}
+
+impl Task for Fill {
+    fn max_episode_steps(&self) -> u32 {
+        MAX_EPISODE_STEPS
+    }
+
+    fn max_dense_reward(&self) -> f64 {
+        1.0
+    }
+
+    fn robot_urdf(&self) -> &'static str {
+        ms2_assets::PANDA_BUCKET_URDF
+    }
+
+    fn build_scene(&mut self, world: &mut World, _rng: &mut EpisodeRng) -> Result<(), EnvError> {
+        self.arm.clear();
+        let beaker = world
+            .add_actor(
+                ActorDesc::new("beaker", ActorKind::Kinematic)
+                    .with_pose(Pose3::translation(BEAKER_X.0, 0.0, 0.0))
+                    .with_shape(ShapeSpec::new(beaker_shape())),
+            )
+            .map_err(|e| EnvError::Physics(e.to_string()))?;
+        self.beaker = Some(beaker);
+        Ok(())
+    }
+
+    fn initialize_actors(
+        &mut self,
+        scene: &mut TaskScene,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
+        self.arm.locate_hand(scene)?;
+        self.beaker_xy = Vec2::new(
+            rng.random_range(BEAKER_X.0..BEAKER_X.1),
+            rng.random_range(BEAKER_Y.0..BEAKER_Y.1),
+        );
+        if let Some(beaker) = self.beaker {
+            scene
+                .world
+                .set_body_pose(
+                    beaker,
+                    &Pose3::translation(self.beaker_xy.x, self.beaker_xy.y, 0.0),
+                )
+                .map_err(|e| EnvError::Physics(e.to_string()))?;
+        }
+        Ok(())
+    }
+
+    fn initialize_task(&mut self, scene: &TaskScene, _rng: &mut EpisodeRng) {
+        // The clay goes into the bucket where the robot's reset put it.
+        let config = SoftConfig {
+            grid_origin: GRID_ORIGIN,
+            ..SoftConfig::default()
+        };
+        let result = (|| -> Result<(), EnvError> {
+            let (mut solver, clay) = SoftWorld::solver_for(&config).map_err(soft_err)?;
+            let spacing = config.particle_spacing;
+            let points = self.clay_in_bucket(&scene.world, spacing);
+            solver
+                .add_particles(&points, clay, spacing.powi(3), Vec3::ZERO)
+                .map_err(|e| soft_err(e.into()))?;
+            let others: Vec<BodyId> = self.beaker.into_iter().collect();
+            self.arm.couple(solver, &scene.world, &others)
+        })();
+        // `initialize_task` cannot fail; the error surfaces at the first physics step.
+        self.setup_error = result.err().map(|e| e.to_string());
+    }
+
+    fn after_physics_step(&mut self, world: &mut World) -> Result<(), EnvError> {
+        if let Some(e) = &self.setup_error {
+            return Err(EnvError::Physics(e.clone()));
+        }
+        self.arm.after_physics_step(world)
+    }
+
+    fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
+        let world = &scene.world;
+        extra.push_vector("tcp_pose", &vectorize_pose(&scene.agent.tcp_pose(world)));
+        extra.push_vector("bucket_pose", &vectorize_pose(&self.arm.bucket_pose(world)));
+        extra.push_vector("beaker_pos", &self.beaker_xy.extend(0.0).to_array());
+    }
+
+    fn evaluate(&self, scene: &TaskScene) -> Evaluation {
+        let Some(e) = self.fill_eval(&scene.world) else {
+            return Evaluation::default();
+        };
+        Evaluation {
+            success: e.success,
+            terms: vec![
+                (
+                    "fraction_inside".to_owned(),
+                    InfoValue::F64(f64::from(e.fraction_inside)),
+                ),
+                (
+                    "mean_soft_speed".to_owned(),
+                    InfoValue::F64(f64::from(e.mean_soft_speed)),
+                ),
+            ],
+        }
+    }
+
+    fn dense_reward(&self, scene: &TaskScene, _eval: &Evaluation) -> f64 {
+        let Some(e) = self.fill_eval(&scene.world) else {
+            return 0.0;
+        };
+        if e.success {
+            return 1.0;
+        }
+        let reach = 1.0 - f64::from(10.0 * e.lip_to_pour_point).tanh();
+        let rest = 1.0 - f64::from(10.0 * e.mean_soft_speed).tanh();
+        0.9 * (0.2 * reach + 0.6 * f64::from(e.fraction_inside) + 0.2 * rest)
+    }
+
+    fn task_state(&self) -> Vec<f32> {
+        let n = self.arm.particle_count();
+        let mut out = Vec::with_capacity(STATE_HEADER + FLOATS_PER_PARTICLE * n);
+        out.extend([self.beaker_xy.x, self.beaker_xy.y, n as f32, 0.0]);
+        self.arm.push_particle_state(&mut out);
+        out
+    }
+
+    fn task_state_len(&self) -> usize {
+        STATE_HEADER + FLOATS_PER_PARTICLE * self.arm.particle_count()
+    }
+
+    fn set_task_state(&mut self, state: &[f32]) {
+        self.beaker_xy = Vec2::new(state[0], state[1]);
+        self.arm.set_particle_state(&state[STATE_HEADER..]);
+    }
+
+    fn particles_obs(&self) -> Option<ObsValue> {
+        self.arm.particles_obs()
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+/// Bucket waypoints of the scripted pour: lift, carry the lip over the beaker, tilt the
+/// opening down about the lip, hold.
+#[derive(Clone, Debug)]
+pub struct PourPlan {
+    waypoints: Vec<(u32, BucketPose)>,
+}
+
+/// Pitch (rad) of the pour: the opening 75° down.
+const POUR_PITCH: f32 = -75.0 * std::f32::consts::PI / 180.0;
+
+impl PourPlan {
+    /// Plans the pour from the bucket's pose `start` to the pour point `pour` (m, world).
+    pub fn new(start: BucketPose, pour: Vec3) -> Self {
+        let hx = BUCKET_INNER_HALF[0];
+        // Plate centre that puts the lip at `pour` for a given pitch.
+        let centre = |pitch: f32| BucketPose {
+            position: pour - Vec3::new(hx * pitch.cos(), 0.0, hx * pitch.sin()),
+            pitch,
+        };
+        let lifted = BucketPose {
+            position: start.position + Vec3::new(0.0, 0.0, 0.04),
+            pitch: 0.0,
+        };
+        let mut above = centre(0.0);
+        above.position.z += 0.02;
+        Self {
+            waypoints: vec![
+                (0, start),
+                (6, lifted),
+                (16, above),
+                (20, centre(0.0)),
+                (24, centre(0.3 * POUR_PITCH)),
+                (36, centre(POUR_PITCH)),
+                (MAX_EPISODE_STEPS, centre(POUR_PITCH)),
+            ],
+        }
+    }
+
+    /// The command for control step `step` (0-based: the pose to reach at its end).
+    pub fn command(&self, step: u32) -> BucketPose {
+        super::excavate::interpolate_waypoints(&self.waypoints, step)
+    }
+}
+
+/// Scripted solution of `Fill-v0` ([`PourPlan`] through [`TcpOracle`]).
+pub struct FillPolicy {
+    oracle: TcpOracle,
+    plan: Option<PourPlan>,
+}
+
+impl FillPolicy {
+    /// A policy driving through `oracle`.
+    pub fn new(oracle: TcpOracle) -> Self {
+        Self { oracle, plan: None }
+    }
+}
+
+impl ScriptedPolicy for FillPolicy {
+    fn reset(&mut self, env: &Env) {
+        let task = env.task_any().and_then(|t| t.downcast_ref::<Fill>());
+        self.plan = match (task, env.task_scene()) {
+            (Some(task), Some(scene)) => {
+                let mut start = task.arm().bucket_command_pose(&scene.world);
+                start.pitch = 0.0;
+                Some(PourPlan::new(start, task.pour_point()))
+            }
+            _ => None,
+        };
+    }
+
+    fn act(&mut self, env: &Env) -> Vec<f32> {
+        let Some(plan) = &self.plan else {
+            return vec![0.0; env.action_space().size()];
+        };
+        let target = tcp_for_bucket(&plan.command(env.elapsed_steps()));
+        self.oracle.action(env, &target, GRIPPER_OPEN)
+    }
+}
