@@ -197,3 +197,48 @@ fn grasps_of_a_cube_are_reachable_and_collision_free() {
         "{err}"
     );
 }
+
+#[test]
+fn tilted_grasps_reach_a_cube_beyond_the_upright_hands_reach() {
+    let panda = KinematicRobot::panda().unwrap();
+    let mut scene = ground_scene();
+    let cube_pose = Isometry3::translation(0.8, 0.15, 0.02);
+    scene
+        .add_box("cube", Vector3::new(0.04, 0.04, 0.04), cube_pose)
+        .unwrap();
+    let cube = OrientedBox {
+        pose_base_from_box: cube_pose,
+        half_extents: Vector3::new(0.02, 0.02, 0.02),
+    };
+    let gripper = GripperSpec::panda();
+    let upright: Vec<_> = ms2_plan::box_grasp_poses(&cube, &gripper)
+        .into_iter()
+        .filter(|g| g.kind == GraspKind::TopDown)
+        .collect();
+    let reach = |poses: Vec<ms2_plan::GraspPose>| {
+        ms2_plan::reachable_grasps(
+            &panda,
+            &scene,
+            Some("cube"),
+            poses,
+            &gripper,
+            &rest(),
+            CheckerOptions::default(),
+        )
+    };
+    let err = reach(upright.clone()).unwrap_err();
+    assert_eq!(err, PlanError::NoGraspFound { candidates: 4 });
+    let tilted: Vec<_> = [0.3, -0.3, 0.6, -0.6]
+        .iter()
+        .flat_map(|&a| upright.iter().map(move |g| g.tilted_about_closing_axis(a)))
+        .collect();
+    let found = reach(tilted).unwrap();
+    for g in &found {
+        let reached = panda.tcp_pose(&g.configuration);
+        // Still a grasp of this cube: its centre on the closing axis, between the fingers.
+        let in_tcp = reached.inverse() * nalgebra::Point3::from(cube_pose.translation.vector);
+        assert!(in_tcp.coords.norm() < 1e-3, "{in_tcp:?}");
+        let approach = reached.rotation * Vector3::z();
+        assert!(approach.z < -0.5, "still from above: {approach:?}");
+    }
+}

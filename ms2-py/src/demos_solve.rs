@@ -35,17 +35,20 @@ pub fn solve_episodes<'py>(
     let results: Vec<Result<DemoEpisode, DemoError>> = py.detach(|| {
         catch_panics(|| {
             in_pool(num_workers, || {
-                // One solver (env + planners) per worker, reused across its seeds.
-                seeds
-                    .par_iter()
-                    .map_init(
-                        || DemoSolver::new(&cfg),
-                        |solver, &seed| match solver {
-                            Ok(solver) => solver.solve(seed).map(|(episode, _)| episode),
-                            Err(err) => Err(err.clone()),
-                        },
-                    )
-                    .collect()
+                // Seeds go out in chunks (a few per worker, for balance); each chunk builds one
+                // solver (env + planners) and reuses it for its seeds.
+                let chunk = seeds.len().div_ceil(4 * num_workers.max(1)).max(1);
+                let chunks: Vec<Vec<Result<DemoEpisode, DemoError>>> = seeds
+                    .par_chunks(chunk)
+                    .map(|chunk| match DemoSolver::new(&cfg) {
+                        Ok(mut solver) => chunk
+                            .iter()
+                            .map(|&seed| solver.solve(seed).map(|(episode, _)| episode))
+                            .collect(),
+                        Err(err) => vec![Err(err); chunk.len()],
+                    })
+                    .collect();
+                chunks.into_iter().flatten().collect()
             })
         })
     })?;

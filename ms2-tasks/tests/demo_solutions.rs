@@ -114,3 +114,22 @@ fn bad_requests_are_typed_errors() {
     let err = solve_episode(&cfg, 0).unwrap_err();
     assert!(err.to_string().contains("pd_ee_delta_pose"), "{err}");
 }
+
+#[test]
+fn trajectories_follow_the_env_control_frequency() {
+    // At 10 Hz each step covers twice the time: the same motion takes about half the steps.
+    let at_20 = solve_episode(&EnvConfig::new("LiftCube-v0"), 4).unwrap();
+    let cfg = EnvConfig {
+        control_freq: 10.0,
+        ..EnvConfig::new("LiftCube-v0")
+    };
+    let at_10 = solve_episode(&cfg, 4).unwrap();
+    assert!(at_10.succeeded(), "info {:?}", at_10.info);
+    let ratio = at_10.elapsed_steps as f64 / at_20.elapsed_steps as f64;
+    assert!(
+        (0.4..0.75).contains(&ratio),
+        "{} vs {} steps",
+        at_10.elapsed_steps,
+        at_20.elapsed_steps
+    );
+}

@@ -98,8 +98,11 @@ impl CubeTaskSolution {
             pre_grasp_distance: PRE_GRASP_DISTANCE,
             ..GripperSpec::panda()
         };
+        // Trajectories are sampled at the env's control frequency: one joint target per step.
+        let control_frequency = driver.env().config().control_freq;
         let config = |phase: u64| PlannerConfig {
             seed: seed.wrapping_mul(16).wrapping_add(phase),
+            control_frequency,
             velocity_scale: SPEED_SCALE,
             acceleration_scale: SPEED_SCALE,
             ..PlannerConfig::default()
