@@ -509,6 +509,11 @@ impl ParticleForces for Coupling {
                             continue;
                         }
                         let local = sh.inverse_rotation * (x - sh.world_position);
+                        // No segment to a stencil node (at most `reach` long) can touch a
+                        // solid farther away than that.
+                        if sh.sdf.distance_and_normal(local).0 > reach.x {
+                            continue;
+                        }
                         let (base, _, _) =
                             crate::math::quadratic_weights((x - grid.origin) * inv_dx);
                         for bit in 0..27 {

@@ -1,33 +1,86 @@
-//! The `EnvConfig` Python passes in, and its resolved copy handed back.
+//! Env configs from Python keyword arguments, and the resolved copy handed back.
 
 use ms2_tasks::EnvConfig;
+use pyo3::conversion::FromPyObjectOwned;
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// The keyword arguments every native constructor takes (same names and defaults as
-/// ManiSkill2's `gym.make` kwargs; `None` = the task's default).
-#[allow(clippy::too_many_arguments)]
-pub fn make_config(
-    env_id: String,
-    obs_mode: String,
-    control_mode: Option<String>,
-    reward_mode: Option<String>,
-    render_mode: Option<String>,
-    sim_freq: f64,
-    control_freq: f64,
-    max_episode_steps: Option<u32>,
-) -> EnvConfig {
-    EnvConfig {
-        env_id,
-        obs_mode,
-        control_mode,
-        reward_mode,
-        render_mode,
-        camera_cfgs: None,
-        sim_freq,
-        control_freq,
-        max_episode_steps,
+use crate::cameras::cameras_from_py;
+
+/// The keyword arguments every native env constructor and demonstration binding accepts, with
+/// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
+/// ([`EnvConfig::new`]: `state_dict`, the task's control/reward mode, 500 Hz / 20 Hz, the task's
+/// episode limit, no render mode, the task's cameras).
+pub const ENV_KWARGS: [&str; 8] = [
+    "obs_mode",
+    "control_mode",
+    "reward_mode",
+    "render_mode",
+    "sim_freq",
+    "control_freq",
+    "max_episode_steps",
+    "camera_cfgs",
+];
+
+/// `value` extracted as a `T`, or a `TypeError` naming the keyword and the expected type.
+fn extract_kwarg<'py, T: FromPyObjectOwned<'py>>(
+    key: &str,
+    value: &Bound<'py, PyAny>,
+    expected: &str,
+) -> PyResult<T> {
+    value.extract().map_err(|_| {
+        let type_name = value
+            .get_type()
+            .name()
+            .map(|n| n.to_string())
+            .unwrap_or_else(|_| "?".to_owned());
+        PyTypeError::new_err(format!("{key} must be {expected}, got {type_name} {value}"))
+    })
+}
+
+/// The config of env `env_id` made with `kwargs` (keys from [`ENV_KWARGS`]). An unknown key
+/// raises `TypeError` listing the valid ones, as Python does for an unexpected keyword; a value
+/// of the wrong type raises `TypeError` naming the key; bad camera configs raise `ValueError`.
+/// Values are checked further (modes, frequencies) when the env is made.
+pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<EnvConfig> {
+    let mut cfg = EnvConfig::new(env_id);
+    let Some(kwargs) = kwargs else {
+        return Ok(cfg);
+    };
+    for (key, value) in kwargs.iter() {
+        let key: String = extract_kwarg("a keyword", &key, "a str")?;
+        if value.is_none() {
+            continue;
+        }
+        match key.as_str() {
+            "obs_mode" => cfg.obs_mode = extract_kwarg(&key, &value, "a str")?,
+            "control_mode" => cfg.control_mode = Some(extract_kwarg(&key, &value, "a str")?),
+            "reward_mode" => cfg.reward_mode = Some(extract_kwarg(&key, &value, "a str")?),
+            "render_mode" => cfg.render_mode = Some(extract_kwarg(&key, &value, "a str")?),
+            "sim_freq" => cfg.sim_freq = extract_kwarg(&key, &value, "a number (Hz)")?,
+            "control_freq" => cfg.control_freq = extract_kwarg(&key, &value, "a number (Hz)")?,
+            "max_episode_steps" => {
+                cfg.max_episode_steps = Some(extract_kwarg(
+                    &key,
+                    &value,
+                    "a non-negative int (env steps)",
+                )?)
+            }
+            "camera_cfgs" => {
+                let dict = value.cast::<PyDict>().map_err(|_| {
+                    PyTypeError::new_err(format!("camera_cfgs must be a dict, got {value}"))
+                })?;
+                cfg.camera_cfgs = cameras_from_py(Some(dict))?;
+            }
+            other => {
+                return Err(PyTypeError::new_err(format!(
+                    "unexpected keyword argument {other:?}; valid keywords: {ENV_KWARGS:?}"
+                )))
+            }
+        }
     }
+    Ok(cfg)
 }
 
 /// A config as a dict with the constructor's keyword names.

@@ -1,8 +1,7 @@
-//! Helpers shared by the demonstration bindings (`demos_solve`, `demos_replay`): env configs
-//! from keyword dicts, episodes to/from Python dicts, and a sized rayon pool.
+//! Helpers shared by the demonstration bindings (`demos_solve`, `demos_replay`): episodes
+//! to/from Python dicts and a sized rayon pool (env configs come from `config::config_from_kwargs`).
 
 use ms2_tasks::demos::{DemoEpisode, DemoError};
-use ms2_tasks::EnvConfig;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -10,45 +9,6 @@ use pyo3::types::PyDict;
 
 use crate::convert::info_to_py;
 use crate::errors::{env_error_to_py, NativeError};
-
-/// The `env_kwargs` keys a demonstration env accepts (ManiSkill2's `gym.make` names).
-const ENV_KWARGS: [&str; 6] = [
-    "obs_mode",
-    "control_mode",
-    "reward_mode",
-    "sim_freq",
-    "control_freq",
-    "max_episode_steps",
-];
-
-/// The config of env `env_id` made with `kwargs` (a subset of [`ENV_KWARGS`]; `None` values take
-/// the defaults). Unknown keys raise `ValueError`.
-pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<EnvConfig> {
-    let mut cfg = EnvConfig::new(env_id);
-    let Some(kwargs) = kwargs else {
-        return Ok(cfg);
-    };
-    for (key, value) in kwargs.iter() {
-        let key: String = key.extract()?;
-        if value.is_none() {
-            continue;
-        }
-        match key.as_str() {
-            "obs_mode" => cfg.obs_mode = value.extract()?,
-            "control_mode" => cfg.control_mode = Some(value.extract()?),
-            "reward_mode" => cfg.reward_mode = Some(value.extract()?),
-            "sim_freq" => cfg.sim_freq = value.extract()?,
-            "control_freq" => cfg.control_freq = value.extract()?,
-            "max_episode_steps" => cfg.max_episode_steps = Some(value.extract()?),
-            other => {
-                return Err(PyValueError::new_err(format!(
-                    "unknown env_kwargs key {other:?}; valid keys: {ENV_KWARGS:?}"
-                )))
-            }
-        }
-    }
-    Ok(cfg)
-}
 
 /// The Python exception for a [`DemoError`]: env errors as in `errors`, unsupported conversions,
 /// missing solutions and invalid episodes as `ValueError`, planning failures as `RuntimeError`.

@@ -6,10 +6,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 
+use crate::config::config_from_kwargs;
 use crate::convert::stack_obs;
-use crate::demos_common::{
-    config_from_kwargs, demo_error_to_py, episode_from_py, episode_to_py, in_pool,
-};
+use crate::demos_common::{demo_error_to_py, episode_from_py, episode_to_py, in_pool};
 use crate::errors::catch_panics;
 
 /// Replays each episode of `episodes` (dicts with `episode_seed`, `control_mode`, `actions`

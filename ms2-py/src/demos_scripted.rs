@@ -6,7 +6,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 
-use crate::demos_common::{config_from_kwargs, demo_error_to_py, episode_to_py, in_pool};
+use crate::config::config_from_kwargs;
+use crate::demos_common::{demo_error_to_py, episode_to_py, in_pool};
 use crate::errors::catch_panics;
 
 /// Records the scripted oracle of `env_id` (control mode `env_kwargs["control_mode"]`, default

@@ -8,8 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use pyo3::IntoPyObjectExt;
 
-use crate::cameras::cameras_from_py;
-use crate::config::{config_to_py, make_config};
+use crate::config::{config_from_kwargs, config_to_py};
 use crate::convert::{box_space_to_py, info_to_py, obs_to_py, space_to_py};
 use crate::errors::{catch_panics, lock, NativeError};
 
@@ -51,35 +50,12 @@ impl NativeEnv {
 
 #[pymethods]
 impl NativeEnv {
-    /// Makes an env; `None` arguments take the task's defaults.
+    /// Makes env `env_id` with ManiSkill2's keyword arguments (see `config::ENV_KWARGS`);
+    /// missing or `None` ones take the task's defaults.
     #[new]
-    #[pyo3(signature = (env_id, obs_mode="state_dict".to_owned(), control_mode=None, reward_mode=None,
-                        render_mode=None, sim_freq=500.0, control_freq=20.0, max_episode_steps=None,
-                        camera_cfgs=None))]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        py: Python<'_>,
-        env_id: String,
-        obs_mode: String,
-        control_mode: Option<String>,
-        reward_mode: Option<String>,
-        render_mode: Option<String>,
-        sim_freq: f64,
-        control_freq: f64,
-        max_episode_steps: Option<u32>,
-        camera_cfgs: Option<Bound<'_, PyDict>>,
-    ) -> PyResult<Self> {
-        let mut cfg = make_config(
-            env_id,
-            obs_mode,
-            control_mode,
-            reward_mode,
-            render_mode,
-            sim_freq,
-            control_freq,
-            max_episode_steps,
-        );
-        cfg.camera_cfgs = cameras_from_py(camera_cfgs.as_ref())?;
+    #[pyo3(signature = (env_id, **kwargs))]
+    fn new(py: Python<'_>, env_id: String, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let cfg = config_from_kwargs(&env_id, kwargs)?;
         let env = py.detach(|| catch_panics(|| Ok(make_env(&cfg)?)))?;
         Ok(NativeEnv {
             inner: Mutex::new(env),

@@ -8,8 +8,7 @@ use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use crate::cameras::cameras_from_py;
-use crate::config::{config_to_py, make_config};
+use crate::config::{config_from_kwargs, config_to_py};
 use crate::convert::{box_space_to_py, space_to_py, stack_obs, vec_info_to_py};
 use crate::errors::{catch_panics, lock, NativeError};
 
@@ -66,39 +65,20 @@ impl NativeVecEnv {
 
 #[pymethods]
 impl NativeVecEnv {
-    /// Makes `num_envs` envs of one config; `None` arguments take the task's defaults.
+    /// Makes `num_envs` envs `env_id` of one config, from ManiSkill2's keyword arguments (see
+    /// `config::ENV_KWARGS`); missing or `None` ones take the task's defaults.
     #[new]
-    #[pyo3(signature = (env_id, num_envs, obs_mode="state_dict".to_owned(), control_mode=None,
-                        reward_mode=None, render_mode=None, sim_freq=500.0, control_freq=20.0,
-                        max_episode_steps=None, camera_cfgs=None))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (env_id, num_envs, **kwargs))]
     fn new(
         py: Python<'_>,
         env_id: String,
         num_envs: usize,
-        obs_mode: String,
-        control_mode: Option<String>,
-        reward_mode: Option<String>,
-        render_mode: Option<String>,
-        sim_freq: f64,
-        control_freq: f64,
-        max_episode_steps: Option<u32>,
-        camera_cfgs: Option<Bound<'_, PyDict>>,
+        kwargs: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         if num_envs == 0 {
             return Err(NativeError::Input("num_envs must be at least 1, got 0".to_owned()).into());
         }
-        let mut cfg = make_config(
-            env_id,
-            obs_mode,
-            control_mode,
-            reward_mode,
-            render_mode,
-            sim_freq,
-            control_freq,
-            max_episode_steps,
-        );
-        cfg.camera_cfgs = cameras_from_py(camera_cfgs.as_ref())?;
+        let cfg = config_from_kwargs(&env_id, kwargs)?;
         let envs = py.detach(|| catch_panics(|| Ok(VecEnv::new(&cfg, num_envs)?)))?;
         let action_dim = envs.envs()[0].action_space().shape.iter().product();
         Ok(NativeVecEnv {

@@ -21,6 +21,22 @@ from .spaces import to_gym_space
 UNLIMITED_EPISODE_STEPS = 2**31 - 1
 
 
+def adopt_config(env: Any, config: dict[str, Any]) -> None:
+    """Sets ``env_id``, ``obs_mode``, ``control_mode``, ``reward_mode``, ``render_mode``,
+    ``sim_freq`` and ``control_freq`` on ``env`` from a native env's resolved ``config()`` (task
+    defaults filled in)."""
+    for key in (
+        "env_id",
+        "obs_mode",
+        "control_mode",
+        "reward_mode",
+        "render_mode",
+        "sim_freq",
+        "control_freq",
+    ):
+        setattr(env, key, config[key])
+
+
 def _seed_from(rng: np.random.Generator) -> int:
     """A 63-bit seed drawn from ``rng``."""
     return int(rng.integers(0, 2**63 - 1))
@@ -69,19 +85,12 @@ class Ms2Env(gym.Env):
             control_mode=control_mode,
             reward_mode=reward_mode,
             render_mode=render_mode,
-            sim_freq=float(sim_freq),
-            control_freq=float(control_freq),
+            sim_freq=sim_freq,
+            control_freq=control_freq,
             max_episode_steps=max_episode_steps,
             camera_cfgs=camera_cfgs,
         )
-        config = self._native.config()
-        self.env_id: str = config["env_id"]
-        self.obs_mode: str = config["obs_mode"]
-        self.control_mode: str = config["control_mode"]
-        self.reward_mode: str = config["reward_mode"]
-        self.render_mode = render_mode
-        self.sim_freq: float = config["sim_freq"]
-        self.control_freq: float = config["control_freq"]
+        adopt_config(self, self._native.config())
         self.observation_space = to_gym_space(self._native.observation_space())
         self.action_space = to_gym_space(self._native.action_space())
         self.metadata = {**self.metadata, "render_fps": self.control_freq}

@@ -17,7 +17,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _native
-from .envs import _seed_from
+from .envs import _seed_from, adopt_config
 from .spaces import to_gym_space
 
 
@@ -31,39 +31,11 @@ class Ms2VectorEnv(VectorEnv):
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
-    def __init__(
-        self,
-        env_id: str = "PickCube-v0",
-        num_envs: int = 1,
-        obs_mode: str = "state_dict",
-        control_mode: str | None = None,
-        reward_mode: str | None = None,
-        render_mode: str | None = None,
-        sim_freq: float = 500.0,
-        control_freq: float = 20.0,
-        max_episode_steps: int | None = None,
-        camera_cfgs: dict[str, Any] | None = None,
-    ) -> None:
+    def __init__(self, env_id: str = "PickCube-v0", num_envs: int = 1, **kwargs: Any) -> None:
         if int(num_envs) < 1:
             raise ValueError(f"num_envs must be at least 1, got {num_envs}")
-        self._native = _native.NativeVecEnv(
-            env_id,
-            int(num_envs),
-            obs_mode=obs_mode,
-            control_mode=control_mode,
-            reward_mode=reward_mode,
-            render_mode=render_mode,
-            sim_freq=float(sim_freq),
-            control_freq=float(control_freq),
-            max_episode_steps=max_episode_steps,
-            camera_cfgs=camera_cfgs,
-        )
-        config = self._native.config()
-        self.env_id: str = config["env_id"]
-        self.obs_mode: str = config["obs_mode"]
-        self.control_mode: str = config["control_mode"]
-        self.reward_mode: str = config["reward_mode"]
-        self.render_mode = render_mode
+        self._native = _native.NativeVecEnv(env_id, int(num_envs), **kwargs)
+        adopt_config(self, self._native.config())
         self.num_envs = int(num_envs)
         self.single_observation_space = to_gym_space(self._native.single_observation_space())
         self.single_action_space = to_gym_space(self._native.single_action_space())

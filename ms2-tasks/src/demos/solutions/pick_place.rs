@@ -76,6 +76,58 @@ const CARRIED_SHRINK: f64 = 0.003;
 /// Fraction of the joint velocity and acceleration limits the trajectories use.
 const SPEED_SCALE: f64 = 0.5;
 
+/// What one run of a solution plans with.
+struct Planning<'p> {
+    panda: &'p KinematicRobot,
+    gripper: GripperSpec,
+    /// The cube to move, then the obstacle cubes.
+    cubes: Vec<&'static str>,
+    /// Env control frequency (Hz): trajectories have one joint target per env step.
+    control_frequency: f64,
+    seed: u64,
+}
+
+impl Planning<'_> {
+    /// Planner settings of phase `phase` (its own RNG stream).
+    fn config(&self, phase: u64) -> PlannerConfig {
+        PlannerConfig {
+            seed: self.seed.wrapping_mul(16).wrapping_add(phase),
+            control_frequency: self.control_frequency,
+            velocity_scale: SPEED_SCALE,
+            acceleration_scale: SPEED_SCALE,
+            ..PlannerConfig::default()
+        }
+    }
+
+    /// A planner for `robot` in phase `phase`.
+    fn planner<'r>(
+        &self,
+        robot: &'r KinematicRobot,
+        phase: u64,
+    ) -> Result<MotionPlanner<'r, KinematicRobot>, SolveError> {
+        MotionPlanner::new(robot, self.config(phase)).map_err(plan_error("config"))
+    }
+}
+
+/// The carry phase: the planning robot with its fingers closed on the cube, the scene with the
+/// cube attached to the hand, and where the grasp left cube and hand.
+struct Carrying {
+    holding: KinematicRobot,
+    scene: CollisionScene,
+    /// Cube centre after grasping (base frame, m).
+    cube_at_grasp: Vector3<f64>,
+    /// Planned TCP pose at the grasp (base frame).
+    tcp_at_grasp: Isometry3<f64>,
+}
+
+impl Carrying {
+    /// The TCP pose that puts the cube centre at `cube_base` (base frame), hand orientation
+    /// kept. The planned TCP (not the measured one) keeps the grasp's steady-state offset.
+    fn tcp_for_cube(&self, cube_base: &Vector3<f64>) -> Isometry3<f64> {
+        Translation3::from(cube_base - self.cube_at_grasp) * self.tcp_at_grasp
+    }
+}
+
 impl CubeTaskSolution {
     /// Runs the solution on `driver`'s freshly reset env. `seed` seeds the planners.
     ///
@@ -89,46 +141,65 @@ impl CubeTaskSolution {
         seed: u64,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
-        let mut names = vec![self.cube];
-        names.extend_from_slice(self.obstacles);
-        let sensed = SensedState::read(driver.env(), &names)?;
-        let goal_world = (self.goal_world)(&sensed)?;
-        let goal_base = sensed.world_point_in_base(&goal_world);
-        let gripper = GripperSpec {
-            pre_grasp_distance: PRE_GRASP_DISTANCE,
-            ..GripperSpec::panda()
+        let mut cubes = vec![self.cube];
+        cubes.extend_from_slice(self.obstacles);
+        let planning = Planning {
+            panda,
+            gripper: GripperSpec {
+                pre_grasp_distance: PRE_GRASP_DISTANCE,
+                ..GripperSpec::panda()
+            },
+            cubes,
+            control_frequency: driver.env().config().control_freq,
+            seed,
         };
-        // Trajectories are sampled at the env's control frequency: one joint target per step.
-        let control_frequency = driver.env().config().control_freq;
-        let config = |phase: u64| PlannerConfig {
-            seed: seed.wrapping_mul(16).wrapping_add(phase),
-            control_frequency,
-            velocity_scale: SPEED_SCALE,
-            acceleration_scale: SPEED_SCALE,
-            ..PlannerConfig::default()
-        };
+        let sensed = SensedState::read(driver.env(), &planning.cubes)?;
+        let goal_base = sensed.world_point_in_base(&(self.goal_world)(&sensed)?);
+        self.pick(driver, &planning, &sensed, timings)?;
+        let carrying = self.attach(driver, &planning)?;
+        match self.finish {
+            Finish::HoldStill => {
+                self.carry(driver, &planning, &carrying, &goal_base, timings)?;
+                driver.hold_until_success(SUCCESS_STEPS, Gripper::Closed)
+            }
+            Finish::PlaceAndRelease => {
+                let above = goal_base + Vector3::new(0.0, 0.0, PLACE_APPROACH_HEIGHT);
+                self.carry(driver, &planning, &carrying, &above, timings)?;
+                self.place(driver, &planning, &carrying, &goal_base, timings)?;
+                driver.hold_until_success(SUCCESS_STEPS, Gripper::Open)
+            }
+        }
+    }
 
-        // Grasp: top-down, at the cube's yaw symmetry closest to the hand's yaw.
+    /// Grasp: the top-down grasp at the cube's yaw symmetry closest to the hand's yaw (tilted
+    /// if the upright one is out of reach); screw motion to the pre-grasp pose (RRT-Connect if
+    /// that fails), screw down (the fingers may touch the cube), settle, close.
+    fn pick(
+        &self,
+        driver: &mut JointTargetDriver<'_>,
+        planning: &Planning<'_>,
+        sensed: &SensedState,
+        timings: &mut SolveTimings,
+    ) -> Result<(), SolveError> {
+        let (panda, gripper) = (planning.panda, &planning.gripper);
         let scene = sensed.collision_scene().map_err(plan_error("scene"))?;
         let start = driver.arm_target().to_vec();
         let cube = sensed.cube(self.cube)?.oriented_box();
         let grasp = timings.time(|| {
-            let candidates = top_down_grasps(&cube, &gripper, &panda.tcp_pose(&start));
+            let candidates = top_down_grasps(&cube, gripper, &panda.tcp_pose(&start));
             reachable_grasps(
                 panda,
                 &scene,
                 Some(self.cube),
                 candidates,
-                &gripper,
+                gripper,
                 &start,
                 CheckerOptions::default(),
             )
             .map(|mut found| found.swap_remove(0))
             .map_err(plan_error("grasp"))
         })?;
-        let mut planner = MotionPlanner::new(panda, config(0)).map_err(plan_error("config"))?;
-
-        // Reach the pre-grasp pose (screw motion, else RRT-Connect to the pre-grasp IK).
+        let mut planner = planning.planner(panda, 0)?;
         let pre_grasp_pose = grasp.grasp.pre_grasp_pose(PRE_GRASP_DISTANCE);
         let reach = timings.time(|| {
             planner
@@ -141,8 +212,7 @@ impl CubeTaskSolution {
         })?;
         driver.follow(&reach.trajectory, Gripper::Open)?;
 
-        // Screw down to the grasp (the fingers may touch the cube) and close.
-        let mut approach_scene = scene.clone();
+        let mut approach_scene = scene;
         for finger in &gripper.touch_links {
             approach_scene.allow_collision(finger.clone(), self.cube);
         }
@@ -158,115 +228,127 @@ impl CubeTaskSolution {
         driver.follow(&descend.trajectory, Gripper::Open)?;
         driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Open)?;
         driver.hold(PAUSE_STEPS, Gripper::Open)?;
-        driver.hold(CLOSE_STEPS, Gripper::Closed)?;
+        driver.hold(CLOSE_STEPS, Gripper::Closed)
+    }
 
-        // Carry: the cube rides on the hand; the planner sees the fingers closed on it.
-        let grasped = SensedState::read(driver.env(), &names)?;
-        let cube_now = grasped.cube(self.cube)?.clone();
-        let mut holding = panda.clone();
+    /// After closing: senses where the cube ended up in the hand and attaches it there.
+    fn attach(
+        &self,
+        driver: &JointTargetDriver<'_>,
+        planning: &Planning<'_>,
+    ) -> Result<Carrying, SolveError> {
+        let grasped = SensedState::read(driver.env(), &planning.cubes)?;
+        let cube = grasped.cube(self.cube)?;
+        let mut holding = planning.panda.clone();
         holding
-            .set_panda_finger_opening(cube_now.half_size)
+            .set_panda_finger_opening(cube.half_size)
             .map_err(plan_error("carry"))?;
-        let grasp_q = driver.arm_target().to_vec();
-        let carry_scene = scene_carrying(&grasped, &holding, &grasp_q, self.cube, &gripper)?;
-        let mut carry_planner =
-            MotionPlanner::new(&holding, config(1)).map_err(plan_error("config"))?;
-        // Translate the TCP as the cube must move; the planned TCP (not the measured one)
-        // keeps the grasp's steady-state offset in the motion.
-        let tcp_for_cube = |cube_base: &Vector3<f64>| {
-            let shift = cube_base - cube_now.pose_base_from_cube.translation.vector;
-            Translation3::from(shift) * holding.tcp_pose(&grasp_q)
-        };
-        let cube_z = cube_now.pose_base_from_cube.translation.vector.z;
-        let place_above = self.finish == Finish::PlaceAndRelease;
-        let carry_target = if place_above {
-            goal_base + Vector3::new(0.0, 0.0, PLACE_APPROACH_HEIGHT)
-        } else {
-            goal_base
-        };
-        // Lift straight up first: by LIFT_CLEARANCE for a low goal, and to the carry height
-        // when other cubes stand around (a slanted carry could clip them: the arm lags its
-        // targets by a few centimetres).
-        let lift_z = if self.obstacles.is_empty() {
-            cube_z + LIFT_CLEARANCE
-        } else {
-            carry_target.z.max(cube_z + LIFT_CLEARANCE)
-        };
-        if carry_target.z < cube_z + LIFT_CLEARANCE || !self.obstacles.is_empty() {
-            let mut lifted = cube_now.pose_base_from_cube.translation.vector;
-            lifted.z = lift_z;
+        let grasp_q = driver.arm_target();
+        let scene = scene_carrying(&grasped, &holding, grasp_q, self.cube, &planning.gripper)?;
+        Ok(Carrying {
+            tcp_at_grasp: holding.tcp_pose(grasp_q),
+            cube_at_grasp: cube.pose_base_from_cube.translation.vector,
+            holding,
+            scene,
+        })
+    }
+
+    /// Carries the cube so that its centre reaches `target` (base frame): first straight up
+    /// (by [`LIFT_CLEARANCE`] for a low target, to the target's height when other cubes stand
+    /// around: a slanted carry could clip them, as the arm lags its targets by centimetres),
+    /// then by screw motion (RRT-Connect if that fails), trying points up to
+    /// [`CubeTaskSolution::goal_tolerance`] short of the target toward the shoulder, then a
+    /// tilted hand, when the upright hand cannot reach it.
+    fn carry(
+        &self,
+        driver: &mut JointTargetDriver<'_>,
+        planning: &Planning<'_>,
+        carrying: &Carrying,
+        target: &Vector3<f64>,
+        timings: &mut SolveTimings,
+    ) -> Result<(), SolveError> {
+        let mut planner = planning.planner(&carrying.holding, 1)?;
+        let cube_z = carrying.cube_at_grasp.z;
+        let crowded = !self.obstacles.is_empty();
+        if target.z < cube_z + LIFT_CLEARANCE || crowded {
+            let mut lifted = carrying.cube_at_grasp;
+            lifted.z = if crowded {
+                target.z.max(cube_z + LIFT_CLEARANCE)
+            } else {
+                cube_z + LIFT_CLEARANCE
+            };
             let lift = timings.time(|| {
-                carry_planner
-                    .plan_screw(&carry_scene, &grasp_q, &tcp_for_cube(&lifted))
+                planner
+                    .plan_screw(
+                        &carrying.scene,
+                        driver.arm_target(),
+                        &carrying.tcp_for_cube(&lifted),
+                    )
                     .map_err(plan_error("lift"))
             })?;
             driver.follow(&lift.trajectory, Gripper::Closed)?;
         }
         let carry = timings.time(|| {
             let start = driver.arm_target();
-            let mut last = None;
-            let toward_shoulder = (Vector3::new(0.0, 0.0, SHOULDER_HEIGHT) - carry_target)
+            let toward_shoulder = (Vector3::new(0.0, 0.0, SHOULDER_HEIGHT) - target)
                 .try_normalize(1e-9)
                 .unwrap_or_else(Vector3::zeros);
             let upright_near_goal = GOAL_SLACK_FRACTIONS.iter().map(|f| {
-                tcp_for_cube(&(carry_target + toward_shoulder * (f * self.goal_tolerance)))
+                carrying.tcp_for_cube(&(target + toward_shoulder * (f * self.goal_tolerance)))
             });
-            let poses = tilted_about(&tcp_for_cube(&carry_target), &carry_target);
-            for tcp in upright_near_goal.chain(poses.skip(1)) {
-                match move_to_pose(&mut carry_planner, &carry_scene, start, &tcp) {
+            let tilted = tilted_about(&carrying.tcp_for_cube(target), target).skip(1);
+            let mut last = PlanError::NoPathFound { iterations: 0 };
+            for tcp in upright_near_goal.chain(tilted) {
+                match move_to_pose(&mut planner, &carrying.scene, start, &tcp) {
                     Ok(motion) => return Ok(motion),
-                    Err(e) => last = Some(e),
+                    Err(e) => last = e,
                 }
             }
-            Err(plan_error("carry")(
-                last.unwrap_or(PlanError::NoPathFound { iterations: 0 }),
-            ))
+            Err(plan_error("carry")(last))
         })?;
-        driver.follow(&carry.trajectory, Gripper::Closed)?;
-
-        match self.finish {
-            Finish::HoldStill => driver.hold_until_success(SUCCESS_STEPS, Gripper::Closed),
-            Finish::PlaceAndRelease => {
-                let lower = timings.time(|| {
-                    carry_planner
-                        .plan_screw(&carry_scene, driver.arm_target(), &tcp_for_cube(&goal_base))
-                        .map_err(plan_error("lower"))
-                })?;
-                driver.follow(&lower.trajectory, Gripper::Closed)?;
-                driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Closed)?;
-                driver.hold(PAUSE_STEPS, Gripper::Closed)?;
-                driver.hold(OPEN_STEPS, Gripper::Open)?;
-                self.retreat(driver, panda, &names, &gripper, config(2), timings)?;
-                driver.hold_until_success(SUCCESS_STEPS, Gripper::Open)
-            }
-        }
+        driver.follow(&carry.trajectory, Gripper::Closed)
     }
 
-    /// Backs the open gripper straight up by [`RETREAT_HEIGHT`] (the fingers may brush the
-    /// released cube).
-    fn retreat(
+    /// Lowers the carried cube onto `place` (its centre, base frame), settles, opens the
+    /// gripper and backs the open hand straight up by [`RETREAT_HEIGHT`] (the fingers may
+    /// brush the released cube).
+    fn place(
         &self,
         driver: &mut JointTargetDriver<'_>,
-        panda: &KinematicRobot,
-        names: &[&str],
-        gripper: &GripperSpec,
-        config: PlannerConfig,
+        planning: &Planning<'_>,
+        carrying: &Carrying,
+        place: &Vector3<f64>,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
-        let released = SensedState::read(driver.env(), names)?;
+        let mut planner = planning.planner(&carrying.holding, 2)?;
+        let lower = timings.time(|| {
+            planner
+                .plan_screw(
+                    &carrying.scene,
+                    driver.arm_target(),
+                    &carrying.tcp_for_cube(place),
+                )
+                .map_err(plan_error("lower"))
+        })?;
+        driver.follow(&lower.trajectory, Gripper::Closed)?;
+        driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Closed)?;
+        driver.hold(PAUSE_STEPS, Gripper::Closed)?;
+        driver.hold(OPEN_STEPS, Gripper::Open)?;
+
+        let released = SensedState::read(driver.env(), &planning.cubes)?;
         let mut scene = released.collision_scene().map_err(plan_error("retreat"))?;
-        for finger in &gripper.touch_links {
+        for finger in &planning.gripper.touch_links {
             scene.allow_collision(finger.clone(), self.cube);
         }
         let start = driver.arm_target().to_vec();
-        let up = Translation3::new(0.0, 0.0, RETREAT_HEIGHT) * panda.tcp_pose(&start);
-        let mut planner = MotionPlanner::new(panda, config).map_err(plan_error("config"))?;
-        let motion = timings.time(|| {
+        let up = Translation3::new(0.0, 0.0, RETREAT_HEIGHT) * planning.panda.tcp_pose(&start);
+        let mut planner = planning.planner(planning.panda, 3)?;
+        let retreat = timings.time(|| {
             planner
                 .plan_screw(&scene, &start, &up)
                 .map_err(plan_error("retreat"))
         })?;
-        driver.follow(&motion.trajectory, Gripper::Open)
+        driver.follow(&retreat.trajectory, Gripper::Open)
     }
 }
 
