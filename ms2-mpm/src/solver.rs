@@ -421,8 +421,11 @@ impl MpmSolver {
 
     /// Puts the particles in canonical order (sorted by bin at their current positions), the
     /// order [`Self::set_state`] produces, so that a run continued from here and a run
-    /// restored from a state captured here are bitwise identical.
-    pub(crate) fn canonicalize(&mut self) {
+    /// restored from a state captured here are bitwise identical. [`Self::state`] calls it;
+    /// call it yourself before reading a state through the `&self` getters
+    /// ([`Self::positions`], ...) that you mean to restore later. A no-op if nothing moved
+    /// since the last sort.
+    pub fn canonicalize(&mut self) {
         if !self.freshly_sorted || self.needs_sort {
             self.sort_particles();
         }

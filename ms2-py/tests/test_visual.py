@@ -168,3 +168,24 @@ def test_make_vec_batched_images_equal_single_env_images():
     assert not np.array_equal(
         batched["image"]["base_camera"]["rgb"][0], batched["image"]["base_camera"]["rgb"][1]
     )
+
+
+def test_make_vec_visual_autoreset_renders_the_new_episode():
+    venv = ms2.make_vec(
+        "PickCube-v0",
+        num_envs=2,
+        obs_mode="pointcloud_robot_seg",
+        max_episode_steps=1,
+        camera_cfgs={"width": 16, "height": 16},
+    )
+    first, _ = venv.reset(seed=3)
+    actions = np.zeros((2, *venv.single_action_space.shape), dtype=np.float32)
+    _, _, _, truncated, _ = venv.step(actions)
+    assert truncated.all()
+    obs, reward, terminated, truncated, _ = venv.step(actions)  # autoreset step
+    assert (reward == 0).all() and not terminated.any() and not truncated.any()
+    assert obs["pointcloud"]["xyzw"].shape == (2, 2 * 16 * 16, 4)
+    assert obs["pointcloud"]["robot_seg"].any()
+    # A new episode (seed drawn from each env's generator): the cube moved, so the cloud differs.
+    assert not np.array_equal(obs["pointcloud"]["xyzw"], first["pointcloud"]["xyzw"])
+    venv.close()

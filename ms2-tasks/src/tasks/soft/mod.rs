@@ -155,6 +155,9 @@ impl SoftWorld {
             &mut MpmRigidWorld::new(world, &self.bodies),
             self.substeps_per_rigid_step,
         )?;
+        // The env's get_state reads particles through `&self`: keep them in the canonical order
+        // that set_state reproduces, so a restored episode steps bit-identically.
+        self.solver.canonicalize();
         Ok(())
     }
 
