@@ -11,11 +11,19 @@ use crate::env::Env;
 /// The control mode the solutions drive.
 pub const CONTROL_MODE: &str = "pd_joint_pos";
 
+/// Lower bound (m) of the `gripper_pd_joint_pos` finger target (action −1).
+const FINGER_TARGET_MIN: f64 = -0.01;
+/// Upper bound (m) of the `gripper_pd_joint_pos` finger target (action +1).
+const FINGER_TARGET_MAX: f64 = 0.04;
+
 /// Gripper command of a `pd_joint_pos` action (the normalised `gripper_pd_joint_pos` entry).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Gripper {
     /// Fingers to 0.04 m each (action +1).
     Open,
+    /// Each finger to this many metres from the hand's centre plane, clamped to the
+    /// controller's −0.01..0.04 m: opened only as wide as an approach needs.
+    Ajar(f64),
     /// Fingers to −0.01 m each (action −1): squeezes whatever is between them.
     Closed,
 }
@@ -25,6 +33,11 @@ impl Gripper {
     pub fn action(self) -> f32 {
         match self {
             Gripper::Open => 1.0,
+            Gripper::Ajar(finger_m) => {
+                let clamped = finger_m.clamp(FINGER_TARGET_MIN, FINGER_TARGET_MAX);
+                (2.0 * (clamped - FINGER_TARGET_MIN) / (FINGER_TARGET_MAX - FINGER_TARGET_MIN)
+                    - 1.0) as f32
+            }
             Gripper::Closed => -1.0,
         }
     }
@@ -179,5 +192,19 @@ impl<'e> JointTargetDriver<'e> {
     /// The recorded episode.
     pub fn finish(self) -> DemoEpisode {
         self.recorder.finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Gripper;
+
+    #[test]
+    fn ajar_maps_finger_targets_onto_the_normalised_action() {
+        assert!((Gripper::Ajar(0.04).action() - Gripper::Open.action()).abs() < 1e-6);
+        assert!((Gripper::Ajar(-0.01).action() - Gripper::Closed.action()).abs() < 1e-6);
+        assert!(Gripper::Ajar(0.015).action().abs() < 1e-6);
+        assert!((Gripper::Ajar(0.03).action() - 0.6).abs() < 1e-6);
+        assert!((Gripper::Ajar(0.2).action() - 1.0).abs() < 1e-6);
     }
 }

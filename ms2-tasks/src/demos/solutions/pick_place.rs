@@ -52,6 +52,29 @@ pub struct CubeTaskSolution {
 const PRE_GRASP_DISTANCE: f64 = 0.05;
 /// Env steps the gripper is given to close on the cube.
 const CLOSE_STEPS: u32 = 8;
+/// Clearance (m) per side between a finger and the cube it approaches.
+const APPROACH_FINGER_MARGIN: f64 = 0.004;
+
+/// Finger opening (m, each finger from the hand's centre plane) while reaching for and
+/// descending onto `cube`: the cube's half width along the closing direction (TCP y axis) of
+/// the hand at `pose_base_from_start_tcp`, plus [`APPROACH_FINGER_MARGIN`].
+///
+/// The solution turns the hand to line its fingers up with the cube (needing only the cube's
+/// half size), but a position-only conversion (`pd_ee_delta_pos`) keeps the starting hand
+/// orientation, so the opening is sized for that hand: as narrow as it can be, so the fingers
+/// do not come down on a neighbouring cube.
+fn approach_finger_opening(cube: &OrientedBox, pose_base_from_start_tcp: &Isometry3<f64>) -> f64 {
+    let closing = pose_base_from_start_tcp.rotation * Vector3::y();
+    let box_rotation = cube.pose_base_from_box.rotation;
+    let half_width: f64 = (0..3)
+        .map(|axis| {
+            let edge = box_rotation * Vector3::ith(axis, 1.0);
+            cube.half_extents[axis] * closing.dot(&edge).abs()
+        })
+        .sum();
+    half_width + APPROACH_FINGER_MARGIN
+}
+
 /// Env steps the gripper is given to open.
 const OPEN_STEPS: u32 = 6;
 /// A cube going to a goal less than this (m) above it is first lifted straight up this much.
@@ -210,7 +233,8 @@ impl CubeTaskSolution {
                 })
                 .map_err(plan_error("reach"))
         })?;
-        driver.follow(&reach.trajectory, Gripper::Open)?;
+        let ajar = Gripper::Ajar(approach_finger_opening(&cube, &panda.tcp_pose(&start)));
+        driver.follow(&reach.trajectory, ajar)?;
 
         let mut approach_scene = scene;
         for finger in &gripper.touch_links {
@@ -225,9 +249,9 @@ impl CubeTaskSolution {
                 )
                 .map_err(plan_error("descend"))
         })?;
-        driver.follow(&descend.trajectory, Gripper::Open)?;
-        driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Open)?;
-        driver.hold(PAUSE_STEPS, Gripper::Open)?;
+        driver.follow(&descend.trajectory, ajar)?;
+        driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, ajar)?;
+        driver.hold(PAUSE_STEPS, ajar)?;
         driver.hold(CLOSE_STEPS, Gripper::Closed)
     }
 
@@ -462,5 +486,36 @@ impl SolveTimings {
         self.planning_seconds += t0.elapsed().as_secs_f64();
         self.planning_queries += 1;
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Isometry3, Vector3};
+
+    use super::{approach_finger_opening, OrientedBox, APPROACH_FINGER_MARGIN};
+
+    #[test]
+    fn approach_opening_fits_the_cube_across_the_starting_hands_closing_direction() {
+        let half = 0.02;
+        let cube_turned_by = |yaw: f64| OrientedBox {
+            pose_base_from_box: Isometry3::new(Vector3::new(0.1, 0.0, 0.02), Vector3::z() * yaw),
+            half_extents: Vector3::repeat(half),
+        };
+        // A hand pointing down (TCP z along base −z), closing along base y.
+        let hand = Isometry3::new(
+            Vector3::new(0.0, 0.0, 0.3),
+            Vector3::x() * std::f64::consts::PI,
+        );
+        let aligned = approach_finger_opening(&cube_turned_by(0.0), &hand);
+        assert!(
+            (aligned - (half + APPROACH_FINGER_MARGIN)).abs() < 1e-9,
+            "{aligned}"
+        );
+        let quarter = approach_finger_opening(&cube_turned_by(std::f64::consts::FRAC_PI_2), &hand);
+        assert!((quarter - aligned).abs() < 1e-9, "{quarter}");
+        let diagonal = approach_finger_opening(&cube_turned_by(std::f64::consts::FRAC_PI_4), &hand);
+        let expected = std::f64::consts::SQRT_2 * half + APPROACH_FINGER_MARGIN;
+        assert!((diagonal - expected).abs() < 1e-9, "{diagonal}");
     }
 }
