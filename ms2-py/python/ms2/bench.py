@@ -18,6 +18,7 @@ import resource
 import subprocess
 import sys
 import time
+from typing import Any
 
 import numpy as np
 
@@ -122,6 +123,31 @@ def _configs(num_envs_list: list[int]) -> list[tuple[str, int]]:
     return [("single", 1)] + [("vec", n) for n in num_envs_list]
 
 
+def _run_rows(
+    env_id: str,
+    steps: int,
+    groups: list[dict],
+    num_envs_list: list[int],
+    format_row: Any,
+) -> list[dict]:
+    """Runs, for each group (``control_mode`` and ``obs_mode``), a single env and ``make_vec``
+    with each of ``num_envs_list`` envs, each in a fresh process; prints a row per run as
+    ``format_row(spec, result, single_env_steps_per_s)`` followed by the load average, and
+    returns the rows (spec, result and load)."""
+    rows = []
+    for group in groups:
+        single = None
+        for kind, n in _configs(num_envs_list):
+            spec = {"kind": kind, "env_id": env_id, **group, "num_envs": n, "steps": steps}
+            load = _load()
+            result = _spawn(spec)
+            if kind == "single":
+                single = result["steps_per_s"]
+            print(f"{format_row(spec, result, single)} {load:>5.1f}", flush=True)
+            rows.append({**spec, **result, "load_1min": load})
+    return rows
+
+
 def _runner_name(kind: str, n: int) -> str:
     return "gym.make (1 env)" if kind == "single" else f"make_vec({n})"
 
@@ -148,31 +174,18 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     )
     print(header)
     print("-" * len(header))
-    rows = []
-    for control_mode in control_modes:
-        single = None
-        for kind, n in _configs(num_envs_list):
-            spec = {
-                "kind": kind,
-                "env_id": args.env_id,
-                "control_mode": control_mode,
-                "obs_mode": "state",
-                "num_envs": n,
-                "steps": steps,
-            }
-            load = _load()
-            result = _spawn(spec)
-            if kind == "single":
-                single = result["steps_per_s"]
-            peer = MANISKILL2_SINGLE_STEPS_PER_S.get(control_mode)
-            vs_peer = f"{result['steps_per_s'] / peer:.2f}" if peer else "-"
-            print(
-                f"{control_mode:<20} {_runner_name(kind, n):<18} {result['steps_per_s']:>9.0f} "
-                f"{result['steps_per_s'] / single:>12.2f} {vs_peer:>12} "
-                f"{result['peak_rss_mb']:>11.0f} {load:>5.1f}",
-                flush=True,
-            )
-            rows.append({**spec, **result, "load_1min": load})
+
+    def state_row(spec: dict, result: dict, single: float) -> str:
+        peer = MANISKILL2_SINGLE_STEPS_PER_S.get(spec["control_mode"])
+        vs_peer = f"{result['steps_per_s'] / peer:.2f}" if peer else "-"
+        return (
+            f"{spec['control_mode']:<20} {_runner_name(spec['kind'], spec['num_envs']):<18} "
+            f"{result['steps_per_s']:>9.0f} {result['steps_per_s'] / single:>12.2f} "
+            f"{vs_peer:>12} {result['peak_rss_mb']:>11.0f}"
+        )
+
+    specs = [{"control_mode": control_mode, "obs_mode": "state"} for control_mode in control_modes]
+    rows = _run_rows(args.env_id, steps, specs, num_envs_list, state_row)
     print(
         "ManiSkill2 0.5.3 on this machine (single env): "
         + ", ".join(f"{m} {v:.0f} steps/s" for m, v in MANISKILL2_SINGLE_STEPS_PER_S.items())
@@ -200,31 +213,17 @@ def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
     )
     print(header)
     print("-" * len(header))
-    rows = []
-    for obs_mode in obs_modes:
-        single = None
-        for kind, n in _configs(num_envs_list):
-            spec = {
-                "kind": kind,
-                "env_id": args.env_id,
-                "control_mode": control_mode,
-                "obs_mode": obs_mode,
-                "num_envs": n,
-                "steps": steps,
-            }
-            load = _load()
-            result = _spawn(spec)
-            if kind == "single":
-                single = result["steps_per_s"]
-            print(
-                f"{obs_mode:<11} {_runner_name(kind, n):<18} {result['steps_per_s']:>9.0f} "
-                f"{result['steps_per_s'] / single:>12.2f} "
-                f"{result['steps_per_s'] / MANISKILL2_VISUAL_STEPS_PER_S:>12.1f} "
-                f"{result['peak_rss_mb']:>11.0f} {result['triangles_per_camera']:>13} "
-                f"{load:>5.1f}",
-                flush=True,
-            )
-            rows.append({**spec, **result, "load_1min": load})
+
+    def visual_row(spec: dict, result: dict, single: float) -> str:
+        return (
+            f"{spec['obs_mode']:<11} {_runner_name(spec['kind'], spec['num_envs']):<18} "
+            f"{result['steps_per_s']:>9.0f} {result['steps_per_s'] / single:>12.2f} "
+            f"{result['steps_per_s'] / MANISKILL2_VISUAL_STEPS_PER_S:>12.1f} "
+            f"{result['peak_rss_mb']:>11.0f} {result['triangles_per_camera']:>13}"
+        )
+
+    specs = [{"control_mode": control_mode, "obs_mode": obs_mode} for obs_mode in obs_modes]
+    rows = _run_rows(args.env_id, steps, specs, num_envs_list, visual_row)
     print(
         f"ManiSkill2 0.5.3 on this machine (single env, lavapipe, same cameras): rgbd and "
         f"pointcloud ~{MANISKILL2_VISUAL_STEPS_PER_S:.0f} steps/s, peak RSS 336-480 MB; it draws "
