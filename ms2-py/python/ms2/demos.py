@@ -48,8 +48,27 @@ def _succeeded(episode: dict[str, Any]) -> bool:
     return len(success) > 0 and bool(success[-1])
 
 
+class _PerEpisodeCost:
+    """Wall-clock and CPU seconds per episode of a result with ``num_episodes``, ``seconds`` and
+    ``cpu_seconds`` (kept episodes for :func:`generate`, replayed ones for :func:`replay`)."""
+
+    num_episodes: int
+    seconds: float
+    cpu_seconds: float
+
+    @property
+    def seconds_per_episode(self) -> float:
+        """Wall-clock seconds per episode."""
+        return self.seconds / max(self.num_episodes, 1)
+
+    @property
+    def cpu_seconds_per_episode(self) -> float:
+        """CPU seconds (all threads of the process) per episode."""
+        return self.cpu_seconds / max(self.num_episodes, 1)
+
+
 @dataclass
-class GenerateResult:
+class GenerateResult(_PerEpisodeCost):
     """What :func:`generate` did."""
 
     path: Path
@@ -59,16 +78,6 @@ class GenerateResult:
     seconds: float
     failed_seeds: list[int] = field(default_factory=list)
     cpu_seconds: float = 0.0
-
-    @property
-    def seconds_per_episode(self) -> float:
-        """Wall-clock seconds per kept episode."""
-        return self.seconds / max(self.num_episodes, 1)
-
-    @property
-    def cpu_seconds_per_episode(self) -> float:
-        """CPU seconds (all threads of the process) per kept episode."""
-        return self.cpu_seconds / max(self.num_episodes, 1)
 
 
 def generate(
@@ -164,7 +173,7 @@ def replay_output_path(
 
 
 @dataclass
-class ReplayResult:
+class ReplayResult(_PerEpisodeCost):
     """What :func:`replay` did."""
 
     num_episodes: int
@@ -179,16 +188,6 @@ class ReplayResult:
     @property
     def success_rate(self) -> float:
         return self.num_succeeded / max(self.num_episodes, 1)
-
-    @property
-    def seconds_per_episode(self) -> float:
-        """Wall-clock seconds per replayed episode."""
-        return self.seconds / max(self.num_episodes, 1)
-
-    @property
-    def cpu_seconds_per_episode(self) -> float:
-        """CPU seconds (all threads of the process) per replayed episode."""
-        return self.cpu_seconds / max(self.num_episodes, 1)
 
 
 def _write_video(env_id: str, env_kwargs: dict[str, Any], episode: dict[str, Any], path: Path):
