@@ -1,6 +1,7 @@
 //! Four 3×3 SVDs at once, one per SIMD lane (glam's `Vec4`: SSE on x86-64, NEON on
 //! aarch64, scalar elsewhere). Same algorithm as [`crate::math::svd3`], with branches
-//! replaced by per-lane selects, so the four decompositions cost about as much as one.
+//! replaced by per-lane selects, so the four decompositions cost about as much as one; the
+//! sweeps stop when all four lanes have converged.
 
 use glam::{BVec4A, Mat3, Vec3, Vec4};
 
@@ -157,7 +158,14 @@ pub fn svd3_x4(a: &[Mat3; 4]) -> [Svd3; 4] {
     let mut v1 = V3x4::splat(Vec3::X);
     let mut v2 = V3x4::splat(Vec3::Y);
     let mut v3 = V3x4::splat(Vec3::Z);
+    let tol2 = Vec4::splat(crate::math::JACOBI_TOLERANCE * crate::math::JACOBI_TOLERANCE);
     for _ in 0..crate::math::JACOBI_SWEEPS {
+        // Stop once every lane has converged (see `math::JACOBI_TOLERANCE`).
+        let off = s12 * s12 + s13 * s13 + s23 * s23;
+        let diag = s11 * s11 + s22 * s22 + s33 * s33;
+        if off.cmple(tol2 * diag).all() {
+            break;
+        }
         jacobi_rotate_x4(
             &mut s11, &mut s22, &mut s12, &mut s13, &mut s23, &mut v1, &mut v2,
         );
