@@ -3,7 +3,7 @@
 
 use glam::{Mat3, Vec3};
 
-pub use crate::math_x4::svd3_x4;
+pub use crate::math_x8::svd3_x8;
 
 /// Singular value decomposition `A = U · diag(sigma) · Vᵀ` of a 3×3 matrix.
 ///
