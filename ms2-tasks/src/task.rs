@@ -102,6 +102,12 @@ pub trait Task: Send + 'static {
         None
     }
 
+    /// MPM substep frequency (Hz) of a soft-body task; `None` for tasks without soft bodies
+    /// (the runtime then refuses an `mpm_freq` in the config).
+    fn mpm_freq(&self) -> Option<f64> {
+        None
+    }
+
     /// The task as `Any`, for scripted policies that read task data.
     fn as_any(&self) -> &dyn Any;
 }

@@ -377,4 +377,61 @@ mod soft_envs {
         assert!(inside >= 100, "only {inside} particles lifted: {info:?}");
         assert!(lowest > f64::from(target_height), "{info:?}");
     }
+
+    /// MPM substeps the clay of `env` has taken so far.
+    fn mpm_substeps_taken(env: &ms2_tasks::Env) -> u64 {
+        use ms2_tasks::tasks::soft::{excavate_env::Excavate, fill::Fill};
+        let task = env.task_any().unwrap();
+        let arm = match task.downcast_ref::<Excavate>() {
+            Some(e) => e.arm(),
+            None => task.downcast_ref::<Fill>().unwrap().arm(),
+        };
+        arm.soft().unwrap().solver().substeps_taken()
+    }
+
+    #[test]
+    fn mpm_freq_sets_the_soft_substeps_and_bad_values_are_refused() {
+        for (env_id, mpm_freq, per_step) in [
+            ("Excavate-v0", None, 50),
+            ("Excavate-v0", Some(2000.0), 100),
+            ("Fill-v0", Some(1500.0), 75),
+        ] {
+            let mut cfg = EnvConfig::new(env_id);
+            cfg.mpm_freq = mpm_freq;
+            let mut env = make_env(&cfg).unwrap();
+            assert_eq!(env.config().mpm_freq, Some(mpm_freq.unwrap_or(1000.0)));
+            env.reset(Some(0), false).unwrap();
+            let before = mpm_substeps_taken(&env);
+            env.step(&vec![0.0; env.action_space().size()]).unwrap();
+            assert_eq!(
+                mpm_substeps_taken(&env) - before,
+                per_step,
+                "{env_id} {mpm_freq:?}"
+            );
+        }
+        for (env_id, bad, named) in [
+            ("Excavate-v0", 1234.0, "1234"),
+            ("Excavate-v0", f64::NAN, "NaN"),
+            ("Fill-v0", -2000.0, "-2000"),
+            ("PickCube-v0", 2000.0, "PickCube-v0"),
+        ] {
+            let mut cfg = EnvConfig::new(env_id);
+            cfg.mpm_freq = Some(bad);
+            let err = make_env(&cfg).err().expect("accepted a bad mpm_freq");
+            let msg = err.to_string();
+            assert!(
+                matches!(err, EnvError::InvalidConfig(_))
+                    && msg.contains("mpm_freq")
+                    && msg.contains(named),
+                "{env_id} {bad}: {msg}"
+            );
+        }
+        assert_eq!(
+            make_env(&EnvConfig::new("PickCube-v0"))
+                .unwrap()
+                .config()
+                .mpm_freq,
+            None
+        );
+    }
 }
