@@ -16,7 +16,10 @@ SOFT_IDS = ("Excavate-v0", "Fill-v0")
 def test_particles_obs_mode_and_default_mpm_freq(env_id):
     env = gym.make(env_id, obs_mode="particles")
     assert env.unwrapped.mpm_freq == 1000.0
-    obs, _ = env.reset(seed=2)
+    space = env.observation_space["particles"]["x"]
+    for seed in range(3):
+        obs, _ = env.reset(seed=seed)
+        assert obs["particles"]["x"].shape == space.shape, seed
     x = obs["particles"]["x"]
     assert x.dtype == np.float32 and x.ndim == 2 and x.shape[1] == 3 and x.shape[0] > 100
     assert np.isfinite(x).all()

@@ -234,6 +234,39 @@ fn kinematic_plate_lifts_a_clay_block() {
     );
 }
 
+#[test]
+fn every_excavate_bed_has_the_same_particle_count_and_its_own_surface() {
+    use ms2_tasks::tasks::soft::excavate::{excavate_soft_config, ExcavateBed, BED_PARTICLES};
+    let config = excavate_soft_config(Vec3::new(-0.18, -0.16, -0.03));
+    let mut left_counts = Vec::new();
+    for seed in 0..12 {
+        let (solver, bed) = ExcavateBed::sample(&config, seed).unwrap();
+        assert_eq!(solver.particle_count(), BED_PARTICLES, "seed {seed}");
+        let x = solver.positions();
+        let highest = x.iter().map(|p| p.z).fold(f32::MIN, f32::max);
+        let lowest = x.iter().map(|p| p.z).fold(f32::MAX, f32::min);
+        assert!(
+            lowest > bed.floor_z && lowest < bed.floor_z + 0.005,
+            "seed {seed}: {lowest}"
+        );
+        assert!(
+            highest <= bed.bed_top_z + 0.005,
+            "seed {seed}: {highest} > {}",
+            bed.bed_top_z
+        );
+        assert!(
+            (x.iter().map(|p| p.z).sum::<f32>() / x.len() as f32 - bed.floor_z - 0.0175).abs()
+                < 0.003,
+            "seed {seed}: the bed's mean height is off"
+        );
+        let centre_x = 0.5 * (bed.footprint[0].x + bed.footprint[1].x);
+        left_counts.push(x.iter().filter(|p| p.x < centre_x).count());
+    }
+    // The height maps differ between seeds: so does the clay on each side of the bed.
+    let spread = left_counts.iter().max().unwrap() - left_counts.iter().min().unwrap();
+    assert!(spread > 40, "particles left of the centre: {left_counts:?}");
+}
+
 mod soft_envs {
     use ms2_tasks::{info_get, make_env, make_scripted_policy, EnvConfig, EnvError, InfoValue};
 
