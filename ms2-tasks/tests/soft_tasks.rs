@@ -450,7 +450,7 @@ mod soft_envs {
         ] {
             let mut cfg = EnvConfig::new(env_id);
             cfg.mpm_freq = Some(bad);
-            let err = make_env(&cfg).err().expect("accepted a bad mpm_freq");
+            let err = make_env(&cfg).expect_err("accepted a bad mpm_freq");
             let msg = err.to_string();
             assert!(
                 matches!(err, EnvError::InvalidConfig(_))
