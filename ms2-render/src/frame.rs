@@ -15,11 +15,13 @@ use crate::{Camera, CameraOutput, RenderError, Scene};
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
 
-/// One instance to draw: which mesh, which texture (if any), which instance record.
+/// One draw: which mesh, which texture (if any), which consecutive instance records (one for
+/// an [`crate::Instance`], one per particle for a [`crate::ParticleSet`]).
 struct Draw {
     mesh: usize,
     texture: Option<usize>,
     record: u64,
+    count: u64,
 }
 
 /// Packs an instance's per-draw data (see `VertexIn` in `shader.wgsl`).
@@ -36,14 +38,43 @@ fn instance_record(instance: &crate::Instance) -> [u32; 32] {
         }
         words[4 * i + 3] = t[i].to_bits();
     }
-    for (k, c) in instance.material.base_color.iter().enumerate() {
+    put_appearance(&mut words, &instance.material, instance.segmentation);
+    words
+}
+
+/// Writes colour, ids and the texture flag into words 24..31 of an instance record.
+fn put_appearance(
+    words: &mut [u32; 32],
+    material: &crate::Material,
+    segmentation: crate::SegmentationIds,
+) {
+    for (k, c) in material.base_color.iter().enumerate() {
         words[24 + k] = c.to_bits();
     }
-    words[28] = instance.segmentation.actor;
-    words[29] = instance.segmentation.link;
+    words[28] = segmentation.actor;
+    words[29] = segmentation.link;
     // Untextured instances skip the texture fetch in the fragment shader.
-    words[30] = u32::from(instance.material.texture.is_some());
-    words
+    words[30] = u32::from(material.texture.is_some());
+}
+
+/// Appends one instance record per particle of `set` (its mesh scaled by the radius, moved to
+/// the particle): the same layout as [`instance_record`], so one pipeline draws both.
+fn particle_records(set: &crate::ParticleSet, records: &mut Vec<[u32; 32]>) {
+    let (r, inv) = (set.radius_m, 1.0 / set.radius_m);
+    let mut template = [0u32; 32];
+    for i in 0..3 {
+        template[4 * i + i] = r.to_bits();
+        template[12 + 4 * i + i] = inv.to_bits();
+    }
+    put_appearance(&mut template, &set.material, set.segmentation);
+    records.reserve(set.positions_world.len());
+    for p in &set.positions_world {
+        let mut words = template;
+        for i in 0..3 {
+            words[4 * i + 3] = p[i].to_bits();
+        }
+        records.push(words);
+    }
 }
 
 /// Words in a uniform block (`CAMERA_BLOCK_BYTES` / 4).
@@ -160,8 +191,18 @@ impl Renderer {
         for (scene, _) in views {
             let mut scene_draws = Vec::new();
             for instance in scene.instances().iter().filter(|i| i.visible) {
-                scene_draws.push(check_draw(&store, instance, records.len() as u64)?);
+                let (mesh, material) = (instance.mesh, &instance.material);
+                scene_draws.push(check_draw(&store, mesh, material, records.len() as u64, 1)?);
                 records.push(instance_record(instance));
+            }
+            for set in scene.particle_sets().iter().filter(|p| p.visible) {
+                let count = set.positions_world.len() as u64;
+                if count == 0 {
+                    continue;
+                }
+                let at = records.len() as u64;
+                scene_draws.push(check_draw(&store, set.mesh, &set.material, at, count)?);
+                particle_records(set, &mut records);
             }
             draws.push(scene_draws);
         }
@@ -244,9 +285,10 @@ impl Renderer {
                 let mesh = &store.meshes[draw.mesh];
                 pass.set_vertex_buffer(0, mesh.vertices.slice(..));
                 let start = draw.record * INSTANCE_BYTES;
-                pass.set_vertex_buffer(1, instances.slice(start..start + INSTANCE_BYTES));
+                let end = start + draw.count * INSTANCE_BYTES;
+                pass.set_vertex_buffer(1, instances.slice(start..end));
                 pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+                pass.draw_indexed(0..mesh.index_count, 0, 0..draw.count as u32);
             }
         }
         for (c, targets) in resources.targets.iter().enumerate() {
@@ -274,9 +316,10 @@ impl Renderer {
                 pass.set_bind_group(1, texture, &[]);
                 pass.set_vertex_buffer(0, mesh.vertices.slice(..));
                 let start = draw.record * INSTANCE_BYTES;
-                pass.set_vertex_buffer(1, instances.slice(start..start + INSTANCE_BYTES));
+                let end = start + draw.count * INSTANCE_BYTES;
+                pass.set_vertex_buffer(1, instances.slice(start..end));
                 pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+                pass.draw_indexed(0..mesh.index_count, 0, 0..draw.count as u32);
             }
         }
         resources.encode_copies(&mut encoder);
@@ -342,20 +385,20 @@ fn begin_pass<'e>(
     })
 }
 
-/// Resolves an instance's mesh and texture handles against the store.
+/// Resolves a draw's mesh and texture handles against the store; its `count` instance records
+/// start at `record`.
 fn check_draw(
     store: &ResourceStore,
-    instance: &crate::Instance,
+    mesh_handle: crate::MeshHandle,
+    material: &crate::Material,
     record: u64,
+    count: u64,
 ) -> Result<Draw, RenderError> {
-    let mesh = instance.mesh.0 as usize;
+    let mesh = mesh_handle.0 as usize;
     if mesh >= store.meshes.len() {
-        return Err(RenderError::UnknownMesh(
-            instance.mesh.0,
-            store.meshes.len(),
-        ));
+        return Err(RenderError::UnknownMesh(mesh_handle.0, store.meshes.len()));
     }
-    let texture = match instance.material.texture {
+    let texture = match material.texture {
         Some(t) if t.0 as usize >= store.textures.len() => {
             return Err(RenderError::UnknownTexture(t.0, store.textures.len()))
         }
@@ -366,6 +409,7 @@ fn check_draw(
         mesh,
         texture,
         record,
+        count,
     })
 }
 
