@@ -3,9 +3,9 @@
 //! Also pipelined batches (submit the next batch before collecting the previous one), as an
 //! environment does when it steps physics while the previous step's images render.
 //! Then a soft-body scene: the light tabletop plus a clay bed of ~4,000 particles (Excavate-v0's
-//! size), drawn as one particle set (one instanced draw) with 20- and 80-triangle spheres, versus
-//! one instance (one draw) per particle; per frame the particle positions are re-set, as an env
-//! does after each step.
+//! size), drawn as one particle set (one instanced draw of exact spheres, two triangles each)
+//! versus one icosphere instance (one draw) per particle; per frame the particle set's positions
+//! are re-set, as an env does after each step.
 //!
 //! `cargo bench -p ms2-render` (prints a table; set `MS2_RENDER_BACKEND=gl` for the GL backend,
 //! `MS2_RENDER_BENCH_SECONDS` to change the time per measurement, default 3).
@@ -189,7 +189,8 @@ fn clay_bed() -> Vec<[f32; 3]> {
     out
 }
 
-/// The particle rows: the light tabletop plus [`clay_bed`], drawn three ways.
+/// The particle rows: the light tabletop plus [`clay_bed`], drawn as a particle set (exact
+/// spheres, two triangles per particle) and as one icosphere instance per particle.
 fn particle_rows(renderer: &Renderer, rounds: usize, budget: Duration, cams: &[Camera]) {
     let bed = clay_bed();
     let ids = SegmentationIds {
@@ -198,31 +199,29 @@ fn particle_rows(renderer: &Renderer, rounds: usize, budget: Duration, cams: &[C
     };
     let clay = Material::color(0.55, 0.35, 0.2);
     let radius = 0.00375;
-    let mut scenes = Vec::new();
+    let mut set_scene = tabletop(renderer, 8, 16);
+    let set = set_scene.add_particle_set(ParticleSet::new(clay, radius, ids));
+    set_scene
+        .set_particle_positions(set, bed.iter().copied())
+        .unwrap();
+    let mut scenes = vec![(
+        "particle set (2 tri/particle)".to_owned(),
+        set_scene,
+        Some(set),
+    )];
     for subdivisions in [0, 1] {
         let mesh = renderer
             .add_mesh(&MeshData::icosphere(1.0, subdivisions))
             .unwrap();
         let mut scene = tabletop(renderer, 8, 16);
-        let set = scene.add_particle_set(ParticleSet::new(mesh, clay, radius, ids));
-        scene
-            .set_particle_positions(set, bed.iter().copied())
-            .unwrap();
-        scenes.push((
-            format!("particle set, {} tri/particle", 20 << (2 * subdivisions)),
-            scene,
-            Some(set),
-        ));
-        if subdivisions == 1 {
-            let mut scene = tabletop(renderer, 8, 16);
-            for p in &bed {
-                scene.add_instance(
-                    Instance::new(mesh, clay, Isometry3::translation(p[0], p[1], p[2]), ids)
-                        .with_scale(Vector3::repeat(radius)),
-                );
-            }
-            scenes.push(("one instance per particle, 80 tri".to_owned(), scene, None));
+        for p in &bed {
+            scene.add_instance(
+                Instance::new(mesh, clay, Isometry3::translation(p[0], p[1], p[2]), ids)
+                    .with_scale(Vector3::repeat(radius)),
+            );
         }
+        let label = format!("instance per particle ({} tri)", 20 << (2 * subdivisions));
+        scenes.push((label, scene, None));
     }
     let triangles: Vec<usize> = scenes
         .iter()

@@ -48,6 +48,7 @@ mod error;
 mod frame;
 pub mod mesh;
 mod output;
+mod particle_gpu;
 pub mod particles;
 mod renderer;
 pub mod scene;

@@ -242,7 +242,7 @@ impl Scene {
     }
 
     /// Total number of triangles drawn per camera, given the renderer's meshes (particle sets
-    /// count their mesh once per particle).
+    /// count two per particle).
     pub fn triangle_count(&self, renderer: &crate::Renderer) -> usize {
         let instances: usize = self
             .instances
@@ -254,7 +254,7 @@ impl Scene {
             .particle_sets
             .iter()
             .filter(|p| p.visible)
-            .map(|p| renderer.mesh_triangle_count(p.mesh).unwrap_or(0) * p.positions_world.len())
+            .map(|p| 2 * p.positions_world.len())
             .sum();
         instances + particles
     }
