@@ -30,6 +30,7 @@ use super::excavate::{
     MAX_EPISODE_STEPS,
 };
 use crate::adapters::mpm_rigid::pose_to_glam;
+use crate::adapters::ParticleVisual;
 use crate::env::Env;
 use crate::error::EnvError;
 use crate::geometry::vectorize_pose;
@@ -201,6 +202,16 @@ impl Task for Excavate {
 
     fn particles_obs(&self) -> Option<ObsValue> {
         self.arm.particles_obs()
+    }
+
+    fn particle_visuals(&self) -> Vec<ParticleVisual> {
+        vec![BucketArm::clay_visual(
+            excavate_soft_config(GRID_ORIGIN).particle_spacing,
+        )]
+    }
+
+    fn particle_positions(&self, _set: usize) -> &[Vec3] {
+        self.arm.particle_positions()
     }
 
     fn as_any(&self) -> &dyn Any {
