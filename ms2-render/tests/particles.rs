@@ -159,7 +159,10 @@ fn particle_set_draws_like_one_sphere_mesh_per_particle() {
     for (x, y) in a.iter().zip(&b) {
         let (clay_x, clay_y) = (clay_pixels(x), clay_pixels(y));
         assert!(clay_x > 50, "{clay_x} clay pixels");
-        assert!(clay_x.abs_diff(clay_y) * 50 <= clay_x, "{clay_x} vs {clay_y} clay pixels");
+        assert!(
+            clay_x.abs_diff(clay_y) * 50 <= clay_x,
+            "{clay_x} vs {clay_y} clay pixels"
+        );
         let n = x.depth_m.len();
         let differ = (0..n)
             .filter(|&i| x.segmentation_link[i] != y.segmentation_link[i])
