@@ -3,8 +3,9 @@
 //! other bodies.
 //!
 //! [`BucketArm`] holds what `Excavate-v0` and `Fill-v0` share: the coupled [`SoftWorld`],
-//! the bucket's pose, the soft substeps after each physics step, the `particles` observation
-//! and the particle part of the task state. A task is then its episode data plus hooks.
+//! the bucket's pose, the soft substeps after each physics step, the `particles` observation,
+//! the clay as the cameras draw it ([`BucketArm::clay_visual`]) and the particle part of the
+//! task state. A task is then its episode data plus hooks.
 
 use glam::{Mat3, Vec2, Vec3};
 use ms2_mpm::{MpmSolver, MpmState};
@@ -14,6 +15,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use super::excavate::BucketPose;
 use super::{SoftConfig, SoftSceneError, SoftWorld};
 use crate::adapters::mpm_rigid::pose_to_glam;
+use crate::adapters::ParticleVisual;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
 use crate::geometry::Pose3;
@@ -26,6 +28,17 @@ pub const DEFAULT_MPM_FREQ_HZ: f64 = 1000.0;
 
 /// Floats of task state per particle: position 3, velocity 3, F 9, C 9 (column-major).
 pub const FLOATS_PER_PARTICLE: usize = 24;
+
+/// Radius of a clay particle's drawn sphere, in particle spacings: above 1/√2 ≈ 0.71, so the
+/// spheres of a lattice overlap and the clay looks solid from any side (no background seen
+/// through it), jittered by up to 0.1 spacing as the beds are.
+pub const CLAY_RENDER_RADIUS_PER_SPACING: f32 = 0.8;
+
+/// Linear RGB colour of the drawn clay (terracotta).
+pub const CLAY_COLOR: [f32; 3] = [0.45, 0.2, 0.08];
+
+/// Name of the clay's segmentation object (channel-1 id) in visual observations.
+pub const CLAY_SEGMENTATION_NAME: &str = "clay";
 
 /// A soft-scene error as an env error.
 pub fn soft_err(e: SoftSceneError) -> EnvError {
@@ -173,6 +186,21 @@ impl BucketArm {
             }),
         );
         Some(particles.build())
+    }
+
+    /// The clay as the cameras draw it: spheres of [`CLAY_RENDER_RADIUS_PER_SPACING`] ×
+    /// `particle_spacing_m` in [`CLAY_COLOR`], segmented as [`CLAY_SEGMENTATION_NAME`].
+    pub fn clay_visual(particle_spacing_m: f32) -> ParticleVisual {
+        ParticleVisual {
+            name: CLAY_SEGMENTATION_NAME.to_owned(),
+            radius_m: CLAY_RENDER_RADIUS_PER_SPACING * particle_spacing_m,
+            rgb: CLAY_COLOR,
+        }
+    }
+
+    /// Particle positions (m, world); empty before the first episode.
+    pub fn particle_positions(&self) -> &[Vec3] {
+        self.soft.as_ref().map_or(&[], |s| s.solver().positions())
     }
 
     /// Number of particles (0 before the first episode).

@@ -30,6 +30,7 @@ use super::excavate::{
     MAX_EPISODE_STEPS,
 };
 use crate::adapters::mpm_rigid::pose_to_glam;
+use crate::adapters::ParticleVisual;
 use crate::config::EnvConfig;
 use crate::env::Env;
 use crate::error::EnvError;
@@ -217,6 +218,16 @@ impl Task for Excavate {
 
     fn mpm_freq(&self) -> Option<f64> {
         Some(self.arm.mpm_freq())
+    }
+
+    fn particle_visuals(&self) -> Vec<ParticleVisual> {
+        vec![BucketArm::clay_visual(
+            excavate_soft_config(GRID_ORIGIN).particle_spacing,
+        )]
+    }
+
+    fn particle_positions(&self, _set: usize) -> &[Vec3] {
+        self.arm.particle_positions()
     }
 
     fn as_any(&self) -> &dyn Any {
