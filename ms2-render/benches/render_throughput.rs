@@ -2,6 +2,10 @@
 //! batched in one submission, for a light (~2 k triangles) and a heavy (~70 k triangles) scene.
 //! Also pipelined batches (submit the next batch before collecting the previous one), as an
 //! environment does when it steps physics while the previous step's images render.
+//! Then a soft-body scene: the light tabletop plus a clay bed of ~4,000 particles (Excavate-v0's
+//! size), drawn as one particle set (one instanced draw of exact spheres, two triangles each)
+//! versus one icosphere instance (one draw) per particle; per frame the particle set's positions
+//! are re-set, as an env does after each step.
 //!
 //! `cargo bench -p ms2-render` (prints a table; set `MS2_RENDER_BACKEND=gl` for the GL backend,
 //! `MS2_RENDER_BENCH_SECONDS` to change the time per measurement, default 3).
@@ -167,5 +171,84 @@ fn main() {
                 rate / rates[0]
             );
         }
+    }
+    particle_rows(&renderer, rounds, budget, &cams);
+}
+
+/// Particle centres of a 12 × 12 × 3.5 cm clay bed at 5 mm spacing (4,225 particles).
+fn clay_bed() -> Vec<[f32; 3]> {
+    let mut out = Vec::new();
+    for k in 0..7 {
+        for j in 0..25 {
+            for i in 0..25 {
+                let p = |n: i32| -0.06 + 0.005 * n as f32;
+                out.push([p(i) - 0.1, p(j), 0.0025 + 0.005 * k as f32]);
+            }
+        }
+    }
+    out
+}
+
+/// The particle rows: the light tabletop plus [`clay_bed`], drawn as a particle set (exact
+/// spheres, two triangles per particle) and as one icosphere instance per particle.
+fn particle_rows(renderer: &Renderer, rounds: usize, budget: Duration, cams: &[Camera]) {
+    let bed = clay_bed();
+    let ids = SegmentationIds {
+        actor: 99,
+        link: 99,
+    };
+    let clay = Material::color(0.55, 0.35, 0.2);
+    let radius = 0.00375;
+    let mut set_scene = tabletop(renderer, 8, 16);
+    let set = set_scene.add_particle_set(ParticleSet::new(clay, radius, ids));
+    set_scene
+        .set_particle_positions(set, bed.iter().copied())
+        .unwrap();
+    let mut scenes = vec![(
+        "particle set (2 tri/particle)".to_owned(),
+        set_scene,
+        Some(set),
+    )];
+    for subdivisions in [0, 1] {
+        let mesh = renderer
+            .add_mesh(&MeshData::icosphere(1.0, subdivisions))
+            .unwrap();
+        let mut scene = tabletop(renderer, 8, 16);
+        for p in &bed {
+            scene.add_instance(
+                Instance::new(mesh, clay, Isometry3::translation(p[0], p[1], p[2]), ids)
+                    .with_scale(Vector3::repeat(radius)),
+            );
+        }
+        let label = format!("instance per particle ({} tri)", 20 << (2 * subdivisions));
+        scenes.push((label, scene, None));
+    }
+    let triangles: Vec<usize> = scenes
+        .iter()
+        .map(|(_, s, _)| s.triangle_count(renderer))
+        .collect();
+    let mut modes: Vec<Mode<'_>> = scenes
+        .iter_mut()
+        .map(|(name, scene, set)| {
+            let label: &'static str = Box::leak(name.clone().into_boxed_str());
+            let bed = &bed;
+            let step = move || {
+                if let Some(set) = *set {
+                    scene
+                        .set_particle_positions(set, bed.iter().copied())
+                        .unwrap();
+                }
+                renderer.render(&[(&*scene, cams)]).unwrap();
+            };
+            (label, cams.len(), Box::new(step) as Box<dyn FnMut() + '_>)
+        })
+        .collect();
+    let rates = measure_side_by_side(rounds, budget, &mut modes);
+    for (((name, _, _), rate), triangles) in modes.iter().zip(&rates).zip(&triangles) {
+        println!(
+            "{:<8} {triangles:>10}  {name:<46} {rate:>9.0} {:>7.2}",
+            "clay",
+            rate / rates[0]
+        );
     }
 }

@@ -7,6 +7,7 @@
 //! has its own small targets and render pass: on lavapipe that beat one shared atlas texture
 //! (llvmpipe bins per-draw state into every tile of a render pass's framebuffer).
 
+use crate::particle_gpu::VERTICES_PER_PARTICLE;
 use crate::renderer::{Renderer, ResourceStore, CAMERA_BLOCK_BYTES, INSTANCE_BYTES};
 use crate::scene::MAX_DIRECTIONAL_LIGHTS;
 use crate::shadow::light_clip_from_world;
@@ -15,11 +16,14 @@ use crate::{Camera, CameraOutput, RenderError, Scene};
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
 
-/// One instance to draw: which mesh, which texture (if any), which instance record.
+/// One draw: which mesh, which texture (if any), which consecutive instance records (one for
+/// an [`crate::Instance`], one per particle for a [`crate::ParticleSet`]).
 struct Draw {
-    mesh: usize,
+    /// `None` for a particle set (drawn with the particle pipeline, no mesh).
+    mesh: Option<usize>,
     texture: Option<usize>,
     record: u64,
+    count: u64,
 }
 
 /// Packs an instance's per-draw data (see `VertexIn` in `shader.wgsl`).
@@ -36,14 +40,44 @@ fn instance_record(instance: &crate::Instance) -> [u32; 32] {
         }
         words[4 * i + 3] = t[i].to_bits();
     }
-    for (k, c) in instance.material.base_color.iter().enumerate() {
+    put_appearance(&mut words, &instance.material, instance.segmentation);
+    words
+}
+
+/// Writes colour, ids and the texture flag into words 24..31 of an instance record.
+fn put_appearance(
+    words: &mut [u32; 32],
+    material: &crate::Material,
+    segmentation: crate::SegmentationIds,
+) {
+    for (k, c) in material.base_color.iter().enumerate() {
         words[24 + k] = c.to_bits();
     }
-    words[28] = instance.segmentation.actor;
-    words[29] = instance.segmentation.link;
+    words[28] = segmentation.actor;
+    words[29] = segmentation.link;
     // Untextured instances skip the texture fetch in the fragment shader.
-    words[30] = u32::from(instance.material.texture.is_some());
-    words
+    words[30] = u32::from(material.texture.is_some());
+}
+
+/// Appends one instance record per particle of `set`: the layout of [`instance_record`] with
+/// the model matrix `radius · I` moved to the particle (the particle shaders read the centre
+/// from the translation and the radius from the first diagonal entry).
+fn particle_records(set: &crate::ParticleSet, records: &mut Vec<[u32; 32]>) {
+    let (r, inv) = (set.radius_m, 1.0 / set.radius_m);
+    let mut template = [0u32; 32];
+    for i in 0..3 {
+        template[4 * i + i] = r.to_bits();
+        template[12 + 4 * i + i] = inv.to_bits();
+    }
+    put_appearance(&mut template, &set.material, set.segmentation);
+    records.reserve(set.positions_world.len());
+    for p in &set.positions_world {
+        let mut words = template;
+        for i in 0..3 {
+            words[4 * i + 3] = p[i].to_bits();
+        }
+        records.push(words);
+    }
 }
 
 /// Words in a uniform block (`CAMERA_BLOCK_BYTES` / 4).
@@ -160,8 +194,18 @@ impl Renderer {
         for (scene, _) in views {
             let mut scene_draws = Vec::new();
             for instance in scene.instances().iter().filter(|i| i.visible) {
-                scene_draws.push(check_draw(&store, instance, records.len() as u64)?);
+                let (mesh, material) = (Some(instance.mesh), &instance.material);
+                scene_draws.push(check_draw(&store, mesh, material, records.len() as u64, 1)?);
                 records.push(instance_record(instance));
+            }
+            for set in scene.particle_sets().iter().filter(|p| p.visible) {
+                let count = set.positions_world.len() as u64;
+                if count == 0 {
+                    continue;
+                }
+                let at = records.len() as u64;
+                scene_draws.push(check_draw(&store, None, &set.material, at, count)?);
+                particle_records(set, &mut records);
             }
             draws.push(scene_draws);
         }
@@ -237,21 +281,13 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&gpu.shadow.pipeline);
             let offset = (block as u64 * gpu.uniform_stride) as u32;
             pass.set_bind_group(0, &resources.camera_bind_group, &[offset]);
-            for draw in &draws[k] {
-                let mesh = &store.meshes[draw.mesh];
-                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                let start = draw.record * INSTANCE_BYTES;
-                pass.set_vertex_buffer(1, instances.slice(start..start + INSTANCE_BYTES));
-                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..mesh.index_count, 0, 0..1);
-            }
+            let pipelines = (&gpu.shadow.pipeline, &gpu.particles.shadow_pipeline);
+            encode_draws(&mut pass, &draws[k], (&store, instances), pipelines, None);
         }
         for (c, targets) in resources.targets.iter().enumerate() {
             let mut pass = begin_pass(&mut encoder, targets);
-            pass.set_pipeline(&gpu.pipeline);
             let offset = (c as u64 * gpu.uniform_stride) as u32;
             pass.set_bind_group(0, &resources.camera_bind_group, &[offset]);
             let shadow_map = match &views[camera_scene[c]].0.lighting.shadow {
@@ -266,18 +302,17 @@ impl Renderer {
                 shadow_map.map_or(&gpu.shadow.disabled, |m| &m.bind_group),
                 &[],
             );
-            for draw in &draws[camera_scene[c]] {
-                let mesh = &store.meshes[draw.mesh];
-                let texture = draw
-                    .texture
-                    .map_or(&gpu.white_texture, |t| &store.textures[t]);
-                pass.set_bind_group(1, texture, &[]);
-                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                let start = draw.record * INSTANCE_BYTES;
-                pass.set_vertex_buffer(1, instances.slice(start..start + INSTANCE_BYTES));
-                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..mesh.index_count, 0, 0..1);
-            }
+            pass.set_bind_group(1, &gpu.white_texture, &[]);
+            let scene_draws = &draws[camera_scene[c]];
+            let pipelines = (&gpu.pipeline, &gpu.particles.pipeline);
+            let white = Some(&gpu.white_texture);
+            encode_draws(
+                &mut pass,
+                scene_draws,
+                (&store, instances),
+                pipelines,
+                white,
+            );
         }
         resources.encode_copies(&mut encoder);
         drop(store);
@@ -303,6 +338,49 @@ impl Renderer {
             cameras,
             backgrounds,
         })
+    }
+}
+
+/// Encodes a scene's draws into `pass` (camera bind groups already set): meshes with
+/// `pipelines.0`, particle sets with `pipelines.1`, switching pipelines only when the kind of
+/// draw changes. With `white_texture` (the camera pass) each mesh draw binds its texture, or
+/// that one, as group 1; the shadow pass has no textures.
+fn encode_draws(
+    pass: &mut wgpu::RenderPass<'_>,
+    draws: &[Draw],
+    (store, instances): (&ResourceStore, &wgpu::Buffer),
+    (mesh_pipeline, particle_pipeline): (&wgpu::RenderPipeline, &wgpu::RenderPipeline),
+    white_texture: Option<&wgpu::BindGroup>,
+) {
+    let mut bound: Option<bool> = None; // Some(true) = particle pipeline bound
+    for draw in draws {
+        let start = draw.record * INSTANCE_BYTES;
+        let records = instances.slice(start..start + draw.count * INSTANCE_BYTES);
+        match draw.mesh {
+            Some(mesh) => {
+                if bound != Some(false) {
+                    pass.set_pipeline(mesh_pipeline);
+                    bound = Some(false);
+                }
+                if let Some(white) = white_texture {
+                    let texture = draw.texture.map_or(white, |t| &store.textures[t]);
+                    pass.set_bind_group(1, texture, &[]);
+                }
+                let mesh = &store.meshes[mesh];
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                pass.set_vertex_buffer(1, records);
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..mesh.index_count, 0, 0..draw.count as u32);
+            }
+            None => {
+                if bound != Some(true) {
+                    pass.set_pipeline(particle_pipeline);
+                    bound = Some(true);
+                }
+                pass.set_vertex_buffer(0, records);
+                pass.draw(0..VERTICES_PER_PARTICLE, 0..draw.count as u32);
+            }
+        }
     }
 }
 
@@ -342,20 +420,22 @@ fn begin_pass<'e>(
     })
 }
 
-/// Resolves an instance's mesh and texture handles against the store.
+/// Resolves a draw's mesh and texture handles against the store; its `count` instance records
+/// start at `record`.
 fn check_draw(
     store: &ResourceStore,
-    instance: &crate::Instance,
+    mesh_handle: Option<crate::MeshHandle>,
+    material: &crate::Material,
     record: u64,
+    count: u64,
 ) -> Result<Draw, RenderError> {
-    let mesh = instance.mesh.0 as usize;
-    if mesh >= store.meshes.len() {
-        return Err(RenderError::UnknownMesh(
-            instance.mesh.0,
-            store.meshes.len(),
-        ));
+    let mesh = mesh_handle.map(|m| m.0 as usize);
+    if let (Some(handle), Some(index)) = (mesh_handle, mesh) {
+        if index >= store.meshes.len() {
+            return Err(RenderError::UnknownMesh(handle.0, store.meshes.len()));
+        }
     }
-    let texture = match instance.material.texture {
+    let texture = match material.texture {
         Some(t) if t.0 as usize >= store.textures.len() => {
             return Err(RenderError::UnknownTexture(t.0, store.textures.len()))
         }
@@ -366,6 +446,7 @@ fn check_draw(
         mesh,
         texture,
         record,
+        count,
     })
 }
 

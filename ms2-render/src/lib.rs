@@ -10,6 +10,8 @@
 //!   environments in one process share one GPU copy. It is `Send + Sync` and cheap to clone.
 //! - A [`Scene`] (owned by the caller, one per environment) places [`Instance`]s of stored
 //!   meshes with poses, [`Material`]s and [`SegmentationIds`]; per frame only poses change.
+//!   [`ParticleSet`]s draw one shared mesh (a small sphere) at many positions in one instanced
+//!   draw: soft bodies' particles, whose positions and count change every frame.
 //! - [`Renderer::render`] draws many [`Camera`]s of many scenes in one submission;
 //!   [`Renderer::submit`] does the same without waiting, so physics can run while the images
 //!   render ([`PendingFrame::wait`] collects them).
@@ -46,6 +48,8 @@ mod error;
 mod frame;
 pub mod mesh;
 mod output;
+mod particle_gpu;
+pub mod particles;
 mod renderer;
 pub mod scene;
 mod shadow;
@@ -56,6 +60,7 @@ pub use error::{RenderError, INSTALL_ADVICE};
 pub use frame::PendingFrame;
 pub use mesh::MeshData;
 pub use output::{CameraOutput, FusedPointCloud};
+pub use particles::{ParticleSet, ParticleSetId};
 pub use renderer::{
     AdapterSummary, BackendChoice, MeshHandle, Renderer, RendererConfig, TextureData,
     TextureHandle, BACKEND_ENV_VAR,

@@ -149,6 +149,77 @@ impl MeshData {
         })
     }
 
+    /// A geodesic sphere of the given radius (metres): an icosahedron (20 triangles, 12
+    /// vertices) whose triangles are split in four `subdivisions` times (at most 5), the new
+    /// vertices pushed onto the sphere; smooth normals, no uvs. The cheapest round shape per
+    /// triangle, for meshes drawn many times such as particles.
+    pub fn icosphere(radius: f32, subdivisions: u32) -> MeshData {
+        let t = (1.0 + 5f32.sqrt()) / 2.0;
+        let mut dirs: Vec<[f32; 3]> = [
+            [-1.0, t, 0.0],
+            [1.0, t, 0.0],
+            [-1.0, -t, 0.0],
+            [1.0, -t, 0.0],
+            [0.0, -1.0, t],
+            [0.0, 1.0, t],
+            [0.0, -1.0, -t],
+            [0.0, 1.0, -t],
+            [t, 0.0, -1.0],
+            [t, 0.0, 1.0],
+            [-t, 0.0, -1.0],
+            [-t, 0.0, 1.0],
+        ]
+        .into_iter()
+        .map(normalized)
+        .collect();
+        let mut faces: Vec<[u32; 3]> = vec![
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        for _ in 0..subdivisions.min(5) {
+            let mut midpoints = std::collections::HashMap::new();
+            let mut midpoint = |a: u32, b: u32, dirs: &mut Vec<[f32; 3]>| -> u32 {
+                *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    let (p, q) = (dirs[a as usize], dirs[b as usize]);
+                    dirs.push(normalized([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
+                    dirs.len() as u32 - 1
+                })
+            };
+            let mut split = Vec::with_capacity(faces.len() * 4);
+            for [a, b, c] in faces {
+                let ab = midpoint(a, b, &mut dirs);
+                let bc = midpoint(b, c, &mut dirs);
+                let ca = midpoint(c, a, &mut dirs);
+                split.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+            }
+            faces = split;
+        }
+        MeshData {
+            positions: dirs.iter().map(|d| d.map(|v| v * radius)).collect(),
+            normals: dirs,
+            uvs: None,
+            indices: faces.into_iter().flatten().collect(),
+        }
+    }
+
     /// A closed cylinder along the local z axis, radius and half length in metres, with
     /// `segments` (≥ 3) around the axis.
     pub fn cylinder(radius: f32, half_length: f32, segments: u32) -> MeshData {
@@ -249,6 +320,12 @@ impl MeshData {
     }
 }
 
+/// `v` scaled to unit length.
+fn normalized(v: [f32; 3]) -> [f32; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    v.map(|x| x / n)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -291,6 +368,20 @@ mod tests {
         assert_outward(&MeshData::sphere(0.5, 16, 8));
         assert_outward(&MeshData::cylinder(0.2, 0.4, 12));
         assert_outward(&MeshData::capsule(0.1, 0.3, 12, 4));
+        for (subdivisions, triangles, vertices) in [(0, 20, 12), (1, 80, 42), (2, 320, 162)] {
+            let ico = MeshData::icosphere(0.5, subdivisions);
+            assert_eq!(ico.triangle_count(), triangles);
+            assert_eq!(
+                ico.positions.len(),
+                vertices,
+                "vertices shared between faces"
+            );
+            assert_outward(&ico);
+            for p in &ico.positions {
+                let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                assert!((r - 0.5).abs() < 1e-5);
+            }
+        }
         let sphere = MeshData::sphere(0.5, 16, 8);
         for p in &sphere.positions {
             let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();

@@ -1,6 +1,7 @@
 //! The renderer: adapter selection, the shared mesh/texture store and the render pipeline.
 
 use crate::error::INSTALL_ADVICE;
+use crate::particle_gpu::ParticleGpu;
 use crate::shadow::{shadow_bind_group_layout, ShadowGpu};
 use crate::targets::FramePool;
 use crate::{MeshData, RenderError};
@@ -106,6 +107,7 @@ pub(crate) struct Gpu {
     pub(crate) sampler: wgpu::Sampler,
     pub(crate) white_texture: wgpu::BindGroup,
     pub(crate) shadow: ShadowGpu,
+    pub(crate) particles: ParticleGpu,
     /// Stride between per-camera uniform blocks, bytes.
     pub(crate) uniform_stride: u64,
 }
@@ -142,6 +144,15 @@ const INSTANCE_ATTRIBUTES: [wgpu::VertexAttribute; 8] = wgpu::vertex_attr_array!
     6 => Float32x4, 7 => Float32x4, 8 => Float32x4,
     9 => Float32x4, 10 => Uint32x4
 ];
+
+/// The instance records alone (buffer 0), for the particle pipelines (`particle_gpu.rs`).
+pub(crate) fn instance_only_buffer_layout() -> [Option<wgpu::VertexBufferLayout<'static>>; 1] {
+    [Some(wgpu::VertexBufferLayout {
+        array_stride: INSTANCE_BYTES,
+        step_mode: wgpu::VertexStepMode::Instance,
+        attributes: &INSTANCE_ATTRIBUTES,
+    })]
+}
 
 /// Vertex buffer 0: mesh vertices; buffer 1: one instance record.
 pub(crate) fn vertex_buffer_layouts() -> [Option<wgpu::VertexBufferLayout<'static>>; 2] {
@@ -436,9 +447,17 @@ impl Gpu {
             (1, 1),
             &[255, 255, 255, 255],
         );
+        let particles = ParticleGpu::new(
+            &device,
+            &shader,
+            &layout,
+            &camera_layout,
+            (COLOR_FORMAT, GBUFFER_FORMAT),
+        );
         let shadow = ShadowGpu::new(&device, shadow_layout, &camera_layout, &shader);
         Gpu {
             shadow,
+            particles,
             device,
             queue,
             pipeline,

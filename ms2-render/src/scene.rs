@@ -4,6 +4,7 @@
 //! meshes and textures stored once in the [`crate::Renderer`], so many scenes share one GPU copy
 //! of each asset. Per frame, callers update poses only ([`Scene::set_pose`]).
 
+use crate::particles::{ParticleSet, ParticleSetId};
 use crate::{MeshHandle, RenderError, TextureHandle};
 use nalgebra::{Isometry3, Vector3};
 
@@ -154,10 +155,11 @@ impl Default for Lighting {
     }
 }
 
-/// Everything that is drawn for one environment: instances and lighting.
+/// Everything that is drawn for one environment: instances, particle sets and lighting.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Scene {
     instances: Vec<Instance>,
+    particle_sets: Vec<ParticleSet>,
     /// Lights and background colour.
     pub lighting: Lighting,
 }
@@ -203,13 +205,58 @@ impl Scene {
         Ok(())
     }
 
-    /// Total number of triangles drawn per camera, given the renderer's meshes.
+    /// Adds a particle set (drawn after the instances, in one instanced draw) and returns its
+    /// id.
+    pub fn add_particle_set(&mut self, set: ParticleSet) -> ParticleSetId {
+        self.particle_sets.push(set);
+        ParticleSetId(self.particle_sets.len() as u32 - 1)
+    }
+
+    /// All particle sets, indexed by [`ParticleSetId`].
+    pub fn particle_sets(&self) -> &[ParticleSet] {
+        &self.particle_sets
+    }
+
+    /// Mutable access to one particle set.
+    pub fn particle_set_mut(&mut self, id: ParticleSetId) -> Result<&mut ParticleSet, RenderError> {
+        let n = self.particle_sets.len();
+        self.particle_sets.get_mut(id.0 as usize).ok_or_else(|| {
+            RenderError::InvalidScene(format!(
+                "particle set id {} out of range (scene has {n})",
+                id.0
+            ))
+        })
+    }
+
+    /// Replaces a particle set's positions (world frame, metres): the per-frame update. The
+    /// count may differ from the previous frame's.
+    pub fn set_particle_positions(
+        &mut self,
+        id: ParticleSetId,
+        positions_world: impl IntoIterator<Item = [f32; 3]>,
+    ) -> Result<(), RenderError> {
+        let set = self.particle_set_mut(id)?;
+        set.positions_world.clear();
+        set.positions_world.extend(positions_world);
+        Ok(())
+    }
+
+    /// Total number of triangles drawn per camera, given the renderer's meshes (particle sets
+    /// count two per particle).
     pub fn triangle_count(&self, renderer: &crate::Renderer) -> usize {
-        self.instances
+        let instances: usize = self
+            .instances
             .iter()
             .filter(|i| i.visible)
             .map(|i| renderer.mesh_triangle_count(i.mesh).unwrap_or(0))
-            .sum()
+            .sum();
+        let particles: usize = self
+            .particle_sets
+            .iter()
+            .filter(|p| p.visible)
+            .map(|p| 2 * p.positions_world.len())
+            .sum();
+        instances + particles
     }
 
     /// Checks lights and instance values for finiteness and range.
@@ -255,6 +302,9 @@ impl Scene {
                     inst.scale
                 )));
             }
+        }
+        for (k, set) in self.particle_sets.iter().enumerate() {
+            set.validate(k)?;
         }
         Ok(())
     }

@@ -9,6 +9,8 @@
 //! | every reset, in this order | [`Task::initialize_actors`], robot reset (rest qpos + noise), [`Task::initialize_task`] |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | after every physics step | [`Task::after_physics_step`] (e.g. soft-body substeps) |
+//! | render scene built (first render after make / reconfigure) | [`Task::particle_visuals`] |
+//! | before every render | [`Task::particle_positions`] of each particle set |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
 
@@ -16,6 +18,7 @@ use std::any::Any;
 
 use ms2_physics::World;
 
+use crate::adapters::ParticleVisual;
 use crate::agent::PandaAgent;
 use crate::error::EnvError;
 use crate::info::Evaluation;
@@ -100,6 +103,25 @@ pub trait Task: Send + 'static {
     /// `{"x": [N, 3] positions (m, world)}`); `None` for tasks without particles.
     fn particles_obs(&self) -> Option<ObsValue> {
         None
+    }
+
+    /// MPM substep frequency (Hz) of a soft-body task; `None` for tasks without soft bodies
+    /// (the runtime then refuses an `mpm_freq` in the config).
+    fn mpm_freq(&self) -> Option<f64> {
+        None
+    }
+
+    /// Particle sets the cameras draw (soft-body tasks: the clay), each with its own
+    /// segmentation object; read when the render scene is built. Their positions come from
+    /// [`Task::particle_positions`] before every render.
+    fn particle_visuals(&self) -> Vec<ParticleVisual> {
+        Vec::new()
+    }
+
+    /// Current positions (m, world) of particle set `set` (an index into
+    /// [`Task::particle_visuals`]); empty when there are none (e.g. before the first episode).
+    fn particle_positions(&self, _set: usize) -> &[glam::Vec3] {
+        &[]
     }
 
     /// The task as `Any`, for scripted policies that read task data.

@@ -110,18 +110,24 @@ impl<T: Task> TaskEnv<T> {
             Some(sensors) => sensors,
             slot @ None => slot.insert(self.new_sensors()?),
         };
+        sync_particles(&self.task, sensors)?;
         f(sensors, &self.scene.world)
     }
 
-    /// The env's cameras and render scene, drawing through the process-wide render context.
+    /// The env's cameras and render scene (with the task's particle sets), drawing through the
+    /// process-wide render context.
     fn new_sensors(&self) -> Result<Sensors, EnvError> {
-        Sensors::new(
+        let mut sensors = Sensors::new(
             RenderContext::shared()?,
             &self.scene.world,
             Some(self.scene.agent.articulation),
             self.camera_cfgs.clone(),
             CameraConfig::render_camera(),
-        )
+        )?;
+        for visual in self.task.particle_visuals() {
+            sensors.add_particle_set(&visual)?;
+        }
+        Ok(sensors)
     }
 
     fn controller_state(&self) -> Vec<f32> {
@@ -133,6 +139,14 @@ impl<T: Task> TaskEnv<T> {
             .flat_map(|(_, v)| v.iter().map(|&x| x as f32))
             .collect()
     }
+}
+
+/// Copies the task's current particle positions into the sensors' particle sets.
+fn sync_particles<T: Task>(task: &T, sensors: &mut Sensors) -> Result<(), EnvError> {
+    for set in 0..sensors.particle_set_count() {
+        sensors.set_particle_positions(set, task.particle_positions(set))?;
+    }
+    Ok(())
 }
 
 /// The error of a sensor lock poisoned by a panic during an earlier render.
@@ -253,6 +267,10 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
         self.task.particles_obs()
     }
 
+    fn mpm_freq(&self) -> Option<f64> {
+        self.task.mpm_freq()
+    }
+
     fn dense_reward(&self, eval: &Evaluation, _action: &[f32]) -> f64 {
         self.task.dense_reward(&self.scene, eval)
     }
@@ -314,6 +332,7 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
             .map_err(poisoned)?
             .as_mut()
             .ok_or_else(|| EnvError::Render("sensors missing after being built".to_owned()))?;
+        sync_particles(&self.task, sensors)?;
         Ok((sensors, &self.scene.world))
     }
 

@@ -11,4 +11,4 @@ pub mod physics_articulation;
 pub mod render_scene;
 
 pub use physics_articulation::{snapshot_articulation, PhysicsArticulation};
-pub use render_scene::{RenderContext, SegmentedObject, WorldRenderScene};
+pub use render_scene::{ParticleVisual, RenderContext, SegmentedObject, WorldRenderScene};

@@ -1,7 +1,9 @@
 //! [`WorldRenderScene`]: an ms2-physics [`World`] seen as an [`ms2_render::Scene`].
 //!
 //! Every visual shape of every actor and articulation link becomes one render instance; per
-//! frame only poses are copied ([`WorldRenderScene::sync_poses`]). Meshes live once per process
+//! frame only poses are copied ([`WorldRenderScene::sync_poses`]). Particle sets (a soft body's
+//! clay, [`ParticleVisual`]) are added with [`WorldRenderScene::add_particle_set`] and get their
+//! positions per frame ([`WorldRenderScene::set_particle_positions`]). Meshes live once per process
 //! in a [`RenderContext`] (one [`Renderer`] plus a cache of primitive meshes): boxes, spheres and
 //! cylinders are unit meshes scaled per instance, so every environment shares them.
 //!
@@ -11,15 +13,16 @@
 //! - channel 1 (`SegmentationIds::link`, ManiSkill2's actor/link id): one id per actor and per
 //!   articulation link, 1, 2, … in build order (the ground included).
 //!
-//! 0 is background in both. [`WorldRenderScene::objects`] names every channel-1 id.
+//! 0 is background in both. [`WorldRenderScene::objects`] names every channel-1 id. A particle
+//! set is one object (and one visual) after the world's actors and links.
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use ms2_physics::{ArticulationId, BodyId, BodyKind, Pose3, ShapeDesc, World};
 use ms2_render::{
-    Instance, InstanceId, Material, MeshData, MeshHandle, Renderer, RendererConfig, Scene,
-    SegmentationIds,
+    Instance, InstanceId, Material, MeshData, MeshHandle, ParticleSet, ParticleSetId, Renderer,
+    RendererConfig, Scene, SegmentationIds,
 };
 use nalgebra::Vector3;
 
@@ -231,6 +234,18 @@ pub struct SegmentedObject {
     pub articulation: Option<ArticulationId>,
 }
 
+/// A set of particles the cameras draw (e.g. a soft body's clay): one sphere per particle, all
+/// of one radius and colour, segmented as one object named `name`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParticleVisual {
+    /// Name of the set's segmentation object (e.g. `"clay"`).
+    pub name: String,
+    /// Radius of each particle's sphere, metres (> 0).
+    pub radius_m: f32,
+    /// Linear RGB colour, each channel in `[0, 1]`.
+    pub rgb: [f32; 3],
+}
+
 /// A render [`Scene`] mirroring a physics [`World`]'s visual shapes.
 #[derive(Debug)]
 pub struct WorldRenderScene {
@@ -350,6 +365,33 @@ impl WorldRenderScene {
             });
         }
         Ok(())
+    }
+
+    /// Adds a particle set drawn as `visual` (initially empty) with its own segmentation
+    /// object and visual id; returns its id for [`WorldRenderScene::set_particle_positions`].
+    pub fn add_particle_set(&mut self, visual: &ParticleVisual) -> ParticleSetId {
+        let object = self.add_object(&visual.name, None);
+        self.visual_count += 1;
+        let [r, g, b] = visual.rgb;
+        self.scene.add_particle_set(ParticleSet::new(
+            Material::color(r, g, b),
+            visual.radius_m,
+            SegmentationIds {
+                actor: self.visual_count,
+                link: object,
+            },
+        ))
+    }
+
+    /// Replaces the positions (m, world) of particle set `set`; the count may change.
+    pub fn set_particle_positions(
+        &mut self,
+        set: ParticleSetId,
+        positions_world: &[glam::Vec3],
+    ) -> Result<(), EnvError> {
+        self.scene
+            .set_particle_positions(set, positions_world.iter().map(|p| p.to_array()))
+            .map_err(render_err)
     }
 
     /// Copies the current body and link poses of `world` into the scene.

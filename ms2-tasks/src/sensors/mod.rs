@@ -2,9 +2,9 @@
 //!
 //! - [`camera`]: [`CameraConfig`] (ManiSkill2's `base_camera`, `hand_camera`, render camera).
 //! - [`visual_obs`]: the `rgbd` / `pointcloud` (+ `robot_seg`) observation layouts.
-//! - [`Sensors`]: one env's render scene (an [`WorldRenderScene`] of its world), its cameras
-//!   and the goal marker drawn only in human renders; it renders through the process-wide
-//!   [`RenderContext`].
+//! - [`Sensors`]: one env's render scene (an [`WorldRenderScene`] of its world, plus the task's
+//!   particle sets, e.g. a soft body's clay), its cameras and the goal marker drawn only in
+//!   human renders; it renders through the process-wide [`RenderContext`].
 //! - [`camera_update`]: [`CameraCfgUpdates`], ManiSkill2's `camera_cfgs` keyword.
 //! - [`batch`]: [`capture_batch`], the cameras of many envs in one GPU submission.
 
@@ -16,7 +16,9 @@ pub mod visual_obs;
 use std::sync::Arc;
 
 use ms2_physics::{ArticulationId, World};
-use ms2_render::{Camera, CameraOutput, Instance, InstanceId, Material, Scene, SegmentationIds};
+use ms2_render::{
+    Camera, CameraOutput, Instance, InstanceId, Material, ParticleSetId, Scene, SegmentationIds,
+};
 use nalgebra::{Isometry3, Vector3};
 
 pub use batch::capture_batch;
@@ -25,6 +27,7 @@ pub use camera_update::{CameraCfgUpdates, CameraUpdate, CAMERA_UPDATE_KEYS};
 pub use visual_obs::{CameraFrame, VisualLayout, NON_PRIVILEGED_EXTRA_KEYS};
 
 use crate::adapters::render_scene::render_err;
+pub use crate::adapters::ParticleVisual;
 use crate::adapters::{RenderContext, WorldRenderScene};
 use crate::error::EnvError;
 
@@ -41,6 +44,7 @@ pub struct Sensors {
     robot: Option<ArticulationId>,
     robot_ids: Vec<u32>,
     goal_marker: InstanceId,
+    particle_sets: Vec<ParticleSetId>,
 }
 
 impl Sensors {
@@ -86,7 +90,43 @@ impl Sensors {
             robot,
             robot_ids,
             goal_marker,
+            particle_sets: Vec::new(),
         })
+    }
+
+    /// Adds a particle set drawn as `visual` (segmentation object `visual.name`, after the
+    /// world's); its index, counted from 0, is the `set` of
+    /// [`Sensors::set_particle_positions`].
+    pub fn add_particle_set(&mut self, visual: &ParticleVisual) -> Result<usize, EnvError> {
+        if !(visual.radius_m.is_finite() && visual.radius_m > 0.0) {
+            return Err(EnvError::InvalidConfig(format!(
+                "particle set {:?}: radius {} m must be finite and > 0",
+                visual.name, visual.radius_m
+            )));
+        }
+        self.particle_sets.push(self.scene.add_particle_set(visual));
+        Ok(self.particle_sets.len() - 1)
+    }
+
+    /// Number of particle sets.
+    pub fn particle_set_count(&self) -> usize {
+        self.particle_sets.len()
+    }
+
+    /// Replaces the positions (m, world) of particle set `set` (they are drawn from the next
+    /// render on; the count may change).
+    pub fn set_particle_positions(
+        &mut self,
+        set: usize,
+        positions_world: &[glam::Vec3],
+    ) -> Result<(), EnvError> {
+        let id = *self.particle_sets.get(set).ok_or_else(|| {
+            EnvError::Render(format!(
+                "particle set {set} does not exist ({} sets)",
+                self.particle_sets.len()
+            ))
+        })?;
+        self.scene.set_particle_positions(id, positions_world)
     }
 
     /// The observation cameras.

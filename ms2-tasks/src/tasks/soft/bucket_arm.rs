@@ -3,8 +3,9 @@
 //! other bodies.
 //!
 //! [`BucketArm`] holds what `Excavate-v0` and `Fill-v0` share: the coupled [`SoftWorld`],
-//! the bucket's pose, the soft substeps after each physics step, the `particles` observation
-//! and the particle part of the task state. A task is then its episode data plus hooks.
+//! the bucket's pose, the soft substeps after each physics step, the `particles` observation,
+//! the clay as the cameras draw it ([`BucketArm::clay_visual`]) and the particle part of the
+//! task state. A task is then its episode data plus hooks.
 
 use glam::{Mat3, Vec2, Vec3};
 use ms2_mpm::{MpmSolver, MpmState};
@@ -12,15 +13,32 @@ use ms2_physics::{ArticulationId, BodyId, World};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
 use super::excavate::BucketPose;
-use super::{SoftSceneError, SoftWorld};
+use super::{SoftConfig, SoftSceneError, SoftWorld};
 use crate::adapters::mpm_rigid::pose_to_glam;
+use crate::adapters::ParticleVisual;
+use crate::config::EnvConfig;
 use crate::error::EnvError;
 use crate::geometry::Pose3;
 use crate::obs::{Array, ArrayData, DictBuilder, ObsValue};
 use crate::task::TaskScene;
 
+/// MPM substep frequency (Hz) of the soft-body tasks unless `EnvConfig::mpm_freq` says
+/// otherwise: 1 kHz, two substeps per 500 Hz physics step (ManiSkill2 uses 2 kHz).
+pub const DEFAULT_MPM_FREQ_HZ: f64 = 1000.0;
+
 /// Floats of task state per particle: position 3, velocity 3, F 9, C 9 (column-major).
 pub const FLOATS_PER_PARTICLE: usize = 24;
+
+/// Radius of a clay particle's drawn sphere, in particle spacings: above 1/√2 ≈ 0.71, so the
+/// spheres of a lattice overlap and the clay looks solid from any side (no background seen
+/// through it), jittered by up to 0.1 spacing as the beds are.
+pub const CLAY_RENDER_RADIUS_PER_SPACING: f32 = 0.8;
+
+/// Linear RGB colour of the drawn clay (terracotta).
+pub const CLAY_COLOR: [f32; 3] = [0.45, 0.2, 0.08];
+
+/// Name of the clay's segmentation object (channel-1 id) in visual observations.
+pub const CLAY_SEGMENTATION_NAME: &str = "clay";
 
 /// A soft-scene error as an env error.
 pub fn soft_err(e: SoftSceneError) -> EnvError {
@@ -43,13 +61,48 @@ pub fn tcp_for_bucket(bucket: &BucketPose) -> Pose3 {
 }
 
 /// The bucket-carrying Panda and its coupled clay (see the [module docs](self)).
-#[derive(Default)]
 pub struct BucketArm {
     soft: Option<SoftWorld>,
     hand: Option<(ArticulationId, usize, BodyId)>,
+    mpm_freq_hz: f64,
+}
+
+impl Default for BucketArm {
+    /// An arm whose clay takes [`DEFAULT_MPM_FREQ_HZ`] substeps.
+    fn default() -> Self {
+        Self {
+            soft: None,
+            hand: None,
+            mpm_freq_hz: DEFAULT_MPM_FREQ_HZ,
+        }
+    }
 }
 
 impl BucketArm {
+    /// An arm whose clay takes `cfg.mpm_freq` substeps per second (default
+    /// [`DEFAULT_MPM_FREQ_HZ`]); an error names a frequency that is not a whole multiple of
+    /// `cfg.sim_freq`.
+    pub fn from_config(cfg: &EnvConfig) -> Result<Self, EnvError> {
+        cfg.mpm_substep_dt(DEFAULT_MPM_FREQ_HZ)?;
+        Ok(Self {
+            mpm_freq_hz: cfg.mpm_freq.unwrap_or(DEFAULT_MPM_FREQ_HZ),
+            ..Self::default()
+        })
+    }
+
+    /// MPM substep frequency of the clay (Hz).
+    pub fn mpm_freq(&self) -> f64 {
+        self.mpm_freq_hz
+    }
+
+    /// `base` with this arm's MPM substep length.
+    pub fn soft_config(&self, base: SoftConfig) -> SoftConfig {
+        SoftConfig {
+            substep_dt: (1.0 / self.mpm_freq_hz) as f32,
+            ..base
+        }
+    }
+
     /// Forgets the previous scene's hand and clay (at scene build).
     pub fn clear(&mut self) {
         self.soft = None;
@@ -133,6 +186,21 @@ impl BucketArm {
             }),
         );
         Some(particles.build())
+    }
+
+    /// The clay as the cameras draw it: spheres of [`CLAY_RENDER_RADIUS_PER_SPACING`] ×
+    /// `particle_spacing_m` in [`CLAY_COLOR`], segmented as [`CLAY_SEGMENTATION_NAME`].
+    pub fn clay_visual(particle_spacing_m: f32) -> ParticleVisual {
+        ParticleVisual {
+            name: CLAY_SEGMENTATION_NAME.to_owned(),
+            radius_m: CLAY_RENDER_RADIUS_PER_SPACING * particle_spacing_m,
+            rgb: CLAY_COLOR,
+        }
+    }
+
+    /// Particle positions (m, world); empty before the first episode.
+    pub fn particle_positions(&self) -> &[Vec3] {
+        self.soft.as_ref().map_or(&[], |s| s.solver().positions())
     }
 
     /// Number of particles (0 before the first episode).

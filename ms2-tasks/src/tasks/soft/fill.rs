@@ -18,7 +18,7 @@ use std::any::Any;
 
 use glam::{Vec2, Vec3};
 use ms2_mpm::sampling;
-use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, World};
+use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, VisualShape, World};
 use nalgebra::Vector3;
 use rand::Rng;
 
@@ -26,6 +26,8 @@ use super::bucket_arm::{soft_err, tcp_for_bucket, BucketArm, FLOATS_PER_PARTICLE
 use super::excavate::{BucketPose, BUCKET_INNER_HALF, BUCKET_WALL_HALF, MAX_SOFT_SPEED};
 use super::{SoftConfig, SoftWorld};
 use crate::adapters::mpm_rigid::pose_to_glam;
+use crate::adapters::ParticleVisual;
+use crate::config::EnvConfig;
 use crate::env::Env;
 use crate::error::EnvError;
 use crate::geometry::vectorize_pose;
@@ -44,6 +46,8 @@ pub const MIN_FRACTION_INSIDE: f32 = 0.9;
 pub const BEAKER_INNER_HALF: f32 = 0.045;
 /// Wall height (m) of the beaker.
 pub const BEAKER_HEIGHT: f32 = 0.06;
+/// Linear RGBA colour of the drawn beaker (opaque pale blue).
+pub const BEAKER_COLOR: [f32; 4] = [0.35, 0.5, 0.65, 1.0];
 /// World position (m) of the soft grid's node (0, 0, 0); the soft floor is the table.
 pub const GRID_ORIGIN: Vec3 = Vec3::new(-0.14, -0.16, -0.03);
 /// Range of the beaker centre (m, world x then y).
@@ -77,6 +81,14 @@ pub struct FillEvaluation {
 }
 
 impl Fill {
+    /// The task for `cfg` (its `mpm_freq`, see [`BucketArm::from_config`]).
+    pub fn new(cfg: &EnvConfig) -> Result<Self, EnvError> {
+        Ok(Self {
+            arm: BucketArm::from_config(cfg)?,
+            ..Self::default()
+        })
+    }
+
     /// The bucket-carrying arm and its clay.
     pub fn arm(&self) -> &BucketArm {
         &self.arm
@@ -167,7 +179,12 @@ impl Task for Fill {
             .add_actor(
                 ActorDesc::new("beaker", ActorKind::Kinematic)
                     .with_pose(Pose3::translation(BEAKER_X.0, 0.0, 0.0))
-                    .with_shape(ShapeSpec::new(beaker_shape())),
+                    .with_shape(ShapeSpec::new(beaker_shape()))
+                    .with_visual(VisualShape {
+                        shape: beaker_shape(),
+                        pose_body_from_shape: Pose3::identity(),
+                        rgba: BEAKER_COLOR,
+                    }),
             )
             .map_err(|e| EnvError::Physics(e.to_string()))?;
         self.beaker = Some(beaker);
@@ -198,10 +215,10 @@ impl Task for Fill {
 
     fn initialize_task(&mut self, scene: &TaskScene, _rng: &mut EpisodeRng) {
         // The clay goes into the bucket where the robot's reset put it.
-        let config = SoftConfig {
+        let config = self.arm.soft_config(SoftConfig {
             grid_origin: GRID_ORIGIN,
             ..SoftConfig::default()
-        };
+        });
         let result = (|| -> Result<(), EnvError> {
             let (mut solver, clay) = SoftWorld::solver_for(&config).map_err(soft_err)?;
             let spacing = config.particle_spacing;
@@ -280,6 +297,20 @@ impl Task for Fill {
 
     fn particles_obs(&self) -> Option<ObsValue> {
         self.arm.particles_obs()
+    }
+
+    fn mpm_freq(&self) -> Option<f64> {
+        Some(self.arm.mpm_freq())
+    }
+
+    fn particle_visuals(&self) -> Vec<ParticleVisual> {
+        vec![BucketArm::clay_visual(
+            SoftConfig::default().particle_spacing,
+        )]
+    }
+
+    fn particle_positions(&self, _set: usize) -> &[Vec3] {
+        self.arm.particle_positions()
     }
 
     fn as_any(&self) -> &dyn Any {
