@@ -27,9 +27,9 @@
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
+use crate::contact::ContactKernel;
 use crate::error::MpmError;
 use crate::grid::GridSpec;
-use crate::contact::ContactKernel;
 use crate::mesh::TriMesh;
 use crate::sdf::{Sdf, SdfVolume};
 use crate::solver::{MpmSolver, ParticleForces, ParticleView};

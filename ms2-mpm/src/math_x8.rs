@@ -254,7 +254,11 @@ mod tests {
         // next to a lane that keeps the sweeps going.
         let mats: [Mat3; 8] = std::array::from_fn(|l| {
             if l == 0 {
-                return Mat3::from_cols(Vec3::new(1.0, 0.3, 0.1), Vec3::Y, Vec3::new(0.2, 0.0, 0.8));
+                return Mat3::from_cols(
+                    Vec3::new(1.0, 0.3, 0.1),
+                    Vec3::Y,
+                    Vec3::new(0.2, 0.0, 0.8),
+                );
             }
             let e = 10f32.powi(-(20 + 2 * l as i32));
             Mat3::from_cols(Vec3::new(1.0, e, 0.0), Vec3::new(e, 1.0, 0.0), Vec3::Z)
@@ -262,7 +266,11 @@ mod tests {
         for (l, d) in svd3_x8(&mats).iter().enumerate() {
             let back = d.u * Mat3::from_diagonal(d.sigma) * d.v.transpose();
             assert!(back.is_finite(), "lane {l}: {d:?}");
-            assert!((back - mats[l]).abs().to_cols_array().iter().all(|e| *e < 1e-6));
+            assert!((back - mats[l])
+                .abs()
+                .to_cols_array()
+                .iter()
+                .all(|e| *e < 1e-6));
         }
     }
 }

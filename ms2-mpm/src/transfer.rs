@@ -85,7 +85,9 @@ pub(crate) fn particle_to_grid(
 ) {
     let units = &binning.units;
     if scratch.locals.len() < units.len() {
-        scratch.locals.resize(units.len(), [Vec4::ZERO; LOCAL_NODES]);
+        scratch
+            .locals
+            .resize(units.len(), [Vec4::ZERO; LOCAL_NODES]);
     }
     let bins = grid.bins;
     let f_ptr = SyncPtr::new(p.f.as_mut_ptr());
@@ -239,11 +241,13 @@ pub(crate) fn grid_to_particle(
             for i in 0..LOCAL {
                 for j in 0..LOCAL {
                     for k in 0..LOCAL {
-                        local[local_index(i, j, k)] = Vec4::from_array(grid.nodes[grid.index(
-                            corner[0] + i as i32,
-                            corner[1] + j as i32,
-                            corner[2] + k as i32,
-                        )]);
+                        local[local_index(i, j, k)] = Vec4::from_array(
+                            grid.nodes[grid.index(
+                                corner[0] + i as i32,
+                                corner[1] + j as i32,
+                                corner[2] + k as i32,
+                            )],
+                        );
                     }
                 }
             }
@@ -299,7 +303,10 @@ pub(crate) fn grid_to_particle(
                         bk += (g1 + g2 * 2.0) * wij;
                     }
                 }
-                let (vel, b) = (vel.truncate(), [bi.truncate(), bj.truncate(), bk.truncate()]);
+                let (vel, b) = (
+                    vel.truncate(),
+                    [bi.truncate(), bj.truncate(), bk.truncate()],
+                );
                 // C = 4/dx² Σ w v (x_i − x_p)ᵀ with x_i − x_p = ((i, j, k) − fx)·dx.
                 let s = 4.0 * inv_dx;
                 cs[q] = Mat3::from_cols(
