@@ -11,8 +11,8 @@ use crate::cameras::cameras_from_py;
 /// The keyword arguments every native env constructor and demonstration binding accepts, with
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
 /// ([`EnvConfig::new`]: `state_dict`, the task's control/reward mode, 500 Hz / 20 Hz, the task's
-/// episode limit, no render mode, the task's cameras).
-pub const ENV_KWARGS: [&str; 8] = [
+/// episode limit, no render mode, the task's cameras, the soft-body task's MPM frequency).
+pub const ENV_KWARGS: [&str; 9] = [
     "obs_mode",
     "control_mode",
     "reward_mode",
@@ -21,6 +21,7 @@ pub const ENV_KWARGS: [&str; 8] = [
     "control_freq",
     "max_episode_steps",
     "camera_cfgs",
+    "mpm_freq",
 ];
 
 /// `value` extracted as a `T`, or a `TypeError` naming the keyword and the expected type.
@@ -60,6 +61,7 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
             "render_mode" => cfg.render_mode = Some(extract_kwarg(&key, &value, "a str")?),
             "sim_freq" => cfg.sim_freq = extract_kwarg(&key, &value, "a number (Hz)")?,
             "control_freq" => cfg.control_freq = extract_kwarg(&key, &value, "a number (Hz)")?,
+            "mpm_freq" => cfg.mpm_freq = Some(extract_kwarg(&key, &value, "a number (Hz)")?),
             "max_episode_steps" => {
                 cfg.max_episode_steps = Some(extract_kwarg(
                     &key,
@@ -94,5 +96,6 @@ pub fn config_to_py<'py>(py: Python<'py>, cfg: &EnvConfig) -> PyResult<Bound<'py
     dict.set_item("sim_freq", cfg.sim_freq)?;
     dict.set_item("control_freq", cfg.control_freq)?;
     dict.set_item("max_episode_steps", cfg.max_episode_steps)?;
+    dict.set_item("mpm_freq", cfg.mpm_freq)?;
     Ok(dict)
 }

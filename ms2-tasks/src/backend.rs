@@ -40,6 +40,10 @@ pub(crate) trait EnvBackend: Send {
     fn observe_particles(&self) -> Option<ObsValue> {
         None
     }
+    /// MPM substep frequency (Hz) of a soft-body env; `None` for envs without soft bodies.
+    fn mpm_freq(&self) -> Option<f64> {
+        None
+    }
     /// Dense reward of the current state after `action`.
     fn dense_reward(&self, eval: &Evaluation, action: &[f32]) -> f64;
     /// Length of the flat state vector.

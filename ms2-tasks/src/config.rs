@@ -30,6 +30,10 @@ pub struct EnvConfig {
     pub control_freq: f64,
     /// Episode length limit in env steps; `None` = the task's default (200 for the rigid tasks).
     pub max_episode_steps: Option<u32>,
+    /// MPM substep frequency in Hz of the soft-body tasks (`Excavate-v0`, `Fill-v0`); `None` =
+    /// the task's default (1000 Hz; ManiSkill2 uses 2000). Must be a whole multiple of
+    /// `sim_freq`; setting it on an env without soft bodies is an error.
+    pub mpm_freq: Option<f64>,
 }
 
 impl Default for EnvConfig {
@@ -44,6 +48,7 @@ impl Default for EnvConfig {
             sim_freq: 500.0,
             control_freq: 20.0,
             max_episode_steps: None,
+            mpm_freq: None,
         }
     }
 }
@@ -65,26 +70,52 @@ impl EnvConfig {
     /// Number of physics substeps per env step (`sim_freq / control_freq`), after checking that
     /// both are finite, positive and that the ratio is a whole number.
     pub fn substeps(&self) -> Result<u32, EnvError> {
-        let (sim, ctrl) = (self.sim_freq, self.control_freq);
-        if !(sim.is_finite() && sim > 0.0) {
-            return Err(EnvError::InvalidConfig(format!(
-                "sim_freq must be a finite positive number of Hz, got {sim}"
-            )));
-        }
-        if !(ctrl.is_finite() && ctrl > 0.0) {
-            return Err(EnvError::InvalidConfig(format!(
-                "control_freq must be a finite positive number of Hz, got {ctrl}"
-            )));
-        }
-        let ratio = sim / ctrl;
-        let rounded = ratio.round();
-        if rounded < 1.0 || (ratio - rounded).abs() > 1e-9 * ratio.max(1.0) {
-            return Err(EnvError::InvalidConfig(format!(
-                "sim_freq ({sim} Hz) must be a whole multiple (>= 1) of control_freq ({ctrl} Hz)"
-            )));
-        }
-        Ok(rounded as u32)
+        whole_multiple(
+            ("sim_freq", self.sim_freq),
+            ("control_freq", self.control_freq),
+        )
     }
+
+    /// The MPM substep length (s) of a soft-body task whose default MPM frequency is
+    /// `default_hz`: `1 / mpm_freq`, after checking that `mpm_freq` is finite, positive and a
+    /// whole multiple (>= 1) of `sim_freq`.
+    ///
+    /// ```
+    /// let mut cfg = ms2_tasks::EnvConfig::new("Excavate-v0");
+    /// assert_eq!(cfg.mpm_substep_dt(1000.0).unwrap(), 1e-3);
+    /// cfg.mpm_freq = Some(2000.0);
+    /// assert_eq!(cfg.mpm_substep_dt(1000.0).unwrap(), 5e-4);
+    /// cfg.mpm_freq = Some(1234.0);
+    /// assert!(cfg.mpm_substep_dt(1000.0).is_err());
+    /// ```
+    pub fn mpm_substep_dt(&self, default_hz: f64) -> Result<f32, EnvError> {
+        let mpm = self.mpm_freq.unwrap_or(default_hz);
+        whole_multiple(("mpm_freq", mpm), ("sim_freq", self.sim_freq))?;
+        Ok((1.0 / mpm) as f32)
+    }
+}
+
+/// `high / low` for two named frequencies (Hz), after checking that both are finite and
+/// positive and that the ratio is a whole number >= 1.
+fn whole_multiple(
+    (high_name, high): (&str, f64),
+    (low_name, low): (&str, f64),
+) -> Result<u32, EnvError> {
+    for (name, hz) in [(high_name, high), (low_name, low)] {
+        if !(hz.is_finite() && hz > 0.0) {
+            return Err(EnvError::InvalidConfig(format!(
+                "{name} must be a finite positive number of Hz, got {hz}"
+            )));
+        }
+    }
+    let ratio = high / low;
+    let rounded = ratio.round();
+    if rounded < 1.0 || (ratio - rounded).abs() > 1e-9 * ratio.max(1.0) {
+        return Err(EnvError::InvalidConfig(format!(
+            "{high_name} ({high} Hz) must be a whole multiple (>= 1) of {low_name} ({low} Hz)"
+        )));
+    }
+    Ok(rounded as u32)
 }
 
 /// Observation modes of the runtime.

@@ -86,7 +86,14 @@ impl Env {
         }
         let substeps = cfg.substeps()?;
         let backend = registry::make_backend(cfg, substeps)?;
+        if let (Some(hz), None) = (cfg.mpm_freq, backend.mpm_freq()) {
+            return Err(EnvError::InvalidConfig(format!(
+                "mpm_freq ({hz} Hz) applies only to envs with soft bodies; {} has none",
+                cfg.env_id
+            )));
+        }
         let resolved = EnvConfig {
+            mpm_freq: backend.mpm_freq(),
             control_mode: Some(backend.control_mode().to_owned()),
             reward_mode: Some(reward_mode.as_str().to_owned()),
             max_episode_steps: Some(

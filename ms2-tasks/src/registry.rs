@@ -35,7 +35,7 @@ const REGISTRY: &[Registration] = &[
             Ok(Box::new(TaskEnv::new(
                 cfg,
                 substeps,
-                crate::tasks::soft::excavate_env::Excavate::default(),
+                crate::tasks::soft::excavate_env::Excavate::new(cfg)?,
             )?))
         },
     },
@@ -45,7 +45,7 @@ const REGISTRY: &[Registration] = &[
             Ok(Box::new(TaskEnv::new(
                 cfg,
                 substeps,
-                crate::tasks::soft::fill::Fill::default(),
+                crate::tasks::soft::fill::Fill::new(cfg)?,
             )?))
         },
     },

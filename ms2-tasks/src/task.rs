@@ -105,6 +105,12 @@ pub trait Task: Send + 'static {
         None
     }
 
+    /// MPM substep frequency (Hz) of a soft-body task; `None` for tasks without soft bodies
+    /// (the runtime then refuses an `mpm_freq` in the config).
+    fn mpm_freq(&self) -> Option<f64> {
+        None
+    }
+
     /// Particle sets the cameras draw (soft-body tasks: the clay), each with its own
     /// segmentation object; read when the render scene is built. Their positions come from
     /// [`Task::particle_positions`] before every render.

@@ -267,6 +267,10 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
         self.task.particles_obs()
     }
 
+    fn mpm_freq(&self) -> Option<f64> {
+        self.task.mpm_freq()
+    }
+
     fn dense_reward(&self, eval: &Evaluation, _action: &[f32]) -> f64 {
         self.task.dense_reward(&self.scene, eval)
     }

@@ -234,6 +234,39 @@ fn kinematic_plate_lifts_a_clay_block() {
     );
 }
 
+#[test]
+fn every_excavate_bed_has_the_same_particle_count_and_its_own_surface() {
+    use ms2_tasks::tasks::soft::excavate::{excavate_soft_config, ExcavateBed, BED_PARTICLES};
+    let config = excavate_soft_config(Vec3::new(-0.18, -0.16, -0.03));
+    let mut left_counts = Vec::new();
+    for seed in 0..12 {
+        let (solver, bed) = ExcavateBed::sample(&config, seed).unwrap();
+        assert_eq!(solver.particle_count(), BED_PARTICLES, "seed {seed}");
+        let x = solver.positions();
+        let highest = x.iter().map(|p| p.z).fold(f32::MIN, f32::max);
+        let lowest = x.iter().map(|p| p.z).fold(f32::MAX, f32::min);
+        assert!(
+            lowest > bed.floor_z && lowest < bed.floor_z + 0.005,
+            "seed {seed}: {lowest}"
+        );
+        assert!(
+            highest <= bed.bed_top_z + 0.005,
+            "seed {seed}: {highest} > {}",
+            bed.bed_top_z
+        );
+        assert!(
+            (x.iter().map(|p| p.z).sum::<f32>() / x.len() as f32 - bed.floor_z - 0.0175).abs()
+                < 0.003,
+            "seed {seed}: the bed's mean height is off"
+        );
+        let centre_x = 0.5 * (bed.footprint[0].x + bed.footprint[1].x);
+        left_counts.push(x.iter().filter(|p| p.x < centre_x).count());
+    }
+    // The height maps differ between seeds: so does the clay on each side of the bed.
+    let spread = left_counts.iter().max().unwrap() - left_counts.iter().min().unwrap();
+    assert!(spread > 40, "particles left of the centre: {left_counts:?}");
+}
+
 mod soft_envs {
     use ms2_tasks::{info_get, make_env, make_scripted_policy, EnvConfig, EnvError, InfoValue};
 
@@ -376,5 +409,62 @@ mod soft_envs {
             .unwrap()[0];
         assert!(inside >= 100, "only {inside} particles lifted: {info:?}");
         assert!(lowest > f64::from(target_height), "{info:?}");
+    }
+
+    /// MPM substeps the clay of `env` has taken so far.
+    fn mpm_substeps_taken(env: &ms2_tasks::Env) -> u64 {
+        use ms2_tasks::tasks::soft::{excavate_env::Excavate, fill::Fill};
+        let task = env.task_any().unwrap();
+        let arm = match task.downcast_ref::<Excavate>() {
+            Some(e) => e.arm(),
+            None => task.downcast_ref::<Fill>().unwrap().arm(),
+        };
+        arm.soft().unwrap().solver().substeps_taken()
+    }
+
+    #[test]
+    fn mpm_freq_sets_the_soft_substeps_and_bad_values_are_refused() {
+        for (env_id, mpm_freq, per_step) in [
+            ("Excavate-v0", None, 50),
+            ("Excavate-v0", Some(2000.0), 100),
+            ("Fill-v0", Some(1500.0), 75),
+        ] {
+            let mut cfg = EnvConfig::new(env_id);
+            cfg.mpm_freq = mpm_freq;
+            let mut env = make_env(&cfg).unwrap();
+            assert_eq!(env.config().mpm_freq, Some(mpm_freq.unwrap_or(1000.0)));
+            env.reset(Some(0), false).unwrap();
+            let before = mpm_substeps_taken(&env);
+            env.step(&vec![0.0; env.action_space().size()]).unwrap();
+            assert_eq!(
+                mpm_substeps_taken(&env) - before,
+                per_step,
+                "{env_id} {mpm_freq:?}"
+            );
+        }
+        for (env_id, bad, named) in [
+            ("Excavate-v0", 1234.0, "1234"),
+            ("Excavate-v0", f64::NAN, "NaN"),
+            ("Fill-v0", -2000.0, "-2000"),
+            ("PickCube-v0", 2000.0, "PickCube-v0"),
+        ] {
+            let mut cfg = EnvConfig::new(env_id);
+            cfg.mpm_freq = Some(bad);
+            let err = make_env(&cfg).expect_err("accepted a bad mpm_freq");
+            let msg = err.to_string();
+            assert!(
+                matches!(err, EnvError::InvalidConfig(_))
+                    && msg.contains("mpm_freq")
+                    && msg.contains(named),
+                "{env_id} {bad}: {msg}"
+            );
+        }
+        assert_eq!(
+            make_env(&EnvConfig::new("PickCube-v0"))
+                .unwrap()
+                .config()
+                .mpm_freq,
+            None
+        );
     }
 }

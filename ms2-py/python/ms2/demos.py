@@ -201,6 +201,7 @@ def _write_video(env_id: str, env_kwargs: dict[str, Any], episode: dict[str, Any
         render_mode="rgb_array",
         sim_freq=float(env_kwargs.get("sim_freq", 500.0)),
         control_freq=float(env_kwargs.get("control_freq", 20.0)),
+        mpm_freq=env_kwargs.get("mpm_freq"),
     )
     env.reset(seed=int(episode["episode_seed"]))
     frames = []
@@ -257,7 +258,7 @@ def replay(
         out_mode = target_control_mode or next(iter(source_modes))
         native_kwargs = {
             key: env_kwargs[key]
-            for key in ("reward_mode", "sim_freq", "control_freq")
+            for key in ("reward_mode", "sim_freq", "control_freq", "mpm_freq")
             if key in env_kwargs
         }
         native_kwargs["obs_mode"] = obs_mode or "state"

@@ -23,8 +23,8 @@ UNLIMITED_EPISODE_STEPS = 2**31 - 1
 
 def adopt_config(env: Any, config: dict[str, Any]) -> None:
     """Sets ``env_id``, ``obs_mode``, ``control_mode``, ``reward_mode``, ``render_mode``,
-    ``sim_freq`` and ``control_freq`` on ``env`` from a native env's resolved ``config()`` (task
-    defaults filled in)."""
+    ``sim_freq``, ``control_freq`` and ``mpm_freq`` (``None`` without soft bodies) on ``env``
+    from a native env's resolved ``config()`` (task defaults filled in)."""
     for key in (
         "env_id",
         "obs_mode",
@@ -33,6 +33,7 @@ def adopt_config(env: Any, config: dict[str, Any]) -> None:
         "render_mode",
         "sim_freq",
         "control_freq",
+        "mpm_freq",
     ):
         setattr(env, key, config[key])
 
@@ -61,6 +62,9 @@ class Ms2Env(gym.Env):
             ``height``, ``fov`` (vertical, radians), ``near``, ``far`` (m), ``p``, ``q`` (pose
             in the mount's frame, quaternion wxyz)). Unknown keys or bad values raise
             ``ValueError``.
+        mpm_freq: MPM substep frequency in Hz of the soft-body tasks (``Excavate-v0``,
+            ``Fill-v0``); ``None`` = the task's default (1000; ManiSkill2 uses 2000). Must be a
+            whole multiple of ``sim_freq``; ``ValueError`` on envs without soft bodies.
 
     Unknown ids or modes raise ``ValueError`` listing the valid ones.
     """
@@ -78,6 +82,7 @@ class Ms2Env(gym.Env):
         control_freq: float = 20.0,
         max_episode_steps: int | None = None,
         camera_cfgs: dict[str, Any] | None = None,
+        mpm_freq: float | None = None,
     ) -> None:
         self._native = _native.NativeEnv(
             env_id,
@@ -89,6 +94,7 @@ class Ms2Env(gym.Env):
             control_freq=control_freq,
             max_episode_steps=max_episode_steps,
             camera_cfgs=camera_cfgs,
+            mpm_freq=mpm_freq,
         )
         adopt_config(self, self._native.config())
         self.observation_space = to_gym_space(self._native.observation_space())

@@ -85,6 +85,7 @@ def _env_info(env: gym.Env) -> dict[str, Any]:
             "reward_mode": unwrapped.reward_mode,
             "sim_freq": unwrapped.sim_freq,
             "control_freq": unwrapped.control_freq,
+            **({"mpm_freq": unwrapped.mpm_freq} if unwrapped.mpm_freq is not None else {}),
         },
     }
 

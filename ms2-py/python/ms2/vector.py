@@ -102,7 +102,7 @@ def make_vec(env_id: str, num_envs: int = 1, **kwargs: Any) -> Ms2VectorEnv:
 
     Keyword arguments are those of ``gymnasium.make`` for ms2 (``obs_mode``, ``control_mode``,
     ``reward_mode``, ``render_mode``, ``sim_freq``, ``control_freq``, ``max_episode_steps``,
-    ``camera_cfgs``). In visual obs modes every env's cameras render in one batch per step
-    (one GPU submission through the process's shared renderer).
+    ``camera_cfgs``, ``mpm_freq``). In visual obs modes every env's cameras render in one batch
+    per step (one GPU submission through the process's shared renderer).
     """
     return Ms2VectorEnv(env_id, num_envs=num_envs, **kwargs)

@@ -13,13 +13,18 @@ use ms2_physics::{ArticulationId, BodyId, World};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
 use super::excavate::BucketPose;
-use super::{SoftSceneError, SoftWorld};
+use super::{SoftConfig, SoftSceneError, SoftWorld};
 use crate::adapters::mpm_rigid::pose_to_glam;
 use crate::adapters::ParticleVisual;
+use crate::config::EnvConfig;
 use crate::error::EnvError;
 use crate::geometry::Pose3;
 use crate::obs::{Array, ArrayData, DictBuilder, ObsValue};
 use crate::task::TaskScene;
+
+/// MPM substep frequency (Hz) of the soft-body tasks unless `EnvConfig::mpm_freq` says
+/// otherwise: 1 kHz, two substeps per 500 Hz physics step (ManiSkill2 uses 2 kHz).
+pub const DEFAULT_MPM_FREQ_HZ: f64 = 1000.0;
 
 /// Floats of task state per particle: position 3, velocity 3, F 9, C 9 (column-major).
 pub const FLOATS_PER_PARTICLE: usize = 24;
@@ -56,13 +61,48 @@ pub fn tcp_for_bucket(bucket: &BucketPose) -> Pose3 {
 }
 
 /// The bucket-carrying Panda and its coupled clay (see the [module docs](self)).
-#[derive(Default)]
 pub struct BucketArm {
     soft: Option<SoftWorld>,
     hand: Option<(ArticulationId, usize, BodyId)>,
+    mpm_freq_hz: f64,
+}
+
+impl Default for BucketArm {
+    /// An arm whose clay takes [`DEFAULT_MPM_FREQ_HZ`] substeps.
+    fn default() -> Self {
+        Self {
+            soft: None,
+            hand: None,
+            mpm_freq_hz: DEFAULT_MPM_FREQ_HZ,
+        }
+    }
 }
 
 impl BucketArm {
+    /// An arm whose clay takes `cfg.mpm_freq` substeps per second (default
+    /// [`DEFAULT_MPM_FREQ_HZ`]); an error names a frequency that is not a whole multiple of
+    /// `cfg.sim_freq`.
+    pub fn from_config(cfg: &EnvConfig) -> Result<Self, EnvError> {
+        cfg.mpm_substep_dt(DEFAULT_MPM_FREQ_HZ)?;
+        Ok(Self {
+            mpm_freq_hz: cfg.mpm_freq.unwrap_or(DEFAULT_MPM_FREQ_HZ),
+            ..Self::default()
+        })
+    }
+
+    /// MPM substep frequency of the clay (Hz).
+    pub fn mpm_freq(&self) -> f64 {
+        self.mpm_freq_hz
+    }
+
+    /// `base` with this arm's MPM substep length.
+    pub fn soft_config(&self, base: SoftConfig) -> SoftConfig {
+        SoftConfig {
+            substep_dt: (1.0 / self.mpm_freq_hz) as f32,
+            ..base
+        }
+    }
+
     /// Forgets the previous scene's hand and clay (at scene build).
     pub fn clear(&mut self) {
         self.soft = None;

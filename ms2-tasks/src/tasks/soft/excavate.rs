@@ -63,6 +63,9 @@ const BED_MAX: [f32; 2] = [0.24, 0.22];
 /// Mean bed thickness (m) and the seeded height map's amplitude (m).
 const BED_THICKNESS: f32 = 0.035;
 const BED_AMPLITUDE: f32 = 0.006;
+/// Clay particles of every bed (the nominal 12 × 12 × 3.5 cm bed holds 4,032 at 5 mm spacing),
+/// fixed so that the `particles` observation has one shape for every episode.
+pub const BED_PARTICLES: usize = 4000;
 /// Clay outside the bucket counts as spilled when it lies more than this (m) outside the
 /// bed's footprint or above the bed's highest initial point. The bed itself deforms as the
 /// bucket pushes into it (its far side bulges by 2-3 cm), which is not spilling.
@@ -125,6 +128,40 @@ pub fn excavate_soft_config(grid_origin: Vec3) -> SoftConfig {
     config
 }
 
+/// Exactly `count` lattice points (`spacing` apart, m) filling the columns between `floor_z`
+/// and the surface of `map`: each vertical column of the lattice gets a share of `count`
+/// proportional to its height (largest remainders first, ties to the lower column index), and
+/// its points stack from half a spacing above the floor.
+fn fixed_count_bed(map: &HeightMap, floor_z: f32, spacing: f32, count: usize) -> Vec<Vec3> {
+    let extent = Vec2::new((map.nx - 1) as f32, (map.ny - 1) as f32) * map.cell_size;
+    let columns = (extent / spacing).floor();
+    let (cx, cy) = (columns.x as usize, columns.y as usize);
+    let start = map.origin + (extent - columns * spacing) * 0.5 + Vec2::splat(0.5 * spacing);
+    let xy = |c: usize| start + Vec2::new((c / cy) as f32, (c % cy) as f32) * spacing;
+    let heights: Vec<f64> = (0..cx * cy)
+        .map(|c| f64::from((map.height_at(xy(c)) - floor_z).max(0.0)))
+        .collect();
+    let total: f64 = heights.iter().sum();
+    let quotas: Vec<f64> = heights.iter().map(|h| h / total * count as f64).collect();
+    let mut per_column: Vec<usize> = quotas.iter().map(|q| q.floor() as usize).collect();
+    let mut by_remainder: Vec<usize> = (0..quotas.len()).collect();
+    by_remainder.sort_by(|&a, &b| {
+        let (ra, rb) = (quotas[a].fract(), quotas[b].fract());
+        rb.total_cmp(&ra).then(a.cmp(&b))
+    });
+    let missing = count - per_column.iter().sum::<usize>();
+    for &c in by_remainder.iter().take(missing) {
+        per_column[c] += 1;
+    }
+    let mut points = Vec::with_capacity(count);
+    for (c, &n) in per_column.iter().enumerate() {
+        for k in 0..n {
+            points.push(xy(c).extend(floor_z + (k as f32 + 0.5) * spacing));
+        }
+    }
+    points
+}
+
 impl ExcavateBed {
     /// Samples an episode from `seed`: the bed's height map (5 × 5 samples, ±6 mm about a
     /// 3.5 cm thick bed) filled with clay particles in a new solver for `config`, and the
@@ -137,8 +174,14 @@ impl ExcavateBed {
         let footprint = [origin + Vec2::from(BED_MIN), origin + Vec2::from(BED_MAX)];
         let (nx, ny) = (5, 5);
         let cell = (BED_MAX[0] - BED_MIN[0]) / (nx - 1) as f32;
-        let heights: Vec<f32> = (0..nx * ny)
-            .map(|_| floor_z + BED_THICKNESS + rng.random_range(-BED_AMPLITUDE..BED_AMPLITUDE))
+        // Zero-mean bumps: every bed holds about the same volume of clay.
+        let bumps: Vec<f32> = (0..nx * ny)
+            .map(|_| rng.random_range(-BED_AMPLITUDE..BED_AMPLITUDE))
+            .collect();
+        let mean_bump = bumps.iter().sum::<f32>() / bumps.len() as f32;
+        let heights: Vec<f32> = bumps
+            .iter()
+            .map(|b| floor_z + BED_THICKNESS + b - mean_bump)
             .collect();
         let bed_top_z = heights.iter().copied().fold(f32::MIN, f32::max);
         let mean_bed_z = heights.iter().sum::<f32>() / heights.len() as f32;
@@ -150,7 +193,8 @@ impl ExcavateBed {
             heights,
         };
         let spacing = config.particle_spacing;
-        let mut points = sampling::sample_heightmap(&map, floor_z, spacing)?;
+        map.validate()?;
+        let mut points = fixed_count_bed(&map, floor_z, spacing, BED_PARTICLES);
         sampling::jitter(&mut points, 0.1 * spacing, seed);
         solver.add_particles(&points, clay, spacing.powi(3), Vec3::ZERO)?;
         let target_particles = rng.random_range(TARGET_RANGE.0..=TARGET_RANGE.1);

@@ -31,6 +31,7 @@ use super::excavate::{
 };
 use crate::adapters::mpm_rigid::pose_to_glam;
 use crate::adapters::ParticleVisual;
+use crate::config::EnvConfig;
 use crate::env::Env;
 use crate::error::EnvError;
 use crate::geometry::vectorize_pose;
@@ -60,6 +61,14 @@ pub struct Excavate {
 }
 
 impl Excavate {
+    /// The task for `cfg` (its `mpm_freq`, see [`BucketArm::from_config`]).
+    pub fn new(cfg: &EnvConfig) -> Result<Self, EnvError> {
+        Ok(Self {
+            arm: BucketArm::from_config(cfg)?,
+            bed: None,
+        })
+    }
+
     /// The episode's bed and goal (after the first reset).
     pub fn bed(&self) -> Option<&ExcavateBed> {
         self.bed.as_ref()
@@ -107,8 +116,11 @@ impl Task for Excavate {
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
         self.arm.locate_hand(scene)?;
-        let (solver, bed) = ExcavateBed::sample(&excavate_soft_config(GRID_ORIGIN), rng.random())
-            .map_err(soft_err)?;
+        let (solver, bed) = ExcavateBed::sample(
+            &self.arm.soft_config(excavate_soft_config(GRID_ORIGIN)),
+            rng.random(),
+        )
+        .map_err(soft_err)?;
         self.arm.couple(solver, &scene.world, &[])?;
         self.bed = Some(bed);
         Ok(())
@@ -202,6 +214,10 @@ impl Task for Excavate {
 
     fn particles_obs(&self) -> Option<ObsValue> {
         self.arm.particles_obs()
+    }
+
+    fn mpm_freq(&self) -> Option<f64> {
+        Some(self.arm.mpm_freq())
     }
 
     fn particle_visuals(&self) -> Vec<ParticleVisual> {

@@ -27,6 +27,7 @@ use super::excavate::{BucketPose, BUCKET_INNER_HALF, BUCKET_WALL_HALF, MAX_SOFT_
 use super::{SoftConfig, SoftWorld};
 use crate::adapters::mpm_rigid::pose_to_glam;
 use crate::adapters::ParticleVisual;
+use crate::config::EnvConfig;
 use crate::env::Env;
 use crate::error::EnvError;
 use crate::geometry::vectorize_pose;
@@ -80,6 +81,14 @@ pub struct FillEvaluation {
 }
 
 impl Fill {
+    /// The task for `cfg` (its `mpm_freq`, see [`BucketArm::from_config`]).
+    pub fn new(cfg: &EnvConfig) -> Result<Self, EnvError> {
+        Ok(Self {
+            arm: BucketArm::from_config(cfg)?,
+            ..Self::default()
+        })
+    }
+
     /// The bucket-carrying arm and its clay.
     pub fn arm(&self) -> &BucketArm {
         &self.arm
@@ -206,10 +215,10 @@ impl Task for Fill {
 
     fn initialize_task(&mut self, scene: &TaskScene, _rng: &mut EpisodeRng) {
         // The clay goes into the bucket where the robot's reset put it.
-        let config = SoftConfig {
+        let config = self.arm.soft_config(SoftConfig {
             grid_origin: GRID_ORIGIN,
             ..SoftConfig::default()
-        };
+        });
         let result = (|| -> Result<(), EnvError> {
             let (mut solver, clay) = SoftWorld::solver_for(&config).map_err(soft_err)?;
             let spacing = config.particle_spacing;
@@ -288,6 +297,10 @@ impl Task for Fill {
 
     fn particles_obs(&self) -> Option<ObsValue> {
         self.arm.particles_obs()
+    }
+
+    fn mpm_freq(&self) -> Option<f64> {
+        Some(self.arm.mpm_freq())
     }
 
     fn particle_visuals(&self) -> Vec<ParticleVisual> {
