@@ -109,21 +109,7 @@ impl Sensors {
     /// world's); its index, counted from 0, is the `set` of
     /// [`Sensors::set_particle_positions`].
     pub fn add_particle_set(&mut self, visual: &ParticleVisual) -> Result<usize, EnvError> {
-        if !(visual.radius_m.is_finite() && visual.radius_m > 0.0) {
-            return Err(EnvError::InvalidConfig(format!(
-                "particle set {:?}: radius {} m must be finite and > 0",
-                visual.name, visual.radius_m
-            )));
-        }
-        if let Some(s) = visual.packing_spacing_m {
-            if !(s.is_finite() && s > 0.0 && visual.radius_m > s * std::f32::consts::FRAC_1_SQRT_2)
-            {
-                return Err(EnvError::InvalidConfig(format!(
-                    "particle set {:?}: packing spacing {s} m must be finite, > 0 and below                      √2 × the radius {} m (so neighbouring spheres hide enclosed particles)",
-                    visual.name, visual.radius_m
-                )));
-            }
-        }
+        visual.validate()?;
         self.particle_sets.push(SensorParticleSet {
             id: self.scene.add_particle_set(visual),
             packing_spacing_m: visual.packing_spacing_m,
