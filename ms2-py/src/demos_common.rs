@@ -72,7 +72,10 @@ pub fn episode_to_py<'py>(py: Python<'py>, ep: &DemoEpisode) -> PyResult<Bound<'
             dict.set_item("env_states", rows_to_py(py, &ep.env_states, state_len)?)?;
         }
         StateRecording::InitialOnly => {
-            dict.set_item("env_init_state", PyArray1::from_slice(py, ep.env_init_state()))?;
+            dict.set_item(
+                "env_init_state",
+                PyArray1::from_slice(py, ep.env_init_state()),
+            )?;
         }
     }
     dict.set_item("success", PyArray1::from_slice(py, &ep.success))?;

@@ -320,9 +320,7 @@ def replay(
         }
         native_kwargs["obs_mode"] = obs_mode or "state"
         native_kwargs["max_episode_steps"] = traj.env_info.get("max_episode_steps")
-        _check_soft_episodes(
-            traj, list(range(len(episodes_meta))), use_env_states, native_kwargs
-        )
+        _check_soft_episodes(traj, list(range(len(episodes_meta))), use_env_states, native_kwargs)
         if any(traj.is_soft(i) for i in range(len(episodes_meta))):
             # Record the resolved MPM frequency (a foreign file may lack it).
             resolved = _native.recorded_env_kwargs(traj.env_id, native_kwargs)

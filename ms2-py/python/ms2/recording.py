@@ -6,7 +6,8 @@
 ``<output_dir>/<name_prefix>_<index>.mp4``. With ``save_trajectory`` it records each episode's
 actions, ``success`` flags and ``env.get_state()`` after reset and after every step (soft-body
 envs, those with an ``mpm_freq``: only after reset, as ManiSkill2's ``env_init_state``; their
-states hold every particle and replays re-simulate from it), and appends it to ``<output_dir>/<trajectory_name>.h5`` + ``.json`` in ManiSkill2's layout (see
+states hold every particle and replays re-simulate from it), and appends it to
+``<output_dir>/<trajectory_name>.h5`` + ``.json`` in ManiSkill2's layout (see
 :mod:`ms2.trajectory`), so ``ms2 replay`` can replay, re-observe and convert it. An episode is
 written when it ends (terminated or truncated), on the next ``reset``, or on ``close``; every file
 is written to a temporary name and renamed, so a partial file never carries the final name.
