@@ -244,6 +244,10 @@ pub struct ParticleVisual {
     pub radius_m: f32,
     /// Linear RGB colour, each channel in `[0, 1]`.
     pub rgb: [f32; 3],
+    /// `Some(s)` when the particles are a dense packing of spacing `s` m (MPM particles) and
+    /// `radius_m > s / √2`: particles enclosed by neighbours on all sides are then not drawn
+    /// (`sensors::particle_culling`). `None` draws every particle.
+    pub packing_spacing_m: Option<f32>,
 }
 
 /// A render [`Scene`] mirroring a physics [`World`]'s visual shapes.
