@@ -132,18 +132,6 @@ impl Sensors {
         Ok(self.particle_sets.len() - 1)
     }
 
-    /// Particles drawn (after culling) per set, as of the last update.
-    pub fn drawn_particle_counts(&self) -> Vec<usize> {
-        self.particle_sets
-            .iter()
-            .map(|p| {
-                self.scene.scene().particle_sets()[p.id.0 as usize]
-                    .positions_world
-                    .len()
-            })
-            .collect()
-    }
-
     /// Number of particle sets.
     pub fn particle_set_count(&self) -> usize {
         self.particle_sets.len()
