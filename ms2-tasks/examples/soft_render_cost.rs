@@ -9,7 +9,8 @@
 //! ```
 //! (defaults: rgbd, 120 steps, seed 1). Prints, per env: state and visual env steps/s, the
 //! visual step minus the state step (ms), the observation alone (ms, wall and process CPU), the
-//! particle count and triangles per camera, and the load average.
+//! scripted policy's time per action (ms, not part of the env steps/s), the particle count and
+//! triangles per camera, and the load average.
 
 use std::time::Instant;
 
@@ -52,9 +53,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     println!(
         "| env | state steps/s | {mode} steps/s | {mode} step − state step (ms) | observation \
-         alone (ms wall / CPU) | particles | triangles/camera | load (1 min) |"
+         alone (ms wall / CPU) | scripted policy (ms) | particles | triangles/camera | load \
+         (1 min) |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for env_id in ["Excavate-v0", "Fill-v0"] {
         let make = |obs_mode: &str| {
             make_env(&EnvConfig {
@@ -66,13 +68,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut policy = make_scripted_policy(&visual)?;
         let load_at_start = load();
         let (mut t_state, mut t_visual, mut t_obs, mut cpu_obs) = (0.0, 0.0, 0.0, 0.0);
+        let mut t_policy = 0.0;
         let mut step = 0;
         while step < steps {
             state.reset(Some(seed), false)?;
             visual.reset(Some(seed), false)?;
             policy.reset(&visual);
             loop {
+                let tp = Instant::now();
                 let action = policy.act(&visual);
+                t_policy += tp.elapsed().as_secs_f64();
                 let t0 = Instant::now();
                 let done_state = state.step(&action)?;
                 let t1 = Instant::now();
@@ -96,12 +101,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let n = f64::from(steps);
         println!(
-            "| {env_id} | {:.1} | {:.1} | {:.1} | {:.1} / {:.1} | {} | {} | {load_at_start:.1} |",
+            "| {env_id} | {:.1} | {:.1} | {:.1} | {:.1} / {:.1} | {:.1} | {} | {} | {load_at_start:.1} |",
             n / t_state,
             n / t_visual,
             1e3 * (t_visual - t_state) / n,
             1e3 * t_obs / n,
             1e3 * cpu_obs / n,
+            1e3 * t_policy / n,
             particle_count(&visual),
             visual.triangles_per_camera(),
         );
