@@ -280,7 +280,10 @@ mod tests {
                 yielded += 1;
             }
         }
-        assert!(inside > 1000 && yielded > 1000, "{inside} inside, {yielded} yielded");
+        assert!(
+            inside > 1000 && yielded > 1000,
+            "{inside} inside, {yielded} yielded"
+        );
     }
 
     #[test]

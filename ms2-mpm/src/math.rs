@@ -229,7 +229,11 @@ mod tests {
                 rng.random_range(-1.0..1.0),
                 rng.random_range(-1e6..1e6),
             );
-            assert_eq!(fast_floor3(v), v.to_array().map(|x| x.floor() as i32), "{v:?}");
+            assert_eq!(
+                fast_floor3(v),
+                v.to_array().map(|x| x.floor() as i32),
+                "{v:?}"
+            );
         }
         for x in [-2.0, -1.5, -1.0, -0.5, -0.0, 0.0, 0.5, 1.0, 2.5] {
             assert_eq!(fast_floor3(Vec3::splat(x)), [x.floor() as i32; 3]);
