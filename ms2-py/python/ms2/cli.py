@@ -180,7 +180,7 @@ def _cmd_demos_bench(args: argparse.Namespace) -> int:
         )
         print(
             f"{args.env_id}: {gen.seconds_per_episode:.3f} s per generated demo, "
-            f"{gen.cpu_seconds_per_episode:.3f} CPU-s ({args.policy}, {args.control_mode}, "
+            f"{gen.cpu_seconds_per_episode:.3f} CPU-s ({args.policy}, {gen.control_mode}, "
             f"{gen.num_episodes} demos, {gen.seeds_tried} seeds, {args.workers} workers)"
         )
         print(f"  file: {_trajectory_size_summary(path)}")
@@ -220,8 +220,9 @@ def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
     g.add_argument(
         "-c",
         "--control-mode",
-        default="pd_joint_pos",
-        help="control mode of the demos (default pd_joint_pos; other modes: --policy scripted)",
+        default=None,
+        help="control mode of the demos (default pd_joint_pos, for soft-body envs "
+        "pd_joint_delta_pos; other modes than pd_joint_pos need --policy scripted)",
     )
     g.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     g.set_defaults(func=_cmd_demos_generate)
@@ -230,9 +231,7 @@ def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
     b.add_argument("-n", "--num-episodes", type=int, default=20)
     b.add_argument("--workers", type=int, default=1)
     b.add_argument("--policy", choices=["solution", "scripted"], default="solution")
-    b.add_argument(
-        "-c", "--control-mode", default="pd_joint_pos", help="control mode of the generated demos"
-    )
+    b.add_argument("-c", "--control-mode", default=None, help="control mode of the generated demos")
     b.add_argument("--max-retry", type=int, default=0)
     b.add_argument(
         "--target-control-modes",
