@@ -27,6 +27,7 @@
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
+use crate::contact::ContactKernel;
 use crate::error::MpmError;
 use crate::grid::GridSpec;
 use crate::mesh::TriMesh;
@@ -181,19 +182,19 @@ impl CouplingParams {
     }
 }
 
-struct CoupledShape {
-    body: usize,
-    sdf: Sdf,
+pub(crate) struct CoupledShape {
+    pub(crate) body: usize,
+    pub(crate) sdf: Sdf,
     position_in_body: Vec3,
     rotation_in_body: Quat,
     /// Cached each sync: world from shape.
-    world_position: Vec3,
-    world_rotation: Quat,
+    pub(crate) world_position: Vec3,
+    pub(crate) world_rotation: Quat,
     /// Cached each sync: shape from world rotation.
-    inverse_rotation: Quat,
+    pub(crate) inverse_rotation: Quat,
     /// Cached each sync: world bounds inflated by the contact offset.
-    world_min: Vec3,
-    world_max: Vec3,
+    pub(crate) world_min: Vec3,
+    pub(crate) world_max: Vec3,
 }
 
 /// Force (N) and torque about the centre of mass (N·m), world frame.
@@ -217,9 +218,10 @@ pub struct Coupling {
     last_wrenches: Vec<Wrench>,
 }
 
-/// Particles per chunk of the parallel force evaluation (fixed, so reductions are
-/// deterministic regardless of thread count).
-const CHUNK: usize = 2048;
+/// Particles per chunk of the parallel contact pass (fixed, so reductions are deterministic
+/// regardless of thread count; small, because particles are sorted by bin and those touching
+/// a tool are bunched together).
+const CHUNK: usize = 256;
 
 impl Coupling {
     /// Copies the shapes of every body of `backend` and builds their SDFs.
@@ -413,72 +415,83 @@ impl Coupling {
     }
 }
 
-impl ParticleForces for Coupling {
-    fn particle_forces(&mut self, particles: ParticleView<'_>, dt: f32, forces: &mut [Vec3]) {
-        let nb = self.bodies.len();
-        if self.shapes.is_empty() {
-            return;
+impl Coupling {
+    /// The contact forces on the particles (into `forces`, if given; the opposite impulses
+    /// are accumulated per body) and the blocked stencil nodes of `grid` (into `masks`, if
+    /// given; see [`ParticleForces::blocked_nodes`]), in one parallel pass over the
+    /// particles. Returns whether any mask bit was set.
+    fn contact_pass(
+        &mut self,
+        particles: ParticleView<'_>,
+        grid: Option<&GridSpec>,
+        dt: f32,
+        forces: Option<&mut [Vec3]>,
+        masks: Option<&mut [u32]>,
+    ) -> bool {
+        let with_forces = forces.is_some();
+        if with_forces {
+            self.accumulated_time += dt as f64;
         }
-        let this = &*self;
-        let partial: Vec<Vec<[[f64; 3]; 2]>> = forces
+        if self.shapes.is_empty() {
+            return false;
+        }
+        let n = particles.positions.len();
+        let nb = self.bodies.len();
+        let kernel = ContactKernel::new(
+            &self.shapes,
+            &self.bodies,
+            &self.params,
+            dt,
+            with_forces,
+            grid.filter(|_| masks.is_some()),
+        );
+        // Unrequested outputs go to scratch buffers (only the single-purpose trait methods
+        // take this path; the solver asks for both).
+        let (mut no_forces, mut no_masks) = (Vec::new(), Vec::new());
+        let forces = forces.unwrap_or_else(|| {
+            no_forces.resize(n, Vec3::ZERO);
+            &mut no_forces
+        });
+        let masks = masks.unwrap_or_else(|| {
+            no_masks.resize(n, 0);
+            &mut no_masks
+        });
+        let partial: Vec<(Vec<[[f64; 3]; 2]>, bool)> = forces
             .par_chunks_mut(CHUNK)
+            .zip(masks.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(ci, out)| {
+            .map(|(ci, (f_out, m_out))| {
                 let mut acc = vec![[[0.0f64; 3]; 2]; nb];
-                let start = ci * CHUNK;
-                for (k, f_out) in out.iter_mut().enumerate() {
-                    let i = start + k;
-                    let x = particles.positions[i];
-                    let v = particles.velocities[i];
-                    let m = particles.masses[i];
-                    let mut total = Vec3::ZERO;
-                    for sh in &this.shapes {
-                        if x.cmplt(sh.world_min).any() || x.cmpgt(sh.world_max).any() {
-                            continue;
-                        }
-                        let local = sh.inverse_rotation * (x - sh.world_position);
-                        let (d, n_local) = sh.sdf.distance_and_normal(local);
-                        let depth = this.params.contact_offset - d;
-                        if depth <= 0.0 {
-                            continue;
-                        }
-                        let n = sh.world_rotation * n_local;
-                        let body = &this.bodies[sh.body];
-                        let rel = v - body.velocity_at(x);
-                        let vn = rel.dot(n);
-                        let fn_mag = m * (this.params.stiffness * depth - this.params.damping * vn);
-                        if fn_mag <= 0.0 {
-                            continue;
-                        }
-                        let vt = rel - vn * n;
-                        let vt_len = vt.length();
-                        let mut f = fn_mag * n;
-                        if vt_len > 0.0 {
-                            let ft = (this.params.friction * fn_mag).min(m * vt_len / dt);
-                            f -= vt * (ft / vt_len);
-                        }
-                        total += f;
-                        // Equal and opposite on the body, with its torque about the COM.
-                        let torque = (x - body.center_of_mass).cross(-f);
-                        let a = &mut acc[sh.body];
-                        for e in 0..3 {
-                            a[0][e] -= (f[e] * dt) as f64;
-                            a[1][e] += (torque[e] * dt) as f64;
-                        }
-                    }
-                    *f_out = total;
+                let mut any = false;
+                for (k, (f, mask)) in f_out.iter_mut().zip(m_out.iter_mut()).enumerate() {
+                    let i = ci * CHUNK + k;
+                    let (x, v, m) = (
+                        particles.positions[i],
+                        particles.velocities[i],
+                        particles.masses[i],
+                    );
+                    (*f, *mask) = kernel.particle(x, v, m, &mut acc);
+                    any |= *mask != 0;
                 }
-                acc
+                (acc, any)
             })
             .collect();
-        for chunk in partial {
+        let mut any = false;
+        for (chunk, chunk_any) in partial {
+            any |= chunk_any;
             for (total, a) in self.impulses.iter_mut().zip(&chunk) {
                 for (t, x) in total.iter_mut().flatten().zip(a.iter().flatten()) {
                     *t += x;
                 }
             }
         }
-        self.accumulated_time += dt as f64;
+        any
+    }
+}
+
+impl ParticleForces for Coupling {
+    fn particle_forces(&mut self, particles: ParticleView<'_>, dt: f32, forces: &mut [Vec3]) {
+        self.contact_pass(particles, None, dt, Some(forces), None);
     }
 
     fn blocked_nodes(
@@ -487,53 +500,17 @@ impl ParticleForces for Coupling {
         grid: &GridSpec,
         masks: &mut [u32],
     ) -> bool {
-        if self.shapes.is_empty() {
-            return false;
-        }
-        let dx = grid.cell_size;
-        let inv_dx = 1.0 / dx;
-        // A stencil node is at most 1.5·√3 cells from its particle.
-        let reach = Vec3::splat(2.6 * dx);
-        let shapes = &self.shapes;
-        masks
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .map(|(ci, out)| {
-                let mut any = false;
-                for (k, mask) in out.iter_mut().enumerate() {
-                    let x = particles.positions[ci * CHUNK + k];
-                    for sh in shapes {
-                        if x.cmplt(sh.world_min - reach).any()
-                            || x.cmpgt(sh.world_max + reach).any()
-                        {
-                            continue;
-                        }
-                        let local = sh.inverse_rotation * (x - sh.world_position);
-                        // No segment to a stencil node (at most `reach` long) can touch a
-                        // solid farther away than that.
-                        if sh.sdf.distance_and_normal(local).0 > reach.x {
-                            continue;
-                        }
-                        let (base, _, _) =
-                            crate::math::quadratic_weights((x - grid.origin) * inv_dx);
-                        for bit in 0..27 {
-                            let (i, j, l) = (bit / 9, (bit / 3) % 3, bit % 3);
-                            let node = grid.origin
-                                + dx * Vec3::new(
-                                    (base[0] + i) as f32,
-                                    (base[1] + j) as f32,
-                                    (base[2] + l) as f32,
-                                );
-                            let node_local = sh.inverse_rotation * (node - sh.world_position);
-                            if sh.sdf.segment_hits(local, node_local) {
-                                *mask |= 1 << bit;
-                            }
-                        }
-                    }
-                    any |= *mask != 0;
-                }
-                any
-            })
-            .reduce(|| false, |a, b| a | b)
+        self.contact_pass(particles, Some(grid), 0.0, None, Some(masks))
+    }
+
+    fn forces_and_blocked_nodes(
+        &mut self,
+        particles: ParticleView<'_>,
+        grid: &GridSpec,
+        dt: f32,
+        forces: &mut [Vec3],
+        masks: &mut [u32],
+    ) -> bool {
+        self.contact_pass(particles, Some(grid), dt, Some(forces), Some(masks))
     }
 }

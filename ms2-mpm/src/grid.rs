@@ -124,6 +124,8 @@ pub(crate) struct GridStorage {
     pub bins: [usize; 3],
     /// Indices of storage blocks that particles may touch (sorted ascending).
     pub active: Vec<u32>,
+    /// Scratch of `set_active_from_bins`: one flag per storage block.
+    mark: Vec<bool>,
 }
 
 impl GridStorage {
@@ -136,6 +138,7 @@ impl GridStorage {
             padded_blocks,
             bins,
             active: Vec::new(),
+            mark: Vec::new(),
         }
     }
 
@@ -153,11 +156,14 @@ impl GridStorage {
     }
 
     /// Marks the storage blocks touched by the given non-empty particle bins.
-    pub fn set_active_from_bins(&mut self, bins: &[u32]) {
+    /// `bins` holds `(bin index, first particle, end particle)` as in `Binning::bins`.
+    pub fn set_active_from_bins(&mut self, bins: &[(u32, u32, u32)]) {
         let [_, by, bz] = self.bins;
         let [_, py, pz] = self.padded_blocks;
-        let mut mark = vec![false; self.padded_blocks.iter().product()];
-        for &b in bins {
+        let mark = &mut self.mark;
+        mark.clear();
+        mark.resize(self.padded_blocks.iter().product(), false);
+        for &(b, _, _) in bins {
             let b = b as usize;
             let (x, y, z) = (b / (by * bz), (b / bz) % by, b % bz);
             // Bin b covers nodes [4b − 1, 4b + 6]: storage blocks b .. b + 2 (padded).
@@ -169,11 +175,12 @@ impl GridStorage {
                 }
             }
         }
-        self.active = mark
-            .iter()
-            .enumerate()
-            .filter_map(|(i, &m)| m.then_some(i as u32))
-            .collect();
+        self.active.clear();
+        self.active.extend(
+            mark.iter()
+                .enumerate()
+                .filter_map(|(i, &m)| m.then_some(i as u32)),
+        );
     }
 
     /// Total mass (kg) on the active blocks (the only ones the last transfer wrote).
@@ -188,16 +195,13 @@ impl GridStorage {
             .sum()
     }
 
-    /// Zeroes every active block.
+    /// Zeroes every active block (on the calling thread: a memset, cheaper than waking
+    /// threads at the sizes this solver runs).
     pub fn clear_active(&mut self) {
-        let nodes = crate::parallel::SyncPtr::new(self.nodes.as_mut_ptr());
-        self.active.par_iter().for_each(|&b| {
+        for &b in &self.active {
             let start = b as usize * BLOCK_NODES;
-            // SAFETY: active block indices are distinct, so the ranges are disjoint, and they
-            // lie inside `nodes` by construction.
-            let block = unsafe { nodes.slice_mut(start, BLOCK_NODES) };
-            block.fill([0.0; 4]);
-        });
+            self.nodes[start..start + BLOCK_NODES].fill([0.0; 4]);
+        }
     }
 
     /// Turns momentum into velocity, adds gravity and applies the boundary conditions, on

@@ -6,9 +6,9 @@
 //!
 //! - [`MpmSolver`]: 3D MLS-MPM with APIC transfers and quadratic B-splines on a bounded regular
 //!   grid (f32, SI units, world frame with +z up). Particles are stored as a struct of arrays,
-//!   kept sorted by 4×4×4 grid bins; the transfers run in parallel over bins with rayon and
-//!   write the grid without atomics (eight colour phases), so results are bitwise identical
-//!   for any thread count. The kernels only read and write flat arrays, which leaves room for
+//!   kept sorted by 4×4×4 grid bins; the transfers run in parallel over runs of particles of
+//!   one bin with rayon, each into a private grid neighbourhood that is then added to the grid
+//!   in a fixed order (no atomics), so results are bitwise identical for any thread count. The kernels only read and write flat arrays, which leaves room for
 //!   a GPU compute backend with the same data layout.
 //! - [`Material`]: von Mises clay, weakly compressible water, fixed-corotated elastic solid.
 //! - [`sampling`]: particle sets from boxes, cylinders, mesh volumes and height maps.
@@ -25,12 +25,14 @@
 
 #![warn(missing_docs)]
 
+mod contact;
 pub mod coupling;
 pub mod error;
 pub mod grid;
+mod lanes;
 pub mod material;
 pub mod math;
-mod math_x4;
+mod math_x8;
 pub mod mesh;
 mod parallel;
 mod particles;

@@ -9,7 +9,7 @@
 #[derive(Clone, Copy)]
 pub(crate) struct SyncPtr<T>(*mut T);
 
-// SAFETY: the pointer is only dereferenced through `slice_mut`/`get_mut`, whose callers
+// SAFETY: the pointer is only dereferenced through `slice_mut`, whose callers
 // guarantee that concurrent accesses are disjoint.
 unsafe impl<T: Send> Send for SyncPtr<T> {}
 unsafe impl<T: Send> Sync for SyncPtr<T> {}
@@ -26,13 +26,5 @@ impl<T> SyncPtr<T> {
     #[allow(clippy::mut_from_ref)]
     pub unsafe fn slice_mut(&self, start: usize, len: usize) -> &mut [T] {
         std::slice::from_raw_parts_mut(self.0.add(start), len)
-    }
-
-    /// # Safety
-    /// `index` must lie within the buffer and no other live reference may alias it.
-    #[inline(always)]
-    #[allow(clippy::mut_from_ref)]
-    pub unsafe fn get_mut(&self, index: usize) -> &mut T {
-        &mut *self.0.add(index)
     }
 }

@@ -62,7 +62,11 @@ impl Particles {
     /// Reorders every array by `perm` (new[i] = old[perm[i]]).
     fn permute(&mut self, perm: &[u32]) {
         fn gather<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[u32]) {
-            let out: Vec<T> = perm.par_iter().map(|&p| v[p as usize]).collect();
+            let out: Vec<T> = if perm.len() >= PARALLEL_SORT_MIN {
+                perm.par_iter().map(|&p| v[p as usize]).collect()
+            } else {
+                perm.iter().map(|&p| v[p as usize]).collect()
+            };
             *v = out;
         }
         gather(&mut self.x, perm);
@@ -76,14 +80,19 @@ impl Particles {
     }
 }
 
-/// The partition of the sorted particles into bins, and the bins grouped into the eight
-/// colours whose members never write to the same grid node.
+/// Most particles one transfer work unit handles: bins holding more are split, so that a few
+/// crowded bins still spread over the threads. A constant (not derived from the thread count)
+/// so that the grid sums, and hence results, do not depend on the thread count.
+pub(crate) const MAX_UNIT_PARTICLES: u32 = 512;
+
+/// The partition of the sorted particles into bins, and into the work units of the transfers.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Binning {
     /// Non-empty bins, ascending: `(bin index, first particle, end particle)`.
     pub bins: Vec<(u32, u32, u32)>,
-    /// Indices into `bins` per colour (`(bx & 1) | (by & 1) << 1 | (bz & 1) << 2`).
-    pub colors: [Vec<u32>; 8],
+    /// Work units, in particle order: `(bin index, first particle, end particle)`, each a
+    /// whole bin or a run of at most [`MAX_UNIT_PARTICLES`] of one bin.
+    pub units: Vec<(u32, u32, u32)>,
 }
 
 /// Bin coordinates of the B-spline base node of a particle at `x`.
@@ -93,48 +102,82 @@ pub(crate) fn base_node(x: Vec3, origin: Vec3, inv_dx: f32) -> [i32; 3] {
     [fast_floor(g.x), fast_floor(g.y), fast_floor(g.z)]
 }
 
+/// Reusable buffers of [`sort_into_bins`].
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SortScratch {
+    keys: Vec<u32>,
+    counts: Vec<u32>,
+    perm: Vec<u32>,
+}
+
+/// Particle count below which sorting runs on the calling thread (the parallel key pass and
+/// gathers cost more in thread wake-ups than they save).
+const PARALLEL_SORT_MIN: usize = 16_384;
+
 /// Sorts the particles by bin (stable counting sort, so the result is deterministic) and
-/// returns the binning. `bins_per_axis` counts the bins covering the grid.
+/// rebuilds `binning`. `bins_per_axis` counts the bins covering the grid. Particles already
+/// in order (the common case between two sorts a few substeps apart) are not moved.
 pub(crate) fn sort_into_bins(
     p: &mut Particles,
     origin: Vec3,
     inv_dx: f32,
     bins_per_axis: [usize; 3],
-) -> Binning {
+    scratch: &mut SortScratch,
+    binning: &mut Binning,
+) {
     let [_, by, bz] = bins_per_axis;
     let nbins = bins_per_axis.iter().product::<usize>();
-    let keys: Vec<u32> =
-        p.x.par_iter()
-            .map(|&x| {
-                let b = base_node(x, origin, inv_dx);
-                let c = |a: usize| (b[a].max(0) as usize / BLOCK).min(bins_per_axis[a] - 1);
-                ((c(0) * by + c(1)) * bz + c(2)) as u32
-            })
-            .collect();
-    let mut counts = vec![0u32; nbins + 1];
-    for &k in &keys {
+    let key = |x: &Vec3| {
+        let b = base_node(*x, origin, inv_dx);
+        let c = |a: usize| (b[a].max(0) as usize / BLOCK).min(bins_per_axis[a] - 1);
+        ((c(0) * by + c(1)) * bz + c(2)) as u32
+    };
+    let keys = &mut scratch.keys;
+    keys.clear();
+    if p.len() >= PARALLEL_SORT_MIN {
+        p.x.par_iter().map(key).collect_into_vec(keys);
+    } else {
+        keys.extend(p.x.iter().map(key));
+    }
+    let counts = &mut scratch.counts;
+    counts.clear();
+    counts.resize(nbins + 1, 0);
+    for &k in keys.iter() {
         counts[k as usize + 1] += 1;
     }
     for i in 0..nbins {
         counts[i + 1] += counts[i];
     }
-    let starts = counts.clone();
-    let mut perm = vec![0u32; keys.len()];
-    let mut fill = counts;
-    for (i, &k) in keys.iter().enumerate() {
-        perm[fill[k as usize] as usize] = i as u32;
-        fill[k as usize] += 1;
+    if keys.windows(2).any(|w| w[0] > w[1]) {
+        let perm = &mut scratch.perm;
+        perm.clear();
+        perm.resize(keys.len(), 0);
+        // `counts[k]` runs from the start of bin k to its end while filling; restored below.
+        for (i, &k) in keys.iter().enumerate() {
+            perm[counts[k as usize] as usize] = i as u32;
+            counts[k as usize] += 1;
+        }
+        for i in (0..nbins).rev() {
+            counts[i + 1] = counts[i];
+        }
+        counts[0] = 0;
+        p.permute(perm);
     }
-    p.permute(&perm);
-    let mut binning = Binning::default();
+    binning.bins.clear();
+    binning.units.clear();
     for b in 0..nbins {
-        let (s, e) = (starts[b], starts[b + 1]);
+        let (s, e) = (counts[b], counts[b + 1]);
         if e > s {
-            let (x, y, z) = (b / (by * bz), (b / bz) % by, b % bz);
-            let color = (x & 1) | ((y & 1) << 1) | ((z & 1) << 2);
-            binning.colors[color].push(binning.bins.len() as u32);
             binning.bins.push((b as u32, s, e));
+            let pieces = (e - s).div_ceil(MAX_UNIT_PARTICLES);
+            // Equal pieces, so a bin of 513 particles is not split into 512 + 1.
+            let len = (e - s).div_ceil(pieces);
+            let mut start = s;
+            while start < e {
+                let end = (start + len).min(e);
+                binning.units.push((b as u32, start, end));
+                start = end;
+            }
         }
     }
-    binning
 }

@@ -5,8 +5,8 @@ use glam::{Mat3, Vec3};
 use crate::error::MpmError;
 use crate::grid::{Boundary, GridSpec, GridStorage};
 use crate::material::{CompiledMaterial, Material};
-use crate::particles::{sort_into_bins, Binning, ParticleId, Particles};
-use crate::transfer::{grid_to_particle, particle_to_grid, TransferParams};
+use crate::particles::{sort_into_bins, Binning, ParticleId, Particles, SortScratch};
+use crate::transfer::{grid_to_particle, particle_to_grid, TransferParams, TransferScratch};
 
 /// Index of a material registered with [`MpmSolver::add_material`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -60,6 +60,21 @@ pub trait ParticleForces {
     ) -> bool {
         false
     }
+
+    /// [`Self::particle_forces`] then [`Self::blocked_nodes`] (what the solver calls each
+    /// substep); implementors may override it to do both in one pass over the particles.
+    /// `forces` and `masks` are zeroed on entry. Returns whether any mask bit was set.
+    fn forces_and_blocked_nodes(
+        &mut self,
+        particles: ParticleView<'_>,
+        grid: &GridSpec,
+        dt: f32,
+        forces: &mut [Vec3],
+        masks: &mut [u32],
+    ) -> bool {
+        self.particle_forces(particles, dt, forces);
+        self.blocked_nodes(particles, grid, masks)
+    }
 }
 
 /// Read-only view of the particles, in the solver's current order.
@@ -96,6 +111,8 @@ pub struct MpmSolver {
     compiled: Vec<CompiledMaterial>,
     particles: Particles,
     binning: Binning,
+    sort_scratch: SortScratch,
+    transfer_scratch: TransferScratch,
     grid: GridStorage,
     needs_sort: bool,
     /// No particle moved since the last sort.
@@ -152,6 +169,8 @@ impl MpmSolver {
             compiled: Vec::new(),
             particles: Particles::default(),
             binning: Binning::default(),
+            sort_scratch: SortScratch::default(),
+            transfer_scratch: TransferScratch::default(),
             needs_sort: true,
             freshly_sorted: false,
             forces: Vec::new(),
@@ -365,10 +384,15 @@ impl MpmSolver {
                 masses: &p.mass,
                 ids: &p.id,
             };
-            ext.particle_forces(view, dt, &mut self.forces);
             self.blocked.clear();
             self.blocked.resize(self.particles.len(), 0);
-            has_blocked = ext.blocked_nodes(view, &self.config.grid, &mut self.blocked);
+            has_blocked = ext.forces_and_blocked_nodes(
+                view,
+                &self.config.grid,
+                dt,
+                &mut self.forces,
+                &mut self.blocked,
+            );
         }
         self.grid.clear_active();
         let params = TransferParams {
@@ -379,7 +403,13 @@ impl MpmSolver {
             blocked: has_blocked.then_some(&self.blocked[..]),
             gravity: self.config.gravity,
         };
-        particle_to_grid(&params, &mut self.particles, &self.binning, &mut self.grid);
+        particle_to_grid(
+            &params,
+            &mut self.particles,
+            &self.binning,
+            &mut self.grid,
+            &mut self.transfer_scratch,
+        );
         self.grid.update_velocities(
             &self.config.grid,
             &self.config.boundary,
@@ -407,14 +437,15 @@ impl MpmSolver {
     /// Sorts the particles into bins now (stable counting sort) and rebuilds the binning.
     fn sort_particles(&mut self) {
         let inv_dx = 1.0 / self.config.grid.cell_size;
-        self.binning = sort_into_bins(
+        sort_into_bins(
             &mut self.particles,
             self.config.grid.origin,
             inv_dx,
             self.grid.bins,
+            &mut self.sort_scratch,
+            &mut self.binning,
         );
-        let bins: Vec<u32> = self.binning.bins.iter().map(|b| b.0).collect();
-        self.grid.set_active_from_bins(&bins);
+        self.grid.set_active_from_bins(&self.binning.bins);
         self.needs_sort = false;
         self.freshly_sorted = true;
     }

@@ -1,17 +1,19 @@
-//! The MLS-MPM transfers (APIC, quadratic B-splines), parallel over particle bins.
+//! The MLS-MPM transfers (APIC, quadratic B-splines), parallel over work units (runs of
+//! particles of one bin, see [`Binning::units`]).
 //!
-//! Particle-to-grid runs in eight colour phases: bins of one colour are at least one bin apart
-//! along some axis, so their grid neighbourhoods (nodes `4b − 1 .. 4b + 6` per axis) are
-//! disjoint and each bin adds its local accumulation to the grid without atomics. Within a bin
-//! particles are visited in order, and colours in a fixed order, so results are bitwise
-//! independent of the thread count.
+//! Particle-to-grid runs in two passes: all units in parallel update their particles'
+//! deformation gradients and accumulate mass and momentum into a private copy of their bin's
+//! grid neighbourhood (nodes `4b − 1 .. 4b + 6` per axis); then the copies are added to the
+//! grid one after the other, in unit order. One parallel region per transfer (not one per bin
+//! colour) and every unit busy at once, whatever the number of bins; and since the sums run
+//! in a fixed order, results are bitwise independent of the thread count.
 
-use glam::{Mat3, Vec3};
+use glam::{Mat3, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::grid::{GridSpec, GridStorage, BLOCK};
 use crate::material::CompiledMaterial;
-use crate::math::{quadratic_weights, svd3_x4, Svd3};
+use crate::math::{quadratic_weights, svd3_x8, Svd3};
 use crate::parallel::SyncPtr;
 use crate::particles::{Binning, Particles};
 
@@ -26,7 +28,15 @@ const IDENTITY_SVD: Svd3 = Svd3 {
     v: Mat3::IDENTITY,
 };
 
-type LocalGrid = [[f32; 4]; LOCAL_NODES];
+/// A bin's grid neighbourhood: momentum or velocity (xyz) and mass (w) per node, in SIMD
+/// registers.
+type LocalGrid = [Vec4; LOCAL_NODES];
+
+/// Reusable per-unit local grids of particle-to-grid.
+#[derive(Default)]
+pub(crate) struct TransferScratch {
+    locals: Vec<LocalGrid>,
+}
 
 #[inline(always)]
 fn local_index(i: usize, j: usize, k: usize) -> usize {
@@ -71,106 +81,127 @@ pub(crate) fn particle_to_grid(
     p: &mut Particles,
     binning: &Binning,
     grid: &mut GridStorage,
+    scratch: &mut TransferScratch,
+) {
+    let units = &binning.units;
+    if scratch.locals.len() < units.len() {
+        scratch
+            .locals
+            .resize(units.len(), [Vec4::ZERO; LOCAL_NODES]);
+    }
+    let bins = grid.bins;
+    let f_ptr = SyncPtr::new(p.f.as_mut_ptr());
+    // Read-only view of F for the trial update; each F is overwritten only after its read.
+    let p_f: &[Mat3] = unsafe { std::slice::from_raw_parts(p.f.as_ptr(), p.f.len()) };
+    let p = &*p;
+    units
+        .par_iter()
+        .zip(scratch.locals[..units.len()].par_iter_mut())
+        .for_each(|(&(bin, start, end), local)| {
+            local.fill(Vec4::ZERO);
+            let corner = bin_corner(bin, bins);
+            // SAFETY: units own disjoint particle ranges and each F is written once, after
+            // its last read.
+            let f_out = unsafe { f_ptr.slice_mut(start as usize, (end - start) as usize) };
+            accumulate_unit(prm, p, p_f, start as usize, f_out, corner, local);
+        });
+    for (&(bin, _, _), local) in units.iter().zip(&scratch.locals) {
+        let corner = bin_corner(bin, bins);
+        for i in 0..LOCAL {
+            for j in 0..LOCAL {
+                for k in 0..LOCAL {
+                    let l = local[local_index(i, j, k)];
+                    if l.w == 0.0 {
+                        continue;
+                    }
+                    let g = grid.index(
+                        corner[0] + i as i32,
+                        corner[1] + j as i32,
+                        corner[2] + k as i32,
+                    );
+                    let node = &mut grid.nodes[g];
+                    *node = (Vec4::from_array(*node) + l).to_array();
+                }
+            }
+        }
+    }
+}
+
+/// Particle-to-grid of one unit (particles `first .. first + f_out.len()`) into `local`, the
+/// unit's neighbourhood starting at real node `corner`; writes the projected F to `f_out`.
+fn accumulate_unit(
+    prm: &TransferParams<'_>,
+    p: &Particles,
+    p_f: &[Mat3],
+    first: usize,
+    f_out: &mut [Mat3],
+    corner: [i32; 3],
+    local: &mut LocalGrid,
 ) {
     let dx = prm.spec.cell_size;
     let inv_dx = 1.0 / dx;
     let origin = prm.spec.origin;
     let dt = prm.dt;
     let stress_scale = -dt * 4.0 * inv_dx * inv_dx;
-    let bins = grid.bins;
-    let f_ptr = SyncPtr::new(p.f.as_mut_ptr());
-    // Read-only view of F for the trial update; each F is overwritten only after its read.
-    let p_f: &[Mat3] = unsafe { std::slice::from_raw_parts(p.f.as_ptr(), p.f.len()) };
     let (x, v, c, mass, volume, material) = (&p.x, &p.v, &p.c, &p.mass, &p.volume, &p.material);
-    let grid_ptr = SyncPtr::new(grid.nodes.as_mut_ptr());
-    let grid_ref = &*grid;
-    for color in &binning.colors {
-        color.par_iter().for_each(|&bi| {
-            let (bin, start, end) = binning.bins[bi as usize];
-            let corner = bin_corner(bin, bins);
-            let mut local: LocalGrid = [[0.0; 4]; LOCAL_NODES];
-            // Particles go in groups of four so that their SVDs run in the SIMD lanes.
-            for group in (start as usize..end as usize).step_by(4) {
-                let n = (end as usize - group).min(4);
-                let mut trial = [Mat3::IDENTITY; 4];
-                let mut any_svd = false;
-                for (l, t) in trial.iter_mut().enumerate().take(n) {
-                    let pi = group + l;
-                    *t = (Mat3::IDENTITY + dt * c[pi]) * p_f[pi];
-                    any_svd |= prm.materials[material[pi] as usize].needs_svd();
-                }
-                let svds = if any_svd {
-                    svd3_x4(&trial)
-                } else {
-                    [IDENTITY_SVD; 4]
-                };
-                for l in 0..n {
-                    let pi = group + l;
-                    let mat = &prm.materials[material[pi] as usize];
-                    let (f_new, tau) = mat.project_and_stress_svd(trial[l], &svds[l]);
-                    // SAFETY: bins own disjoint particle ranges and each F is written once,
-                    // after its last read above.
-                    unsafe { *f_ptr.get_mut(pi) = f_new };
-                    let (base, fx, w) = quadratic_weights((x[pi] - origin) * inv_dx);
-                    let m = mass[pi];
-                    let affine = (stress_scale * volume[pi]) * tau + m * c[pi];
-                    let mut mv = m * v[pi];
-                    if let Some(forces) = prm.forces {
-                        mv += dt * forces[pi];
-                    }
-                    // Momentum at node offset (i, j, k): mv + affine·((i, j, k) − fx)·dx.
-                    let a = affine * dx;
-                    let m0 = mv - a * fx;
-                    let blocked = prm.blocked.map_or(0, |b| b[pi]);
-                    let o = [
-                        (base[0] - corner[0]) as usize,
-                        (base[1] - corner[1]) as usize,
-                        (base[2] - corner[2]) as usize,
-                    ];
-                    for i in 0..3 {
-                        let mi = m0 + a.x_axis * i as f32;
-                        for j in 0..3 {
-                            let mij = mi + a.y_axis * j as f32;
-                            let wij = w[0][i] * w[1][j];
-                            let row = local_index(o[0] + i, o[1] + j, o[2]);
-                            for k in 0..3 {
-                                if blocked != 0 && blocked & (1 << ((i * 3 + j) * 3 + k)) != 0 {
-                                    continue;
-                                }
-                                let wt = wij * w[2][k];
-                                let mom = (mij + a.z_axis * k as f32) * wt;
-                                let node = &mut local[row + k];
-                                node[0] += mom.x;
-                                node[1] += mom.y;
-                                node[2] += mom.z;
-                                node[3] += wt * m;
-                            }
-                        }
-                    }
-                }
+    let end = first + f_out.len();
+    // Particles go in groups of eight so that their SVDs run in the SIMD lanes.
+    for group in (first..end).step_by(8) {
+        let n = (end - group).min(8);
+        let mut trial = [Mat3::IDENTITY; 8];
+        let mut any_svd = false;
+        for (l, t) in trial.iter_mut().enumerate().take(n) {
+            let pi = group + l;
+            *t = (Mat3::IDENTITY + dt * c[pi]) * p_f[pi];
+            any_svd |= prm.materials[material[pi] as usize].needs_svd();
+        }
+        let svds = if any_svd {
+            svd3_x8(&trial)
+        } else {
+            [IDENTITY_SVD; 8]
+        };
+        for l in 0..n {
+            let pi = group + l;
+            let mat = &prm.materials[material[pi] as usize];
+            let (f_new, tau) = mat.project_and_stress_svd(trial[l], &svds[l]);
+            f_out[pi - first] = f_new;
+            let (base, fx, w) = quadratic_weights((x[pi] - origin) * inv_dx);
+            let m = mass[pi];
+            let affine = (stress_scale * volume[pi]) * tau + m * c[pi];
+            let mut mv = m * v[pi];
+            if let Some(forces) = prm.forces {
+                mv += dt * forces[pi];
             }
-            for i in 0..LOCAL {
-                for j in 0..LOCAL {
-                    for k in 0..LOCAL {
-                        let l = local[local_index(i, j, k)];
-                        if l[3] == 0.0 {
+            // Momentum at node offset (i, j, k): mv + affine·((i, j, k) − fx)·dx; the mass
+            // rides in the w lane (the affine columns have w = 0).
+            let a = affine * dx;
+            let m0 = (mv - a * fx).extend(m);
+            let (ax, ay, az) = (
+                a.x_axis.extend(0.0),
+                a.y_axis.extend(0.0),
+                a.z_axis.extend(0.0),
+            );
+            let blocked = prm.blocked.map_or(0, |b| b[pi]);
+            let o = [
+                (base[0] - corner[0]) as usize,
+                (base[1] - corner[1]) as usize,
+                (base[2] - corner[2]) as usize,
+            ];
+            for i in 0..3 {
+                let mi = m0 + ax * i as f32;
+                for j in 0..3 {
+                    let mij = mi + ay * j as f32;
+                    let wij = w[0][i] * w[1][j];
+                    let row = local_index(o[0] + i, o[1] + j, o[2]);
+                    for k in 0..3 {
+                        if blocked != 0 && blocked & (1 << ((i * 3 + j) * 3 + k)) != 0 {
                             continue;
                         }
-                        let g = grid_ref.index(
-                            corner[0] + i as i32,
-                            corner[1] + j as i32,
-                            corner[2] + k as i32,
-                        );
-                        // SAFETY: same-colour bins have disjoint neighbourhoods (see module
-                        // docs), and phases of different colours do not overlap in time.
-                        let node = unsafe { grid_ptr.get_mut(g) };
-                        for e in 0..4 {
-                            node[e] += l[e];
-                        }
+                        local[row + k] += (mij + az * k as f32) * (wij * w[2][k]);
                     }
                 }
             }
-        });
+        }
     }
 }
 
@@ -202,19 +233,21 @@ pub(crate) fn grid_to_particle(
     let v_ptr = SyncPtr::new(p.v.as_mut_ptr());
     let c_ptr = SyncPtr::new(p.c.as_mut_ptr());
     let (needs_sort, diverged) = binning
-        .bins
+        .units
         .par_iter()
         .map(|&(bin, start, end)| {
             let corner = bin_corner(bin, bins);
-            let mut local: LocalGrid = [[0.0; 4]; LOCAL_NODES];
+            let mut local: LocalGrid = [Vec4::ZERO; LOCAL_NODES];
             for i in 0..LOCAL {
                 for j in 0..LOCAL {
                     for k in 0..LOCAL {
-                        local[local_index(i, j, k)] = grid.nodes[grid.index(
-                            corner[0] + i as i32,
-                            corner[1] + j as i32,
-                            corner[2] + k as i32,
-                        )];
+                        local[local_index(i, j, k)] = Vec4::from_array(
+                            grid.nodes[grid.index(
+                                corner[0] + i as i32,
+                                corner[1] + j as i32,
+                                corner[2] + k as i32,
+                            )],
+                        );
                     }
                 }
             }
@@ -236,40 +269,44 @@ pub(crate) fn grid_to_particle(
                     (base[1] - corner[1]) as usize,
                     (base[2] - corner[2]) as usize,
                 ];
-                let mut vel = Vec3::ZERO;
-                // Σ w·v·(i, j, k)ᵀ, as three columns.
-                let mut b = [Vec3::ZERO; 3];
                 let pi = start + q;
                 let blocked = prm.blocked.map_or(0, |bl| bl[pi]);
                 // Blocked nodes stand in with the particle's own update (its velocity plus
                 // gravity and its external force), so it is not dragged across the surface.
                 let own = if blocked != 0 {
                     let f = prm.forces.map_or(Vec3::ZERO, |f| f[pi]);
-                    vs[q] + dt * (prm.gravity + f / mass[pi])
+                    (vs[q] + dt * (prm.gravity + f / mass[pi])).extend(0.0)
                 } else {
-                    Vec3::ZERO
+                    Vec4::ZERO
                 };
+                let node = |index: usize, bit: usize| {
+                    if blocked != 0 && blocked & (1 << bit) != 0 {
+                        own
+                    } else {
+                        local[index]
+                    }
+                };
+                // Σ w·v, and Σ w·v·i, Σ w·v·j, Σ w·v·k (xyz lanes; w carries no meaning).
+                let (mut vel, mut bi, mut bj, mut bk) =
+                    (Vec4::ZERO, Vec4::ZERO, Vec4::ZERO, Vec4::ZERO);
                 for i in 0..3 {
                     for j in 0..3 {
-                        let wij = w[0][i] * w[1][j];
                         let row = local_index(o[0] + i, o[1] + j, o[2]);
-                        for k in 0..3 {
-                            let wt = wij * w[2][k];
-                            let n = local[row + k];
-                            let node_v =
-                                if blocked != 0 && blocked & (1 << ((i * 3 + j) * 3 + k)) != 0 {
-                                    own
-                                } else {
-                                    Vec3::new(n[0], n[1], n[2])
-                                };
-                            let gv = node_v * wt;
-                            vel += gv;
-                            b[0] += gv * i as f32;
-                            b[1] += gv * j as f32;
-                            b[2] += gv * k as f32;
-                        }
+                        let bit = (i * 3 + j) * 3;
+                        let g1 = node(row + 1, bit + 1) * w[2][1];
+                        let g2 = node(row + 2, bit + 2) * w[2][2];
+                        let wij = w[0][i] * w[1][j];
+                        let r = (node(row, bit) * w[2][0] + g1 + g2) * wij;
+                        vel += r;
+                        bi += r * i as f32;
+                        bj += r * j as f32;
+                        bk += (g1 + g2 * 2.0) * wij;
                     }
                 }
+                let (vel, b) = (
+                    vel.truncate(),
+                    [bi.truncate(), bj.truncate(), bk.truncate()],
+                );
                 // C = 4/dx² Σ w v (x_i − x_p)ᵀ with x_i − x_p = ((i, j, k) − fx)·dx.
                 let s = 4.0 * inv_dx;
                 cs[q] = Mat3::from_cols(

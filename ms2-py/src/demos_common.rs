@@ -1,7 +1,7 @@
 //! Helpers shared by the demonstration bindings (`demos_solve`, `demos_replay`): episodes
 //! to/from Python dicts and a sized rayon pool (env configs come from `config::config_from_kwargs`).
 
-use ms2_tasks::demos::{DemoEpisode, DemoError};
+use ms2_tasks::demos::{DemoEpisode, DemoError, StateRecording};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -58,15 +58,26 @@ pub fn rows_from_py(array: &PyReadonlyArray2<'_, f32>) -> Vec<Vec<f32>> {
 
 /// An episode as the dict the Python side writes to trajectory files:
 /// `{"episode_seed", "control_mode", "actions" f32[T,A], "env_states" f32[T+1,S],
-/// "success" bool[T], "elapsed_steps", "info"}`.
+/// "success" bool[T], "elapsed_steps", "info"}`; a soft-body episode
+/// ([`StateRecording::InitialOnly`]) has `"env_init_state"` f32[S] instead of `"env_states"`.
 pub fn episode_to_py<'py>(py: Python<'py>, ep: &DemoEpisode) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
     dict.set_item("env_id", &ep.env_id)?;
     dict.set_item("episode_seed", ep.episode_seed)?;
     dict.set_item("control_mode", &ep.control_mode)?;
     dict.set_item("actions", rows_to_py(py, &ep.actions, 0)?)?;
-    let state_len = ep.env_states.first().map_or(0, Vec::len);
-    dict.set_item("env_states", rows_to_py(py, &ep.env_states, state_len)?)?;
+    match ep.state_recording {
+        StateRecording::EveryStep => {
+            let state_len = ep.env_states.first().map_or(0, Vec::len);
+            dict.set_item("env_states", rows_to_py(py, &ep.env_states, state_len)?)?;
+        }
+        StateRecording::InitialOnly => {
+            dict.set_item(
+                "env_init_state",
+                PyArray1::from_slice(py, ep.env_init_state()),
+            )?;
+        }
+    }
     dict.set_item("success", PyArray1::from_slice(py, &ep.success))?;
     dict.set_item("elapsed_steps", ep.elapsed_steps)?;
     dict.set_item("info", info_to_py(py, &ep.info)?)?;
@@ -74,14 +85,24 @@ pub fn episode_to_py<'py>(py: Python<'py>, ep: &DemoEpisode) -> PyResult<Bound<'
 }
 
 /// An episode from a dict with the keys of [`episode_to_py`] (`info` is ignored: replay
-/// recomputes it). Arrays must be float32 / bool numpy arrays.
+/// recomputes it): `"env_init_state"` (float32 [S]) makes a soft-body episode, else
+/// `"env_states"` is required. Arrays must be float32 / bool numpy arrays.
 pub fn episode_from_py(env_id: &str, dict: &Bound<'_, PyDict>) -> PyResult<DemoEpisode> {
     let get = |key: &str| {
         dict.get_item(key)?
             .ok_or_else(|| PyValueError::new_err(format!("episode dict has no key {key:?}")))
     };
     let actions: PyReadonlyArray2<'_, f32> = get("actions")?.extract()?;
-    let env_states: PyReadonlyArray2<'_, f32> = get("env_states")?.extract()?;
+    let (env_states, state_recording) = match dict.get_item("env_init_state")? {
+        Some(init) => {
+            let init: PyReadonlyArray1<'_, f32> = init.extract()?;
+            (vec![init.as_array().to_vec()], StateRecording::InitialOnly)
+        }
+        None => {
+            let states: PyReadonlyArray2<'_, f32> = get("env_states")?.extract()?;
+            (rows_from_py(&states), StateRecording::EveryStep)
+        }
+    };
     let success: PyReadonlyArray1<'_, bool> = get("success")?.extract()?;
     let actions = rows_from_py(&actions);
     Ok(DemoEpisode {
@@ -90,10 +111,39 @@ pub fn episode_from_py(env_id: &str, dict: &Bound<'_, PyDict>) -> PyResult<DemoE
         control_mode: get("control_mode")?.extract()?,
         elapsed_steps: u32::try_from(actions.len()).unwrap_or(u32::MAX),
         actions,
-        env_states: rows_from_py(&env_states),
+        env_states,
+        state_recording,
         success: success.as_array().to_vec(),
         info: Vec::new(),
     })
+}
+
+/// The keyword arguments that rebuild env `env_id` made with `env_kwargs`, as a trajectory
+/// file's `env_info` records them, resolved by making the env: `{"obs_mode", "control_mode",
+/// "reward_mode", "sim_freq", "control_freq", "max_episode_steps"}` plus `"mpm_freq"` (Hz) for
+/// soft-body envs. `ValueError` for an unknown id or bad `env_kwargs`.
+#[pyfunction]
+#[pyo3(signature = (env_id, env_kwargs=None))]
+pub fn recorded_env_kwargs<'py>(
+    py: Python<'py>,
+    env_id: String,
+    env_kwargs: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let cfg = crate::config::config_from_kwargs(&env_id, env_kwargs)?;
+    let resolved = py.detach(|| {
+        crate::errors::catch_panics(|| Ok(ms2_tasks::make_env(&cfg)?.config().clone()))
+    })?;
+    let dict = PyDict::new(py);
+    dict.set_item("obs_mode", &resolved.obs_mode)?;
+    dict.set_item("control_mode", &resolved.control_mode)?;
+    dict.set_item("reward_mode", &resolved.reward_mode)?;
+    dict.set_item("sim_freq", resolved.sim_freq)?;
+    dict.set_item("control_freq", resolved.control_freq)?;
+    dict.set_item("max_episode_steps", resolved.max_episode_steps)?;
+    if let Some(hz) = resolved.mpm_freq {
+        dict.set_item("mpm_freq", hz)?;
+    }
+    Ok(dict)
 }
 
 /// Runs `f` on a rayon pool of `num_workers` threads (at least 1).

@@ -12,8 +12,9 @@ use crate::demos_common::{demo_error_to_py, episode_from_py, episode_to_py, in_p
 use crate::errors::catch_panics;
 
 /// Replays each episode of `episodes` (dicts with `episode_seed`, `control_mode`, `actions`
-/// float32 [T, A], `env_states` float32 [T+1, S], `success` bool [T]) of env `env_id` made with
-/// `env_kwargs`, on `num_workers` threads with the GIL released.
+/// float32 [T, A], `env_states` float32 [T+1, S] or, for soft-body episodes, `env_init_state`
+/// float32 [S], `success` bool [T]) of env `env_id` made with `env_kwargs`, on `num_workers`
+/// threads with the GIL released.
 ///
 /// `target_control_mode` (`None` = each episode's own) converts actions closed-loop;
 /// `use_env_states` restores the recorded states after every step; `record_obs` collects the

@@ -83,5 +83,6 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(demos_replay::replay_episodes, m)?)?;
     m.add_function(wrap_pyfunction!(demos_scripted::scripted_episodes, m)?)?;
     m.add_function(wrap_pyfunction!(demos_solve::solution_env_ids, m)?)?;
+    m.add_function(wrap_pyfunction!(demos_common::recorded_env_kwargs, m)?)?;
     Ok(())
 }

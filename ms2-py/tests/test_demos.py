@@ -235,7 +235,16 @@ def test_missing_truncated_and_foreign_files_give_clear_errors(demo_file, tmp_pa
     soft_meta = json.loads(text_json)
     soft_meta["episodes"] = soft_meta["episodes"][:1]
     soft.with_suffix(".json").write_text(json.dumps(soft_meta))
-    with open_trajectory(soft) as traj, pytest.raises(TrajectoryFileError, match="soft-body"):
+    # The soft-body layout opens; a state of another length than the env's cannot replay.
+    with open_trajectory(soft) as traj:
+        episode = traj.read_episode(0)
+    assert "env_states" not in episode and episode["env_init_state"].shape == (5,)
+    with pytest.raises(TrajectoryFileError, match=r"soft.h5: traj_0: env_init_state has shape"):
+        replay(soft, progress=False)
+    with h5py.File(soft, "a") as f:
+        del f["traj_0/env_init_state"]
+        f.create_dataset("traj_0/env_init_state", data=np.zeros((2, 5), np.float32))
+    with open_trajectory(soft) as traj, pytest.raises(TrajectoryFileError, match="soft.h5: traj_0"):
         traj.read_episode(0)
 
     fewer = tmp_path / "fewer.h5"

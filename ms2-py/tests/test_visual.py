@@ -189,3 +189,84 @@ def test_make_vec_visual_autoreset_renders_the_new_episode():
     # A new episode (seed drawn from each env's generator): the cube moved, so the cloud differs.
     assert not np.array_equal(obs["pointcloud"]["xyzw"], first["pointcloud"]["xyzw"])
     venv.close()
+
+
+SOFT_TASKS = [i for i in ("Excavate-v0", "Fill-v0") if i in ms2.env_ids()]
+
+
+@pytest.mark.parametrize("env_id", SOFT_TASKS)
+@pytest.mark.parametrize("obs_mode", VISUAL_MODES)
+def test_soft_tasks_step_in_every_visual_mode(env_id, obs_mode):
+    env = gym.make(env_id, obs_mode=obs_mode, camera_cfgs={"width": 32, "height": 32})
+    obs, _ = env.reset(seed=0)
+    assert obs in env.observation_space
+    obs, *_ = env.step(np.zeros(env.action_space.shape, dtype=np.float32))
+    assert obs in env.observation_space
+    env.close()
+
+
+def _clay_points(env_id: str, seed: int):
+    """(points, rgb, ids) of the clay in a pointcloud_robot_seg observation, and the particles.
+
+    The clay is the segmentation object (channel 1) whose points lie on the particles of the
+    same episode (an env in obs mode ``particles`` with the same seed)."""
+    env = gym.make(env_id, obs_mode="pointcloud_robot_seg")
+    obs, _ = env.reset(seed=seed)
+    twin = gym.make(env_id, obs_mode="particles")
+    particles = twin.reset(seed=seed)[0]["particles"]["x"]
+    cloud = obs["pointcloud"]
+    valid = cloud["xyzw"][:, 3] == 1
+    xyz, ids = cloud["xyzw"][valid, :3], cloud["Segmentation"][valid]
+    # Distance from each point to its nearest particle centre.
+    nearest = np.min(np.linalg.norm(xyz[:, None, :] - particles[None, ::2, :], axis=2), axis=1)
+    on_clay = nearest < 0.008
+    clay_id = np.bincount(ids[on_clay, 1]).argmax()
+    clay = ids[:, 1] == clay_id
+    assert not cloud["robot_seg"][valid][clay].any(), "clay points are not robot"
+    assert len(np.unique(ids[clay, 0])) == 1, "the clay is one visual id"
+    return xyz[clay], cloud["rgb"][valid][clay], particles
+
+
+def test_excavate_point_cloud_shows_the_clay_bed():
+    xyz, rgb, particles = _clay_points("Excavate-v0", seed=2)
+    assert len(xyz) > 300
+    # Every clay point lies on a particle's sphere (radius 4 mm at 5 mm spacing).
+    nearest = np.min(np.linalg.norm(xyz[:, None, :] - particles[None, :, :], axis=2), axis=1)
+    assert nearest.max() < 0.0055
+    # Seen from above: the bed's top surface, terracotta (red over blue).
+    assert xyz[:, 2].max() > np.percentile(particles[:, 2], 90)
+    assert rgb[:, 0].mean() > rgb[:, 2].mean() + 30
+
+
+def test_fill_point_cloud_shows_the_clay_in_the_bucket():
+    xyz, _rgb, particles = _clay_points("Fill-v0", seed=3)
+    assert len(xyz) > 50
+    assert np.linalg.norm(xyz.mean(axis=0) - particles.mean(axis=0)) < 0.03
+
+
+def test_soft_render_rgb_array_shows_the_clay():
+    env = gym.make("Excavate-v0", render_mode="rgb_array")
+    env.reset(seed=2)
+    image = env.render().astype(int)
+    env.close()
+    # Terracotta pixels (red well above green and blue) where the bed lies.
+    clay = (image[..., 0] > image[..., 1] + 40) & (image[..., 0] > image[..., 2] + 60)
+    assert clay.sum() > 200
+
+
+def test_make_vec_soft_env_images_equal_single_env_images():
+    cfgs = {"width": 48, "height": 48}
+    venv = ms2.make_vec("Excavate-v0", num_envs=2, obs_mode="rgbd", camera_cfgs=cfgs)
+    venv.reset(seed=[8, 9])
+    actions = np.full((2, *venv.single_action_space.shape), 0.2, dtype=np.float32)
+    stepped, *_ = venv.step(actions)
+    venv.close()
+    for k in range(2):
+        env = gym.make("Excavate-v0", obs_mode="rgbd", camera_cfgs=cfgs)
+        env.reset(seed=8 + k)
+        after, *_ = env.step(actions[k])
+        env.close()
+        for cam in CAMERAS:
+            for key in ("rgb", "depth"):
+                got, alone = stepped["image"][cam][key][k], after["image"][cam][key]
+                np.testing.assert_array_equal(got, alone)

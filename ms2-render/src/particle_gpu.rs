@@ -4,8 +4,8 @@
 
 use crate::renderer::{instance_only_buffer_layout, DEPTH_FORMAT};
 
-/// Vertices per particle (two triangles, no index buffer).
-pub(crate) const VERTICES_PER_PARTICLE: u32 = 6;
+/// Vertices per particle (a two-triangle strip, no index buffer).
+pub(crate) const VERTICES_PER_PARTICLE: u32 = 4;
 
 /// Particle pipelines for the camera pass and the shadow pass.
 pub(crate) struct ParticleGpu {
@@ -25,7 +25,7 @@ impl ParticleGpu {
     ) -> ParticleGpu {
         let buffers = instance_only_buffer_layout();
         let primitive = wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
+            topology: wgpu::PrimitiveTopology::TriangleStrip,
             cull_mode: None,
             ..Default::default()
         };

@@ -159,13 +159,9 @@ struct ParticleOut {
     @location(3) @interpolate(flat) ids: vec4<u32>,
 };
 
-// Corners of the two triangles of a quad, in units of the radius.
+// Corner `k` (0..4) of a quad drawn as a triangle strip, in units of the radius.
 fn quad_corner(k: u32) -> vec2<f32> {
-    var corners = array<vec2<f32>, 6>(
-        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
-        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0),
-    );
-    return corners[k];
+    return vec2<f32>(select(-1.0, 1.0, (k & 1u) != 0u), select(-1.0, 1.0, k >= 2u));
 }
 
 fn particle_sphere(p: ParticleIn) -> vec4<f32> {

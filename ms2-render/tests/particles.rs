@@ -258,3 +258,55 @@ fn bad_particles_give_typed_errors() {
         "{err}"
     );
 }
+
+/// With shadows on, a floating slab of particles shades the ground under it (the particle
+/// shadow pass draws disks facing the light), and its spheres are lit from above.
+#[test]
+fn particles_cast_shadows_when_enabled() {
+    let (mut scene, clay) = scene_with_particles();
+    scene.lighting = Lighting {
+        ambient: [0.2; 3],
+        directional: vec![DirectionalLight {
+            direction_world: Vector3::new(0.0, 0.0, -1.0),
+            color: [0.8; 3],
+        }],
+        background: [0.0; 3],
+        shadow: None,
+    };
+    // A 6 × 6 cm slab, one particle thick, 0.2 m above the ground at x = −0.1.
+    let slab: Vec<[f32; 3]> = slab(0.03, SPACING)
+        .into_iter()
+        .map(|p| [p[0] - 0.1, p[1], 0.2])
+        .collect();
+    scene.set_particle_positions(clay, slab).unwrap();
+    let camera = Camera::new(96, 96, 1.2, 0.01, 10.0).looking_at(
+        Point3::new(0.4, 0.0, 0.15),
+        Point3::new(-0.05, 0.0, 0.0),
+        Vector3::z(),
+    );
+    let r = renderer();
+    let ground_brightness = |out: &CameraOutput, world: Point3<f32>| {
+        let uv = out.intrinsic_cv() * (out.extrinsic_cv() * world.to_homogeneous());
+        let i = (uv.y / uv.z).round() as usize * 96 + (uv.x / uv.z).round() as usize;
+        assert_eq!(out.segmentation_link[i], 1, "expected ground at {world:?}");
+        out.rgb[3 * i] as i32
+    };
+    let (under, beside) = (Point3::new(-0.1, 0.0, 0.0), Point3::new(0.1, 0.0, 0.0));
+    let lit = &r.render(&[(&scene, &[camera][..])]).unwrap()[0];
+    assert!((ground_brightness(lit, under) - ground_brightness(lit, beside)).abs() <= 2);
+    scene.lighting.shadow = Some(Shadow {
+        center_world: Vector3::zeros(),
+        radius_m: 0.5,
+        resolution: 256,
+    });
+    let shadowed = &r.render(&[(&scene, &[camera][..])]).unwrap()[0];
+    let (dark, bright) = (
+        ground_brightness(shadowed, under),
+        ground_brightness(shadowed, beside),
+    );
+    assert!(
+        dark + 40 < bright,
+        "under the slab {dark}, beside it {bright}"
+    );
+    assert!(clay_pixels(shadowed) > 20, "the slab is seen");
+}

@@ -1,8 +1,12 @@
 //! Demonstration replay and closed-loop conversion (`ms2_tasks::demos`), on PickCube /
-//! StackCube episodes recorded from the scripted oracle in the source control mode.
+//! StackCube episodes recorded from the scripted oracle in the source control mode, and on short
+//! soft-body (Fill-v0) episodes, which keep only their initial state.
 
-use ms2_tasks::demos::{replay_episode, scripted_episode, DemoEpisode, DemoError, ReplayOptions};
-use ms2_tasks::{make_env, EnvConfig, EnvError};
+use ms2_tasks::demos::{
+    replay_episode, scripted_episode, DemoEpisode, DemoError, EpisodeRecorder, ReplayOptions,
+    StateRecording,
+};
+use ms2_tasks::{make_env, make_scripted_policy, EnvConfig, EnvError};
 
 fn cfg(env_id: &str, control_mode: &str) -> EnvConfig {
     EnvConfig {
@@ -246,4 +250,103 @@ fn failed_conversions_of_successful_sources_are_retried() {
     assert_eq!(retried.attempts, 3);
     // 10 settle steps after a successful source.
     assert!((5 + 10..=20 + 10).contains(&retried.episode.actions.len()));
+}
+
+/// The first `steps` steps of the scripted Fill-v0 policy in `control_mode` for `seed`, recorded
+/// as a soft-body episode, with every state it went through (taken separately).
+fn soft_episode(control_mode: &str, seed: u64, steps: usize) -> (DemoEpisode, Vec<Vec<f32>>) {
+    let mut env = make_env(&cfg("Fill-v0", control_mode)).unwrap();
+    let mut policy = make_scripted_policy(&env).unwrap();
+    let (mut recorder, _) = EpisodeRecorder::reset(&mut env, seed).unwrap();
+    policy.reset(&env);
+    let mut states = vec![env.get_state()];
+    for _ in 0..steps {
+        let action = policy.act(&env);
+        recorder.step(&mut env, &action).unwrap();
+        states.push(env.get_state());
+    }
+    let episode = recorder.finish();
+    episode.validate().unwrap();
+    (episode, states)
+}
+
+/// The state `episode` (a soft-body one) ends in: its initial state restored after the reset,
+/// then its actions stepped.
+fn final_state(episode: &DemoEpisode) -> Vec<f32> {
+    let mut env = make_env(&cfg(&episode.env_id, &episode.control_mode)).unwrap();
+    env.reset(Some(episode.episode_seed), false).unwrap();
+    env.set_state(episode.env_init_state()).unwrap();
+    for action in &episode.actions {
+        env.step(action).unwrap();
+    }
+    env.get_state()
+}
+
+#[test]
+fn soft_episodes_keep_only_the_initial_state_and_replay_bit_for_bit() {
+    let (episode, states) = soft_episode("pd_joint_delta_pos", 3, 5);
+    assert_eq!(episode.state_recording, StateRecording::InitialOnly);
+    assert_eq!(episode.env_states.len(), 1);
+    assert_eq!(episode.env_init_state(), states[0].as_slice());
+    assert_eq!(episode.actions.len(), 5);
+    let out = replay(&episode, ReplayOptions::default()).unwrap();
+    assert_eq!(out.episode.state_recording, StateRecording::InitialOnly);
+    assert_eq!(out.episode.env_states, episode.env_states);
+    assert_eq!(out.episode.success, episode.success);
+    assert_eq!(out.episode.actions, episode.actions);
+    // The replay ends where the recording did, to the bit (and the clay moved meanwhile).
+    assert_eq!(&final_state(&out.episode), states.last().unwrap());
+    assert_ne!(states[0], states[5]);
+
+    let err = replay(
+        &episode,
+        ReplayOptions {
+            use_env_states: true,
+            ..ReplayOptions::default()
+        },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, DemoError::InvalidOptions(ref m) if m.contains("env_init_state")),
+        "{err}"
+    );
+    // An initial state of another length (e.g. ManiSkill2's layout) is refused by name.
+    let mut foreign = episode.clone();
+    foreign.env_states[0].truncate(100);
+    let err = replay(&foreign, ReplayOptions::default()).unwrap_err();
+    assert!(
+        matches!(err, DemoError::InvalidEpisode { ref reason, .. }
+            if reason.contains("env_init_state has 100 values") && reason.contains("ManiSkill2")),
+        "{err}"
+    );
+    // Per-step states in a soft-body episode break its invariant.
+    let mut mixed = episode.clone();
+    mixed.env_states = states.clone();
+    assert!(mixed.validate().is_err());
+}
+
+#[test]
+fn soft_conversion_resimulates_the_source_like_recorded_states_would() {
+    let (episode, states) = soft_episode("pd_joint_delta_pos", 1, 4);
+    // The same episode with every state kept, as a rigid-body recording would hold it.
+    let every_step = DemoEpisode {
+        env_states: states,
+        state_recording: StateRecording::EveryStep,
+        ..episode.clone()
+    };
+    every_step.validate().unwrap();
+    for target in ["pd_ee_delta_pose", "pd_joint_pos"] {
+        let opts = ReplayOptions {
+            target_control_mode: Some(target.to_owned()),
+            ..ReplayOptions::default()
+        };
+        let converted = replay(&episode, opts.clone()).unwrap().episode;
+        assert_eq!(converted.control_mode, target);
+        assert_eq!(converted.state_recording, StateRecording::InitialOnly);
+        assert_eq!(converted.env_states, episode.env_states);
+        assert!(converted.actions.len() >= episode.actions.len());
+        // Source targets read from the re-simulated source equal those from recorded states.
+        let from_states = replay(&every_step, opts).unwrap().episode;
+        assert_eq!(converted.actions, from_states.actions, "{target}");
+    }
 }

@@ -7,6 +7,13 @@ would. Observations are ``state`` by default; ``ms2 bench --visual`` measures th
 modes (``rgbd`` and ``pointcloud``, ManiSkill2's two 128×128 cameras) and also prints the
 triangles drawn per camera and the render adapter. Every row shows the 1-minute load average
 at its start, since other processes on the machine change the figures.
+
+``--policy scripted`` drives single envs with the task's scripted solution instead of random
+actions (the soft-body tasks need it to move clay). The soft-body comparison with the paper is
+``ms2 bench --visual --env-id Excavate-v0 --policy scripted --obs-modes state,rgbd`` (and the
+same for ``Fill-v0``): it prints the render cost per env step, the difference between the rgbd
+and state rows in wall-clock and in process CPU time (which other processes' load does not
+inflate).
 """
 
 from __future__ import annotations
@@ -29,6 +36,17 @@ MANISKILL2_PEAK_RSS_MB = 336.0
 #: ManiSkill2 0.5.3, same machine, PickCube-v0 single env in rgbd / pointcloud (lavapipe, 2
 #: cameras 128×128: base_camera + hand_camera): ~18 steps/s in both.
 MANISKILL2_VISUAL_STEPS_PER_S = 18.0
+#: The ManiSkill2 paper (appendix, MPM parameters): "for all soft body environments with
+#: rendering, a single environment runs at around 17-18 FPS" (RTX Titan GPU).
+MANISKILL2_SOFT_RENDER_STEPS_PER_S = 17.5
+#: Envs whose peer figure is the paper's soft-body one.
+SOFT_ENV_IDS = ("Excavate-v0", "Fill-v0")
+
+
+def _cpu_seconds() -> float:
+    """This process's CPU time (user + system, all threads) in seconds."""
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
 
 
 def _peak_rss_mb() -> float:
@@ -41,27 +59,40 @@ def _random_actions(low: np.ndarray, high: np.ndarray, count: int, seed: int) ->
     return rng.uniform(low, high, size=(count, *low.shape)).astype(np.float32)
 
 
-def _run_single(env_id: str, control_mode: str, obs_mode: str, steps: int) -> dict:
+def _run_single(env_id: str, control_mode: str, obs_mode: str, steps: int, policy: str) -> dict:
     import gymnasium as gym
 
-    import ms2  # noqa: F401  (registers the envs)
+    import ms2
 
     env = gym.make(env_id, obs_mode=obs_mode, control_mode=control_mode)
     space = env.action_space
     actions = _random_actions(space.low, space.high, 1024, seed=1)
-    env.reset(seed=0)
+    scripted = ms2.ScriptedPolicy(env) if policy == "scripted" else None
+
+    def reset(seed: int | None = None) -> None:
+        env.reset(seed=seed)
+        if scripted is not None:
+            scripted.reset()
+
+    def action(i: int) -> np.ndarray:
+        return scripted.act() if scripted is not None else actions[i % len(actions)]
+
+    reset(seed=0)
     for i in range(10):  # warm-up
-        env.step(actions[i])
-    env.reset(seed=1)
+        env.step(action(i))
+    reset(seed=1)
+    cpu_started = _cpu_seconds()
     started = time.perf_counter()
     for i in range(steps):
-        _obs, _reward, terminated, truncated, _info = env.step(actions[i % len(actions)])
+        _obs, _reward, terminated, truncated, _info = env.step(action(i))
         if terminated or truncated:
-            env.reset()
+            reset()
     elapsed = time.perf_counter() - started
+    cpu = _cpu_seconds() - cpu_started
     return {
         "steps_per_s": steps / elapsed,
         "seconds": elapsed,
+        "cpu_ms_per_step": 1e3 * cpu / steps,
         "env_steps": steps,
         "triangles_per_camera": env.unwrapped._native.triangles_per_camera(),
     }
@@ -78,13 +109,16 @@ def _run_vec(env_id: str, control_mode: str, obs_mode: str, num_envs: int, steps
     for i in range(5):  # warm-up
         envs.step(actions[i])
     batches = max(1, steps // num_envs)
+    cpu_started = _cpu_seconds()
     started = time.perf_counter()
     for i in range(batches):
         envs.step(actions[i % len(actions)])
     elapsed = time.perf_counter() - started
+    cpu = _cpu_seconds() - cpu_started
     return {
         "steps_per_s": batches * num_envs / elapsed,
         "seconds": elapsed,
+        "cpu_ms_per_step": 1e3 * cpu / (batches * num_envs),
         "env_steps": batches * num_envs,
         "triangles_per_camera": envs._native.triangles_per_camera(),
     }
@@ -94,7 +128,8 @@ def _worker(args: argparse.Namespace) -> int:
     spec = json.loads(args.worker)
     obs_mode = spec.get("obs_mode", "state")
     if spec["kind"] == "single":
-        result = _run_single(spec["env_id"], spec["control_mode"], obs_mode, spec["steps"])
+        policy = spec.get("policy", "random")
+        result = _run_single(spec["env_id"], spec["control_mode"], obs_mode, spec["steps"], policy)
     else:
         result = _run_vec(
             spec["env_id"], spec["control_mode"], obs_mode, spec["num_envs"], spec["steps"]
@@ -164,7 +199,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     from . import _native
 
     print(
-        f"ms2 bench: {args.env_id}, obs_mode=state, random actions, 500 Hz physics / 20 Hz "
+        f"ms2 bench: {args.env_id}, obs_mode=state, {args.policy} actions, 500 Hz physics / 20 Hz "
         f"control, {os.cpu_count()} cores, vector pool {_native.num_threads()} threads, "
         f"{steps} env steps per row"
     )
@@ -184,7 +219,13 @@ def _cmd_bench(args: argparse.Namespace) -> int:
             f"{vs_peer:>12} {result['peak_rss_mb']:>11.0f}"
         )
 
-    specs = [{"control_mode": control_mode, "obs_mode": "state"} for control_mode in control_modes]
+    if args.policy == "scripted" and num_envs_list:
+        print("(--policy scripted drives single envs only: make_vec rows skipped)")
+        num_envs_list = []
+    specs = [
+        {"control_mode": control_mode, "obs_mode": "state", "policy": args.policy}
+        for control_mode in control_modes
+    ]
     rows = _run_rows(args.env_id, steps, specs, num_envs_list, state_row)
     print(
         "ManiSkill2 0.5.3 on this machine (single env): "
@@ -196,20 +237,27 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
-    """``ms2 bench --visual``: rgbd / pointcloud steps/s, memory and triangles per camera."""
+    """``ms2 bench --visual``: rgbd / pointcloud steps/s, memory and triangles per camera; with
+    a ``state`` obs mode among them, the render cost per env step."""
     from . import _native
 
-    steps = args.steps or 1000
+    soft = args.env_id in SOFT_ENV_IDS
+    steps = args.steps or (200 if soft else 1000)
     obs_modes = [m for m in args.obs_modes.split(",") if m]
     control_mode = (args.control_modes or "pd_joint_delta_pos").split(",")[0]
+    if args.policy == "scripted" and num_envs_list:
+        print("(--policy scripted drives single envs only: make_vec rows skipped)")
+        num_envs_list = []
+    peer = MANISKILL2_SOFT_RENDER_STEPS_PER_S if soft else MANISKILL2_VISUAL_STEPS_PER_S
     print(
-        f"ms2 bench --visual: {args.env_id}, {control_mode}, random actions, 500 Hz physics / "
-        f"20 Hz control, cameras base_camera + hand_camera 128x128, {os.cpu_count()} cores, "
-        f"renderer {_native.render_adapter()}, {steps} env steps per row"
+        f"ms2 bench --visual: {args.env_id}, {control_mode}, {args.policy} actions, 500 Hz "
+        f"physics / 20 Hz control, cameras base_camera + hand_camera 128x128, "
+        f"{os.cpu_count()} cores, renderer {_native.render_adapter()}, {steps} env steps per row"
     )
     header = (
-        f"{'obs_mode':<11} {'runner':<18} {'steps/s':>9} {'x our single':>12} "
-        f"{'x MS2 single':>12} {'peak RSS MB':>11} {'triangles/cam':>13} {'load':>5}"
+        f"{'obs_mode':<11} {'runner':<18} {'steps/s':>9} {'cpu ms/step':>11} "
+        f"{'x our single':>12} {'x MS2 single':>12} {'peak RSS MB':>11} {'triangles/cam':>13} "
+        f"{'load':>5}"
     )
     print(header)
     print("-" * len(header))
@@ -217,20 +265,49 @@ def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
     def visual_row(spec: dict, result: dict, single: float) -> str:
         return (
             f"{spec['obs_mode']:<11} {_runner_name(spec['kind'], spec['num_envs']):<18} "
-            f"{result['steps_per_s']:>9.0f} {result['steps_per_s'] / single:>12.2f} "
-            f"{result['steps_per_s'] / MANISKILL2_VISUAL_STEPS_PER_S:>12.1f} "
+            f"{result['steps_per_s']:>9.1f} {result['cpu_ms_per_step']:>11.1f} "
+            f"{result['steps_per_s'] / single:>12.2f} "
+            f"{result['steps_per_s'] / peer:>12.2f} "
             f"{result['peak_rss_mb']:>11.0f} {result['triangles_per_camera']:>13}"
         )
 
-    specs = [{"control_mode": control_mode, "obs_mode": obs_mode} for obs_mode in obs_modes]
+    specs = [
+        {"control_mode": control_mode, "obs_mode": obs_mode, "policy": args.policy}
+        for obs_mode in obs_modes
+    ]
     rows = _run_rows(args.env_id, steps, specs, num_envs_list, visual_row)
-    print(
-        f"ManiSkill2 0.5.3 on this machine (single env, lavapipe, same cameras): rgbd and "
-        f"pointcloud ~{MANISKILL2_VISUAL_STEPS_PER_S:.0f} steps/s, peak RSS 336-480 MB; it draws "
-        f"the Panda's full visual meshes, ms2 draws the primitive shapes counted above"
-    )
+    _print_render_cost(rows)
+    if soft:
+        print(
+            f"ManiSkill2 paper: soft-body envs with rendering ~{peer:.1f} steps/s single env on "
+            f"an RTX Titan GPU (MPM on the GPU); ms2 runs MPM and rendering on the CPU cores above"
+        )
+    else:
+        print(
+            f"ManiSkill2 0.5.3 on this machine (single env, lavapipe, same cameras): rgbd and "
+            f"pointcloud ~{peer:.0f} steps/s, peak RSS 336-480 MB; it draws the Panda's full "
+            f"visual meshes, ms2 draws the primitive shapes counted above"
+        )
     _write_json(args.json, rows)
     return 0
+
+
+def _print_render_cost(rows: list[dict]) -> None:
+    """Prints, for each visual single-env row measured alongside a ``state`` one, the render
+    cost per env step: wall-clock and CPU ms/step of the visual row minus the state row's."""
+    singles = {r["obs_mode"]: r for r in rows if r["kind"] == "single"}
+    state = singles.get("state")
+    if state is None:
+        return
+    for obs_mode, row in singles.items():
+        if obs_mode == "state":
+            continue
+        wall = 1e3 / row["steps_per_s"] - 1e3 / state["steps_per_s"]
+        cpu = row["cpu_ms_per_step"] - state["cpu_ms_per_step"]
+        print(
+            f"render cost per env step ({obs_mode} minus state, single env): wall {wall:.1f} ms, "
+            f"CPU {cpu:.1f} ms"
+        )
 
 
 def _write_json(path: str | None, rows: list[dict]) -> None:
@@ -249,7 +326,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--steps",
         type=int,
         default=None,
-        help="env steps per configuration (default 4000; 1000 with --visual)",
+        help="env steps per configuration (default 4000; --visual: 1000, soft-body envs 200)",
     )
     p.add_argument(
         "--visual",
@@ -263,6 +340,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="comma-separated (default pd_ee_delta_pose,pd_joint_delta_pos; --visual: the first "
         "one given, else pd_joint_delta_pos)",
+    )
+    p.add_argument(
+        "--policy",
+        choices=["random", "scripted"],
+        default="random",
+        help="actions: uniform random (default) or the task's scripted solution (single envs)",
     )
     p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     p.add_argument("--worker", default=None, help=argparse.SUPPRESS)

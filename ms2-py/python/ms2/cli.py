@@ -126,6 +126,7 @@ def _cmd_demos_generate(args: argparse.Namespace) -> int:
         max_seeds=args.max_seeds,
         policy=args.policy,
         progress=not args.quiet,
+        control_mode=args.control_mode,
     )
     print(
         f"wrote {result.num_episodes} {args.env_id} episodes to {result.path} "
@@ -180,7 +181,7 @@ def _cmd_demos_bench(args: argparse.Namespace) -> int:
 def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("demos", help="generate demonstrations (trajectory files)")
     demos_sub = p.add_subparsers(dest="demos_command", required=True)
-    g = demos_sub.add_parser("generate", help="write successful pd_joint_pos demonstrations")
+    g = demos_sub.add_parser("generate", help="write successful demonstrations (trajectory files)")
     g.add_argument("env_id", help="task id, e.g. PickCube-v0")
     g.add_argument("-n", "--num-episodes", type=int, default=100)
     g.add_argument("-o", "--output", required=True, help="output .h5 (its .json is written too)")
@@ -192,6 +193,12 @@ def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
         choices=["solution", "scripted"],
         default="solution",
         help="motion-planning solution (default) or the scripted oracle",
+    )
+    g.add_argument(
+        "-c",
+        "--control-mode",
+        default="pd_joint_pos",
+        help="control mode of the demos (default pd_joint_pos; other modes: --policy scripted)",
     )
     g.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     g.set_defaults(func=_cmd_demos_generate)

@@ -9,6 +9,11 @@
   closed-loop to another control mode (ManiSkill2 paper, Sec. 2.2), and writing the result to
   ``X.<obs_mode>.<control_mode>.h5``.
 
+Soft-body envs (those with an ``mpm_freq``: Excavate-v0, Fill-v0) are written in ManiSkill2's
+soft-body layout: each episode keeps only ``env_init_state`` (the state after reset), and
+replays restore it after ``reset(seed)`` and step the actions (the simulation is
+deterministic); conversions re-simulate the source alongside.
+
 The simulation runs in Rust (``ms2._native.solve_episodes`` / ``scripted_episodes`` /
 ``replay_episodes``) with the GIL released, on a pool of ``num_workers`` threads.
 """
@@ -23,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _native
-from .trajectory import TrajectoryWriter, open_trajectory
+from .trajectory import TrajectoryFileError, TrajectoryWriter, is_soft_episode, open_trajectory
 
 #: Control mode the demonstration sources produce.
 SOURCE_CONTROL_MODE = "pd_joint_pos"
@@ -90,9 +95,13 @@ def generate(
     policy: str = "solution",
     chunk_size: int | None = None,
     progress: bool = True,
+    control_mode: str = SOURCE_CONTROL_MODE,
 ) -> GenerateResult:
-    """Writes ``num_episodes`` successful ``pd_joint_pos`` demonstrations of ``env_id`` to
-    ``output`` (``.h5``; the ``.json`` is written next to it).
+    """Writes ``num_episodes`` successful demonstrations of ``env_id`` to ``output`` (``.h5``;
+    the ``.json`` is written next to it), in ``pd_joint_pos`` (the motion-planning solutions'
+    mode) or, with ``policy="scripted"``, in ``control_mode`` (any position-based mode the
+    scripted oracle drives). Soft-body envs are written in the soft-body layout
+    (``env_init_state``) with their ``mpm_freq`` in ``env_kwargs``.
 
     Seeds ``seed, seed + 1, ...`` are tried in chunks of ``chunk_size`` (default
     ``4 * num_workers``) until ``num_episodes`` succeed or ``max_seeds`` (default
@@ -115,14 +124,20 @@ def generate(
             f"no motion-planning solution for {env_id!r}; envs with one: "
             f"{sorted(_native.solution_env_ids())} (or use policy='scripted')"
         )
+    if policy == "solution" and control_mode != SOURCE_CONTROL_MODE:
+        raise ValueError(
+            f"the motion-planning solutions act in {SOURCE_CONTROL_MODE!r}, not {control_mode!r} "
+            "(convert with ms2 replay, or use policy='scripted')"
+        )
     max_seeds = 4 * num_episodes + 20 if max_seeds is None else max_seeds
     chunk_size = chunk_size or 4 * num_workers
-    env_kwargs = {"obs_mode": "state", "control_mode": SOURCE_CONTROL_MODE}
+    env_kwargs = {"obs_mode": "state", "control_mode": control_mode}
     run = _native.solve_episodes if policy == "solution" else _native.scripted_episodes
+    recorded = dict(_native.recorded_env_kwargs(env_id, env_kwargs))
     env_info = {
         "env_id": env_id,
-        "max_episode_steps": int(_native.default_max_episode_steps(env_id)),
-        "env_kwargs": {**env_kwargs, "sim_freq": 500.0, "control_freq": 20.0},
+        "max_episode_steps": int(recorded.pop("max_episode_steps")),
+        "env_kwargs": recorded,
     }
     started, cpu_started = time.perf_counter(), time.process_time()
     result = GenerateResult(Path(output), 0, 0, 0, 0.0)
@@ -191,7 +206,9 @@ class ReplayResult(_PerEpisodeCost):
 
 
 def _write_video(env_id: str, env_kwargs: dict[str, Any], episode: dict[str, Any], path: Path):
-    """Renders each recorded state of ``episode`` (the human view) into an MP4 at ``path``."""
+    """Renders ``episode`` (the human view) into an MP4 at ``path``: each recorded state of a
+    rigid-body episode; a soft-body episode is re-simulated (its ``env_init_state`` restored
+    after the reset, then its actions stepped), rendering as it goes."""
     from .recording import write_video
 
     env = _native.NativeEnv(
@@ -204,11 +221,50 @@ def _write_video(env_id: str, env_kwargs: dict[str, Any], episode: dict[str, Any
         mpm_freq=env_kwargs.get("mpm_freq"),
     )
     env.reset(seed=int(episode["episode_seed"]))
+    fps = float(env_kwargs.get("control_freq", 20.0))
+    if is_soft_episode(episode):
+        env.set_state(episode["env_init_state"])
+
+        def frames() -> Iterator[Any]:
+            yield env.render()
+            for action in episode["actions"]:
+                env.step(action)
+                yield env.render()
+
+        return write_video(path, frames(), fps=fps)
     frames = []
     for state in episode["env_states"]:
         env.set_state(state)
         frames.append(env.render())
-    return write_video(path, frames, fps=float(env_kwargs.get("control_freq", 20.0)))
+    return write_video(path, frames, fps=fps)
+
+
+def _check_soft_episodes(traj: Any, indices: list[int], use_env_states: bool, kwargs: dict) -> None:
+    """Refuses, naming the file and episode, ``use_env_states`` on soft-body episodes and
+    ``env_init_state`` vectors whose length is not the env's state length."""
+    soft = [i for i in indices if traj.is_soft(i)]
+    if not soft:
+        return
+    name = f"traj_{traj.episodes[soft[0]]['episode_id']}"
+    if use_env_states:
+        raise ValueError(
+            f"{traj.path}: --use-env-states (use_env_states=True) restores per-step env_states, "
+            f"but {name} is a soft-body episode that stores only env_init_state (ManiSkill2's "
+            "soft-body layout); replay it without the option: the replay restores env_init_state "
+            "after reset(seed) and steps the actions, deterministically"
+        )
+    env = _native.NativeEnv(traj.env_id, **{**kwargs, "obs_mode": "state"})
+    env.reset(seed=0)
+    expected = len(env.get_state())
+    for i in soft:
+        length = traj.h5[f"traj_{traj.episodes[i]['episode_id']}"]["env_init_state"].shape
+        if length != (expected,):
+            raise TrajectoryFileError(
+                f"{traj.path}: traj_{traj.episodes[i]['episode_id']}: env_init_state has shape "
+                f"{length} but a {traj.env_id} state in ms2 has {expected} values; ms2's state "
+                "layout differs from ManiSkill2's, so ManiSkill2 soft-body trajectories open "
+                "(actions, success, env_init_state) but cannot be replayed in ms2 envs"
+            )
 
 
 def replay(
@@ -230,7 +286,8 @@ def replay(
         traj_path: the ``X.h5`` to replay (with its ``X.json``).
         obs_mode: record observations of this mode (``None``: none).
         target_control_mode: convert the actions closed-loop to this mode (``None``: keep).
-        use_env_states: restore the recorded state after every step (no conversion).
+        use_env_states: restore the recorded state after every step (no conversion; refused
+            for soft-body episodes, which store only ``env_init_state``).
         save_traj: write ``X.<obs_mode>.<control_mode>.h5`` (+ ``.json``).
         save_video: write one MP4 per episode to ``X.<obs_mode>.<control_mode>.videos/``.
         num_workers: native worker threads.
@@ -263,6 +320,11 @@ def replay(
         }
         native_kwargs["obs_mode"] = obs_mode or "state"
         native_kwargs["max_episode_steps"] = traj.env_info.get("max_episode_steps")
+        _check_soft_episodes(traj, list(range(len(episodes_meta))), use_env_states, native_kwargs)
+        if any(traj.is_soft(i) for i in range(len(episodes_meta))):
+            # Record the resolved MPM frequency (a foreign file may lack it).
+            resolved = _native.recorded_env_kwargs(traj.env_id, native_kwargs)
+            env_kwargs.setdefault("mpm_freq", resolved["mpm_freq"])
         output = replay_output_path(traj_path, obs_mode, out_mode)
         if save_traj and output.resolve() == Path(traj_path).resolve():
             raise ValueError(f"{traj_path}: the replayed copy would overwrite its source")

@@ -4,8 +4,10 @@
 ``render_mode="rgb_array"``) it renders one frame after ``reset`` and after every ``step`` (the
 512x512 human view, goal markers shown) and writes each finished episode to
 ``<output_dir>/<name_prefix>_<index>.mp4``. With ``save_trajectory`` it records each episode's
-actions, ``success`` flags and ``env.get_state()`` after reset and after every step, and appends
-it to ``<output_dir>/<trajectory_name>.h5`` + ``.json`` in ManiSkill2's layout (see
+actions, ``success`` flags and ``env.get_state()`` after reset and after every step (soft-body
+envs, those with an ``mpm_freq``: only after reset, as ManiSkill2's ``env_init_state``; their
+states hold every particle and replays re-simulate from it), and appends it to
+``<output_dir>/<trajectory_name>.h5`` + ``.json`` in ManiSkill2's layout (see
 :mod:`ms2.trajectory`), so ``ms2 replay`` can replay, re-observe and convert it. An episode is
 written when it ends (terminated or truncated), on the next ``reset``, or on ``close``; every file
 is written to a temporary name and renamed, so a partial file never carries the final name.
@@ -22,7 +24,9 @@ imageio-ffmpeg)::
 
 from __future__ import annotations
 
+import itertools
 import os
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -30,19 +34,22 @@ import gymnasium as gym
 import numpy as np
 
 
-def write_video(path: str | os.PathLike[str], frames: list[np.ndarray], fps: float) -> Path:
-    """Writes uint8 [H, W, 3] ``frames`` to an H.264 MP4 at ``path`` (temporary file, then
-    rename). Returns the path. Raises ``ValueError`` on empty or malformed frames and
-    ``ImportError`` (naming the ``video`` extra) without imageio-ffmpeg."""
+def write_video(path: str | os.PathLike[str], frames: Iterable[np.ndarray], fps: float) -> Path:
+    """Writes uint8 [H, W, 3] ``frames`` (a list, or any iterable: a generator streams them
+    without holding them all) to an H.264 MP4 at ``path`` (temporary file, then rename).
+    Returns the path. Raises ``ValueError`` on empty or malformed frames and ``ImportError``
+    (naming the ``video`` extra) without imageio-ffmpeg."""
     try:
         import imageio.v2 as imageio
     except ImportError as e:  # pragma: no cover - depends on the installation
         raise ImportError(
             "writing videos needs imageio and imageio-ffmpeg: pip install 'ms2[video]'"
         ) from e
-    if not frames:
+    frames = iter(frames)
+    first = next(frames, None)
+    if first is None:
         raise ValueError("no frames to write")
-    first = np.asarray(frames[0])
+    first = np.asarray(first)
     if first.ndim != 3 or first.shape[2] != 3 or first.dtype != np.uint8:
         raise ValueError(f"frames must be uint8 [H, W, 3], got {first.dtype} {first.shape}")
     if not (fps > 0 and np.isfinite(fps)):
@@ -52,7 +59,7 @@ def write_video(path: str | os.PathLike[str], frames: list[np.ndarray], fps: flo
     tmp = path.with_name(f".{path.stem}.tmp{os.getpid()}.mp4")
     writer = imageio.get_writer(tmp, fps=fps, codec="libx264", macro_block_size=16)
     try:
-        for frame in frames:
+        for frame in itertools.chain([first], frames):
             frame = np.asarray(frame)
             if frame.shape != first.shape or frame.dtype != np.uint8:
                 raise ValueError(
@@ -91,23 +98,37 @@ def _env_info(env: gym.Env) -> dict[str, Any]:
 
 
 class _EpisodeLog:
-    """Actions, success flags and states of the episode being recorded."""
+    """Actions, success flags and states of the episode being recorded (``soft``: the state
+    after reset only)."""
 
-    def __init__(self, episode_seed: int, first_state: np.ndarray) -> None:
+    def __init__(self, episode_seed: int, first_state: np.ndarray, soft: bool) -> None:
         self.episode_seed = episode_seed
+        self.soft = soft
         self.actions: list[np.ndarray] = []
         self.success: list[bool] = []
         self.env_states: list[np.ndarray] = [first_state]
         self.info: dict[str, Any] = {}
 
+    def record_step(self, env: gym.Env, action: Any, info: dict[str, Any]) -> None:
+        self.actions.append(np.asarray(action, dtype=np.float32))
+        self.success.append(bool(info.get("success", False)))
+        if not self.soft:
+            self.env_states.append(env.unwrapped.get_state())
+        self.info = dict(info)
+
     def as_episode(self, control_mode: str) -> dict[str, Any]:
         """The episode dict :meth:`ms2.trajectory.TrajectoryWriter.append` takes."""
+        states = (
+            {"env_init_state": np.asarray(self.env_states[0], dtype=np.float32)}
+            if self.soft
+            else {"env_states": np.stack(self.env_states).astype(np.float32)}
+        )
         return {
             "episode_seed": self.episode_seed,
             "control_mode": control_mode,
             "actions": np.asarray(self.actions, dtype=np.float32).reshape(len(self.actions), -1),
             "success": np.asarray(self.success, dtype=np.bool_),
-            "env_states": np.stack(self.env_states).astype(np.float32),
+            **states,
             "elapsed_steps": len(self.actions),
             "info": self.info,
         }
@@ -201,17 +222,18 @@ class RecordEpisode(gym.Wrapper):
         self._capture()
         if self.save_trajectory:
             unwrapped = self.env.unwrapped
-            self._log = _EpisodeLog(int(unwrapped.episode_seed), unwrapped.get_state())
+            self._log = _EpisodeLog(
+                int(unwrapped.episode_seed),
+                unwrapped.get_state(),
+                soft=getattr(unwrapped, "mpm_freq", None) is not None,
+            )
         return out
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         obs, reward, terminated, truncated, info = self.env.step(action)
         self._capture()
         if self._log is not None:
-            self._log.actions.append(np.asarray(action, dtype=np.float32))
-            self._log.success.append(bool(info.get("success", False)))
-            self._log.env_states.append(self.env.unwrapped.get_state())
-            self._log.info = dict(info)
+            self._log.record_step(self.env, action, info)
         if terminated or truncated:
             self.flush()
         return obs, reward, terminated, truncated, info

@@ -5,6 +5,9 @@
 * ``actions``: float32 ``[T, A]`` in the episode's control mode,
 * ``success``: bool ``[T]`` (``info["success"]`` after each step),
 * ``env_states``: float32 ``[T+1, S]`` (``env.get_state()`` after reset, then after each step),
+  for rigid-body envs; soft-body envs (``mpm_freq`` set: Excavate-v0, Fill-v0) store instead
+* ``env_init_state``: float32 ``[S]``, the state after reset only (ManiSkill2's soft-body
+  layout; a replay restores it after ``reset(seed)`` and steps the actions),
 * ``obs`` (optional): the observations ``[T+1, ...]``; a dict observation becomes nested groups
   (``obs/agent/qpos``, ...), an array observation (``state`` mode) one dataset.
 
@@ -23,6 +26,7 @@ complete version. Opening a missing, truncated or foreign file raises ``FileNotF
         writer.commit()                   # both files now hold every appended episode
     with open_trajectory("demos/PickCube-v0.h5") as traj:
         first = traj.read_episode(0)      # {"actions": ..., "env_states": ..., "success": ...}
+        # (soft-body episodes: "env_init_state" instead of "env_states")
 """
 
 from __future__ import annotations
@@ -37,14 +41,17 @@ from typing import Any
 import numpy as np
 
 ENV_INFO_KEYS = ("env_id", "max_episode_steps", "env_kwargs")
+#: Keys every JSON episode entry needs (``reset_kwargs`` is optional: older ManiSkill2 files lack
+#: it; it defaults to ``{"seed": episode_seed}``).
 EPISODE_KEYS = (
     "episode_id",
     "episode_seed",
-    "reset_kwargs",
     "control_mode",
     "elapsed_steps",
     "info",
 )
+#: Per-step states (rigid-body episodes) and the state after reset only (soft-body episodes).
+STATE_KEYS = ("env_states", "env_init_state")
 
 
 class TrajectoryFileError(ValueError):
@@ -102,13 +109,26 @@ def _read_obs(node: Any) -> Any:
     return node[()]
 
 
-def _check_episode_arrays(episode: Mapping[str, Any]) -> tuple[np.ndarray, ...]:
-    """The ``actions``, ``success`` and ``env_states`` of an episode dict, with their dtypes and
+def is_soft_episode(episode: Mapping[str, Any]) -> bool:
+    """Whether an episode dict is a soft-body one (``env_init_state``, no ``env_states``)."""
+    return "env_init_state" in episode and "env_states" not in episode
+
+
+def _check_episode_arrays(episode: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray, str, Any]:
+    """The ``actions``, ``success`` and state array of an episode dict with the state array's
+    name (``env_states`` [T+1, S] or, soft-body episodes, ``env_init_state`` [S]), dtypes and
     shapes checked (``ValueError`` naming the episode and the array otherwise)."""
     seed = episode.get("episode_seed", "?")
+    present = [k for k in STATE_KEYS if k in episode]
+    if len(present) != 1:
+        raise ValueError(
+            f"episode (seed {seed}): needs exactly one of env_states (rigid-body envs, [T+1, S]) "
+            f"and env_init_state (soft-body envs, [S]); it has {present or 'neither'}"
+        )
+    (state_key,) = present
     actions = np.asarray(episode["actions"])
     success = np.asarray(episode["success"])
-    states = np.asarray(episode["env_states"])
+    states = np.asarray(episode[state_key])
     if actions.ndim != 2 or actions.dtype != np.float32:
         raise ValueError(
             f"episode (seed {seed}): actions must be float32 [T, A], got {actions.dtype} "
@@ -120,12 +140,20 @@ def _check_episode_arrays(episode: Mapping[str, Any]) -> tuple[np.ndarray, ...]:
             f"episode (seed {seed}): success must be bool [{steps}], got {success.dtype} "
             f"{success.shape}"
         )
-    if states.ndim != 2 or states.shape[0] != steps + 1 or states.dtype != np.float32:
+    if state_key == "env_init_state":
+        if states.ndim != 1 or states.size == 0 or states.dtype != np.float32:
+            raise ValueError(
+                f"episode (seed {seed}): env_init_state must be float32 [S] (one state), got "
+                f"{states.dtype} {states.shape}"
+            )
+        if not np.isfinite(states).all():
+            raise ValueError(f"episode (seed {seed}): env_init_state holds non-finite values")
+    elif states.ndim != 2 or states.shape[0] != steps + 1 or states.dtype != np.float32:
         raise ValueError(
             f"episode (seed {seed}): env_states must be float32 [{steps + 1}, S], got "
             f"{states.dtype} {states.shape}"
         )
-    return actions, success, states
+    return actions, success, state_key, states
 
 
 class TrajectoryWriter:
@@ -174,16 +202,17 @@ class TrajectoryWriter:
 
     def append(self, episode: Mapping[str, Any], obs: Any = None) -> int:
         """Adds one episode (a dict with ``episode_seed``, ``control_mode``, ``actions``,
-        ``env_states``, ``success``, ``elapsed_steps``, ``info``; optional ``reset_kwargs``) and
-        its observations ``[T+1, ...]`` (optional). Returns its ``episode_id``."""
-        actions, success, states = _check_episode_arrays(episode)
+        ``env_states`` — or ``env_init_state`` for a soft-body episode —, ``success``,
+        ``elapsed_steps``, ``info``; optional ``reset_kwargs``) and its observations
+        ``[T+1, ...]`` (optional). Returns its ``episode_id``."""
+        actions, success, state_key, states = _check_episode_arrays(episode)
         episode_id = len(self.episodes)
         group = self._working_file().create_group(f"traj_{episode_id}")
         group.create_dataset("actions", data=actions)
         group.create_dataset("success", data=success)
-        group.create_dataset("env_states", data=states)
+        group.create_dataset(state_key, data=states)
         if obs is not None:
-            _write_obs(group, "obs", obs, states.shape[0])
+            _write_obs(group, "obs", obs, actions.shape[0] + 1)
         seed = int(episode["episode_seed"])
         self.episodes.append(
             {
@@ -255,23 +284,31 @@ class Trajectory:
     def env_id(self) -> str:
         return str(self.env_info["env_id"])
 
+    def is_soft(self, index: int) -> bool:
+        """Whether episode ``index`` is a soft-body one (stores ``env_init_state`` only)."""
+        group = self.h5[f"traj_{self.episodes[index]['episode_id']}"]
+        return "env_init_state" in group and "env_states" not in group
+
     def read_episode(self, index: int, with_obs: bool = False) -> dict[str, Any]:
         """Episode ``index`` (position in the JSON list): its JSON entry plus ``actions``
-        (float32 [T, A]), ``success`` (bool [T]), ``env_states`` (float32 [T+1, S]) and, with
+        (float32 [T, A]), ``success`` (bool [T]), ``env_states`` (float32 [T+1, S]) — or, for a
+        soft-body episode, ``env_init_state`` (float32 [S], the state after reset) — and, with
         ``with_obs``, ``obs`` (``None`` when the file has none)."""
         meta = self.episodes[index]
         name = f"traj_{meta['episode_id']}"
         group = self.h5[name]
-        if "env_states" not in group and "env_init_state" in group:
+        state_key = "env_states" if "env_states" in group else "env_init_state"
+        if state_key not in group:
             raise TrajectoryFileError(
-                f"{self.path}: {name} stores only env_init_state (a soft-body trajectory); ms2 "
-                "reads rigid-body trajectories with per-step env_states"
+                f"{self.path}: episode {name} has neither env_states (rigid-body layout) nor "
+                "env_init_state (soft-body layout)"
             )
         try:
             out = dict(meta)
+            out.setdefault("reset_kwargs", {"seed": meta["episode_seed"]})
             out["actions"] = np.asarray(group["actions"][()], dtype=np.float32)
             out["success"] = np.asarray(group["success"][()], dtype=np.bool_)
-            out["env_states"] = np.asarray(group["env_states"][()], dtype=np.float32)
+            out[state_key] = np.asarray(group[state_key][()], dtype=np.float32)
             if with_obs:
                 out["obs"] = _read_obs(group["obs"]) if "obs" in group else None
         except (KeyError, OSError) as e:
@@ -355,6 +392,7 @@ __all__ = [
     "Trajectory",
     "TrajectoryFileError",
     "TrajectoryWriter",
+    "is_soft_episode",
     "json_path_of",
     "open_trajectory",
 ]

@@ -244,6 +244,33 @@ pub struct ParticleVisual {
     pub radius_m: f32,
     /// Linear RGB colour, each channel in `[0, 1]`.
     pub rgb: [f32; 3],
+    /// `Some(s)` when the particles are a dense packing of spacing `s` m (MPM particles) and
+    /// `radius_m > s / √2`: particles enclosed by neighbours on all sides are then not drawn
+    /// (`sensors::particle_culling`). `None` draws every particle.
+    pub packing_spacing_m: Option<f32>,
+}
+
+impl ParticleVisual {
+    /// Checks the radius (finite, > 0) and the packing spacing (finite, > 0 and below √2 × the
+    /// radius, so that neighbouring spheres hide enclosed particles).
+    pub fn validate(&self) -> Result<(), EnvError> {
+        if !(self.radius_m.is_finite() && self.radius_m > 0.0) {
+            return Err(EnvError::InvalidConfig(format!(
+                "particle set {:?}: radius {} m must be finite and > 0",
+                self.name, self.radius_m
+            )));
+        }
+        if let Some(s) = self.packing_spacing_m {
+            if !(s.is_finite() && s > 0.0 && self.radius_m > s * std::f32::consts::FRAC_1_SQRT_2) {
+                return Err(EnvError::InvalidConfig(format!(
+                    "particle set {:?}: packing spacing {s} m must be finite, > 0 and below \
+                     √2 × the radius {} m (so neighbouring spheres hide enclosed particles)",
+                    self.name, self.radius_m
+                )));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// A render [`Scene`] mirroring a physics [`World`]'s visual shapes.
@@ -455,5 +482,48 @@ fn source_pose(world: &World, source: PoseSource) -> Result<Pose3, EnvError> {
     match source {
         PoseSource::Body(body) => world.body_pose(body).map_err(physics),
         PoseSource::Link(art, link) => world.link_pose(art, link).map_err(physics),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn particle_visuals_are_validated() {
+        let clay = ParticleVisual {
+            name: "clay".to_owned(),
+            radius_m: 0.004,
+            rgb: [0.5, 0.3, 0.2],
+            packing_spacing_m: Some(0.005),
+        };
+        assert!(clay.validate().is_ok());
+        let no_culling = ParticleVisual {
+            packing_spacing_m: None,
+            ..clay.clone()
+        };
+        assert!(no_culling.validate().is_ok());
+        for bad in [
+            ParticleVisual {
+                radius_m: 0.0,
+                ..clay.clone()
+            },
+            ParticleVisual {
+                radius_m: f32::NAN,
+                ..clay.clone()
+            },
+            // 3 mm spheres at 5 mm spacing leave gaps: enclosed particles could be seen.
+            ParticleVisual {
+                radius_m: 0.003,
+                ..clay.clone()
+            },
+            ParticleVisual {
+                packing_spacing_m: Some(-1.0),
+                ..clay.clone()
+            },
+        ] {
+            let err = bad.validate().unwrap_err().to_string();
+            assert!(err.contains("\"clay\""), "{err}");
+        }
     }
 }

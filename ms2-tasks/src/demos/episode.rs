@@ -6,11 +6,37 @@ use crate::env::{Env, StepOutput};
 use crate::info::{info_get, Info, InfoValue};
 use crate::obs::ObsValue;
 
+/// Which env states a [`DemoEpisode`] keeps (ManiSkill2's two trajectory layouts).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StateRecording {
+    /// The state after reset and after every step (`env_states` `[T+1][S]`): rigid-body envs.
+    #[default]
+    EveryStep,
+    /// Only the state after reset (`env_states` `[1][S]`, written as ManiSkill2's
+    /// `env_init_state`): soft-body envs, whose states hold every particle (~100 k floats) and
+    /// whose replay restores that state and steps the actions (the simulation is deterministic).
+    InitialOnly,
+}
+
+impl StateRecording {
+    /// How episodes of `env` are recorded: [`StateRecording::InitialOnly`] for soft-body envs
+    /// (those with an MPM frequency, `env.config().mpm_freq`), else
+    /// [`StateRecording::EveryStep`].
+    pub fn for_env(env: &Env) -> Self {
+        if env.config().mpm_freq.is_some() {
+            Self::InitialOnly
+        } else {
+            Self::EveryStep
+        }
+    }
+}
+
 /// One episode in ManiSkill2's trajectory layout (row-major, float32 like the `.h5` file).
 ///
 /// Invariants (checked by [`DemoEpisode::validate`]): `actions`, `success` have `T =
-/// elapsed_steps` rows, `env_states` has `T + 1`, rows of one array have equal lengths, and every
-/// value is finite.
+/// elapsed_steps` rows, `env_states` has `T + 1` rows ([`StateRecording::EveryStep`]) or one
+/// ([`StateRecording::InitialOnly`]), rows of one array have equal lengths, and every value is
+/// finite.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DemoEpisode {
     /// Registered env id, e.g. `"PickCube-v0"`.
@@ -21,8 +47,11 @@ pub struct DemoEpisode {
     pub control_mode: String,
     /// Actions `[T][A]`, one per env step, in `control_mode`'s units.
     pub actions: Vec<Vec<f32>>,
-    /// Env states `[T+1][S]`: [`crate::Env::get_state`] after reset, then after each step.
+    /// Env states: [`crate::Env::get_state`] after reset, then (with
+    /// [`StateRecording::EveryStep`]) after each step: `[T+1][S]`, or `[1][S]`.
     pub env_states: Vec<Vec<f32>>,
+    /// Which states `env_states` holds.
+    pub state_recording: StateRecording,
     /// `info["success"]` after each step `[T]`.
     pub success: Vec<bool>,
     /// Number of env steps (`== actions.len()`).
@@ -36,6 +65,12 @@ impl DemoEpisode {
     /// conversion must preserve).
     pub fn succeeded(&self) -> bool {
         self.success.last() == Some(&true)
+    }
+
+    /// The state after reset (ManiSkill2's `env_init_state`); empty only for an episode that
+    /// fails [`DemoEpisode::validate`].
+    pub fn env_init_state(&self) -> &[f32] {
+        self.env_states.first().map_or(&[], Vec::as_slice)
     }
 
     /// Checks the layout invariants (see the type docs); the error names the array and the
@@ -58,12 +93,21 @@ impl DemoEpisode {
                 self.success.len()
             )));
         }
-        if self.env_states.len() != steps + 1 {
-            return Err(invalid(format!(
-                "env_states has {} rows, expected actions + 1 = {}",
-                self.env_states.len(),
-                steps + 1
-            )));
+        let rows = match self.state_recording {
+            StateRecording::EveryStep => steps + 1,
+            StateRecording::InitialOnly => 1,
+        };
+        if self.env_states.len() != rows {
+            return Err(invalid(match self.state_recording {
+                StateRecording::EveryStep => format!(
+                    "env_states has {} rows, expected actions + 1 = {rows}",
+                    self.env_states.len()
+                ),
+                StateRecording::InitialOnly => format!(
+                    "a soft-body episode keeps only env_init_state (1 state), got {} states",
+                    self.env_states.len()
+                ),
+            }));
         }
         check_rows("actions", &self.actions).map_err(invalid)?;
         check_rows("env_states", &self.env_states).map_err(invalid)
@@ -90,7 +134,8 @@ fn check_rows(name: &str, rows: &[Vec<f32>]) -> Result<(), String> {
 }
 
 /// Records a [`DemoEpisode`] while an env is stepped: the state after reset, then action,
-/// state and success of every step.
+/// success and (rigid-body envs only, see [`StateRecording::for_env`]) state of every step.
+/// A soft-body episode thus holds one state whatever its length.
 ///
 /// ```
 /// use ms2_tasks::demos::EpisodeRecorder;
@@ -120,6 +165,7 @@ impl EpisodeRecorder {
                 control_mode: env.control_mode().to_owned(),
                 actions: Vec::new(),
                 env_states: vec![env.get_state()],
+                state_recording: StateRecording::for_env(env),
                 success: Vec::new(),
                 elapsed_steps: 0,
                 info,
@@ -131,7 +177,7 @@ impl EpisodeRecorder {
     /// Steps `env` with `action` and records the step.
     pub fn step(&mut self, env: &mut Env, action: &[f32]) -> Result<StepOutput, DemoError> {
         let out = env.step(action)?;
-        self.push(action, env.get_state(), out.info.clone());
+        self.push(action, env, out.info.clone());
         Ok(out)
     }
 
@@ -140,11 +186,14 @@ impl EpisodeRecorder {
         self.episode.env_states[0] = state;
     }
 
-    /// Records a step taken elsewhere: its action, the env state after it and its info.
-    pub fn push(&mut self, action: &[f32], state_after: Vec<f32>, info: Info) {
+    /// Records a step taken elsewhere: its action, its info and (with
+    /// [`StateRecording::EveryStep`]) `env`'s current state.
+    pub fn push(&mut self, action: &[f32], env: &Env, info: Info) {
         let ep = &mut self.episode;
         ep.actions.push(action.to_vec());
-        ep.env_states.push(state_after);
+        if ep.state_recording == StateRecording::EveryStep {
+            ep.env_states.push(env.get_state());
+        }
         ep.success
             .push(info_get(&info, "success") == Some(InfoValue::Bool(true)));
         ep.elapsed_steps += 1;

@@ -2,7 +2,8 @@
 //! produce them, and closed-loop replay / control-mode conversion.
 //!
 //! * [`DemoEpisode`] — one recorded episode (actions, env states, success flags), row-major
-//!   float32 like the `.h5` trajectory files (see `docs/trajectory_format.md`).
+//!   float32 like the `.h5` trajectory files (see `docs/trajectory_format.md`); soft-body
+//!   episodes keep only the state after reset ([`StateRecording`]).
 //! * [`EpisodeRecorder`] — records an episode while an env is stepped.
 //! * [`solutions`] — sense-plan-act solutions that produce `pd_joint_pos` episodes;
 //!   [`scripted_episode`] records the scripted oracle instead.
@@ -17,7 +18,7 @@ mod scripted;
 pub mod solutions;
 mod source_targets;
 
-pub use episode::{DemoEpisode, EpisodeRecorder};
+pub use episode::{DemoEpisode, EpisodeRecorder, StateRecording};
 pub use replay::{replay_episode, ReplayOptions, ReplayedEpisode, MAX_EXTRA_STEPS_PER_SOURCE_STEP};
 pub use scripted::scripted_episode;
 

@@ -3,7 +3,7 @@
 //! control mode (the ManiSkill2 paper, Sec. 2.2).
 
 use super::source_targets::SourceJointTargets;
-use super::{DemoEpisode, DemoError, EpisodeRecorder};
+use super::{DemoEpisode, DemoError, EpisodeRecorder, StateRecording};
 use crate::adapters::snapshot_articulation;
 use crate::config::EnvConfig;
 use crate::env::{make_env, Env};
@@ -28,8 +28,9 @@ pub const TRAILING_TOLERANCE_M: f32 = 0.01;
 pub struct ReplayOptions {
     /// Control mode of the replayed actions; `None` = the source's (no conversion).
     pub target_control_mode: Option<String>,
-    /// Restore the recorded env state after every step (replay without conversion only): the
-    /// output's states are then exactly the recorded ones.
+    /// Restore the recorded env state after every step (replay without conversion, of episodes
+    /// with [`StateRecording::EveryStep`] only): the output's states are then exactly the
+    /// recorded ones.
     pub use_env_states: bool,
     /// Collect the observations (in `cfg.obs_mode`) after reset and after every step.
     pub record_obs: bool,
@@ -56,6 +57,11 @@ pub struct ReplayedEpisode {
 ///
 /// * Same control mode: the source actions are stepped from the source's seed; with
 ///   `use_env_states`, each recorded state is restored after its step (and before the first).
+/// * Soft-body episodes ([`StateRecording::InitialOnly`]): after the reset, the recorded
+///   `env_init_state` is restored (as ManiSkill2 does) and the actions are stepped; the output
+///   keeps only its own initial state too. `use_env_states` is refused (there are no per-step
+///   states); a conversion re-simulates the source episode in a second env to read the source
+///   robot's joint positions at every step, so it costs about twice the simulation.
 /// * Another control mode: closed-loop conversion. At each source step `t` the source action's
 ///   desired joint targets `q̄_src(t)` are computed (see [`SourceJointTargets`]); the target
 ///   controller then gets the action that makes its drive targets reproduce `q̄_src(t)` *from
@@ -84,6 +90,14 @@ pub fn replay_episode(
         .clone()
         .unwrap_or_else(|| source.control_mode.clone());
     let converting = target_mode != source.control_mode;
+    if opts.use_env_states && source.state_recording == StateRecording::InitialOnly {
+        return Err(DemoError::InvalidOptions(format!(
+            "use_env_states (--use-env-states) restores per-step env_states, but episode seed {} \
+             is a soft-body episode that stores only env_init_state; replay it without the \
+             option (it restores env_init_state and steps the actions, deterministically)",
+            source.episode_seed
+        )));
+    }
     if converting && opts.use_env_states {
         return Err(DemoError::InvalidOptions(format!(
             "use_env_states restores the recorded {:?} states, which a conversion to {target_mode:?} \
@@ -158,8 +172,8 @@ fn replay_same_mode(
     opts: &ReplayOptions,
 ) -> Result<(DemoEpisode, Option<Vec<ObsValue>>), DemoError> {
     let (mut recorder, mut first_obs) = EpisodeRecorder::reset(env, source.episode_seed)?;
-    if opts.use_env_states {
-        env.set_state(&source.env_states[0])?;
+    if opts.use_env_states || source.state_recording == StateRecording::InitialOnly {
+        restore_init_state(env, source)?;
         recorder.restart_from_state(env.get_state());
         if opts.record_obs {
             first_obs = env.try_observe()?;
@@ -168,17 +182,37 @@ fn replay_same_mode(
     let mut obs = ObsLog::new(opts.record_obs, first_obs);
     for (t, action) in source.actions.iter().enumerate() {
         let out = env.step(action)?;
-        let mut state = env.get_state();
         let mut step_obs = Some(out.obs);
-        if opts.use_env_states && state != source.env_states[t + 1] {
+        if opts.use_env_states && env.get_state() != source.env_states[t + 1] {
             env.set_state(&source.env_states[t + 1])?;
-            state = env.get_state();
             step_obs = None;
         }
-        recorder.push(action, state, out.info);
+        recorder.push(action, env, out.info);
         obs.push(env, step_obs)?;
     }
     Ok((recorder.finish(), obs.0))
+}
+
+/// Restores `source`'s state after reset into `env` (just reset with the source's seed),
+/// checking its length first: a state of another length (e.g. from a ManiSkill2 file, whose
+/// state layout differs from ms2's) is an [`DemoError::InvalidEpisode`] saying so.
+pub(crate) fn restore_init_state(env: &mut Env, source: &DemoEpisode) -> Result<(), DemoError> {
+    let init = source.env_init_state();
+    let expected = env.get_state().len();
+    if init.len() != expected {
+        return Err(DemoError::InvalidEpisode {
+            seed: source.episode_seed,
+            reason: format!(
+                "env_init_state has {} values but a {} state in ms2 has {expected}; ms2's state \
+                 layout differs from ManiSkill2's, so trajectories recorded by ManiSkill2 (or by \
+                 another ms2 version) open but cannot be replayed in ms2 envs",
+                init.len(),
+                source.env_id
+            ),
+        });
+    }
+    env.set_state(init)?;
+    Ok(())
 }
 
 /// One closed-loop conversion of `source` into `env`'s control mode. With
@@ -191,7 +225,14 @@ fn convert_once(
     record_obs: bool,
     trailing_tolerance: Option<f32>,
 ) -> Result<(DemoEpisode, Option<Vec<ObsValue>>), DemoError> {
-    let (mut recorder, first_obs) = EpisodeRecorder::reset(env, source.episode_seed)?;
+    let (mut recorder, mut first_obs) = EpisodeRecorder::reset(env, source.episode_seed)?;
+    if source.state_recording == StateRecording::InitialOnly {
+        restore_init_state(env, source)?;
+        recorder.restart_from_state(env.get_state());
+        if record_obs {
+            first_obs = env.try_observe()?;
+        }
+    }
     let mut obs = ObsLog::new(record_obs, first_obs);
     let mut targets = SourceJointTargets::new(cfg, env, source)?;
     let dof = targets.dof();

@@ -3,7 +3,8 @@
 
 use ms2_control::{Articulation, CombinedController, ControlMode, ControlTiming, RobotConfig};
 
-use super::{DemoEpisode, DemoError};
+use super::replay::restore_init_state;
+use super::{DemoEpisode, DemoError, StateRecording};
 use crate::adapters::snapshot_articulation;
 use crate::config::EnvConfig;
 use crate::env::{make_env, Env};
@@ -15,7 +16,9 @@ use crate::error::EnvError;
 ///
 /// Modes whose targets do not depend on the current state (`pd_joint_pos`) skip the recorded
 /// states; the others (`pd_joint_delta_pos`, `pd_ee_delta_pose`, ...) restore each recorded
-/// state into a private env to read the joint positions it held.
+/// state into a private env to read the joint positions it held. A soft-body source keeps only
+/// its initial state: the private env then restores that and steps the source actions in
+/// lockstep (deterministic, so it passes through the states the recording went through).
 pub(crate) struct SourceJointTargets {
     controller: CombinedController,
     /// Whether the source mode's targets depend on the recorded joint positions.
@@ -24,6 +27,8 @@ pub(crate) struct SourceJointTargets {
     state_cfg: EnvConfig,
     /// Env that holds the recorded states (made on first use).
     state_env: Option<Env>,
+    /// Source steps the private env has taken since its reset (soft-body sources).
+    state_env_step: usize,
     articulation: ms2_control::PerfectTrackingArticulation,
     action_f64: Vec<f64>,
 }
@@ -68,6 +73,7 @@ impl SourceJointTargets {
             needs_state,
             state_cfg,
             state_env: None,
+            state_env_step: 0,
             articulation,
             action_f64,
         };
@@ -76,8 +82,10 @@ impl SourceJointTargets {
         Ok(this)
     }
 
-    /// The env holding recorded state `t` of `source`.
+    /// The env holding recorded state `t` of `source` (a soft-body source's private env only
+    /// steps forward: asking for an earlier `t` replays from the start).
     fn recorded_state(&mut self, source: &DemoEpisode, t: usize) -> Result<&Env, DemoError> {
+        let fresh = self.state_env.is_none();
         let env = match &mut self.state_env {
             Some(env) => env,
             slot @ None => {
@@ -86,7 +94,22 @@ impl SourceJointTargets {
                 slot.insert(env)
             }
         };
-        env.set_state(&source.env_states[t])?;
+        match source.state_recording {
+            StateRecording::EveryStep => env.set_state(&source.env_states[t])?,
+            StateRecording::InitialOnly => {
+                if fresh || self.state_env_step > t {
+                    if !fresh {
+                        env.reset(Some(source.episode_seed), false)?;
+                    }
+                    restore_init_state(env, source)?;
+                    self.state_env_step = 0;
+                }
+                while self.state_env_step < t {
+                    env.step(&source.actions[self.state_env_step])?;
+                    self.state_env_step += 1;
+                }
+            }
+        }
         Ok(env)
     }
 

@@ -11,6 +11,7 @@
 pub mod batch;
 pub mod camera;
 pub mod camera_update;
+pub mod particle_culling;
 pub mod visual_obs;
 
 use std::sync::Arc;
@@ -44,7 +45,17 @@ pub struct Sensors {
     robot: Option<ArticulationId>,
     robot_ids: Vec<u32>,
     goal_marker: InstanceId,
-    particle_sets: Vec<ParticleSetId>,
+    particle_sets: Vec<SensorParticleSet>,
+}
+
+/// A particle set of the render scene and how its positions are filtered.
+#[derive(Debug)]
+struct SensorParticleSet {
+    id: ParticleSetId,
+    /// Packing spacing (m) when enclosed particles are culled.
+    packing_spacing_m: Option<f32>,
+    /// The drawn positions of the last update (reused buffer).
+    drawn: Vec<glam::Vec3>,
 }
 
 impl Sensors {
@@ -98,13 +109,12 @@ impl Sensors {
     /// world's); its index, counted from 0, is the `set` of
     /// [`Sensors::set_particle_positions`].
     pub fn add_particle_set(&mut self, visual: &ParticleVisual) -> Result<usize, EnvError> {
-        if !(visual.radius_m.is_finite() && visual.radius_m > 0.0) {
-            return Err(EnvError::InvalidConfig(format!(
-                "particle set {:?}: radius {} m must be finite and > 0",
-                visual.name, visual.radius_m
-            )));
-        }
-        self.particle_sets.push(self.scene.add_particle_set(visual));
+        visual.validate()?;
+        self.particle_sets.push(SensorParticleSet {
+            id: self.scene.add_particle_set(visual),
+            packing_spacing_m: visual.packing_spacing_m,
+            drawn: Vec::new(),
+        });
         Ok(self.particle_sets.len() - 1)
     }
 
@@ -114,19 +124,24 @@ impl Sensors {
     }
 
     /// Replaces the positions (m, world) of particle set `set` (they are drawn from the next
-    /// render on; the count may change).
+    /// render on; the count may change). Sets with a packing spacing draw only the particles
+    /// not enclosed by neighbours ([`particle_culling`]).
     pub fn set_particle_positions(
         &mut self,
         set: usize,
         positions_world: &[glam::Vec3],
     ) -> Result<(), EnvError> {
-        let id = *self.particle_sets.get(set).ok_or_else(|| {
-            EnvError::Render(format!(
-                "particle set {set} does not exist ({} sets)",
-                self.particle_sets.len()
-            ))
+        let count = self.particle_sets.len();
+        let entry = self.particle_sets.get_mut(set).ok_or_else(|| {
+            EnvError::Render(format!("particle set {set} does not exist ({count} sets)"))
         })?;
-        self.scene.set_particle_positions(id, positions_world)
+        match entry.packing_spacing_m {
+            Some(spacing) => {
+                particle_culling::visible_particles(positions_world, spacing, &mut entry.drawn);
+                self.scene.set_particle_positions(entry.id, &entry.drawn)
+            }
+            None => self.scene.set_particle_positions(entry.id, positions_world),
+        }
     }
 
     /// The observation cameras.

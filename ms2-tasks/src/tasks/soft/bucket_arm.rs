@@ -189,12 +189,14 @@ impl BucketArm {
     }
 
     /// The clay as the cameras draw it: spheres of [`CLAY_RENDER_RADIUS_PER_SPACING`] ×
-    /// `particle_spacing_m` in [`CLAY_COLOR`], segmented as [`CLAY_SEGMENTATION_NAME`].
+    /// `particle_spacing_m` in [`CLAY_COLOR`], segmented as [`CLAY_SEGMENTATION_NAME`];
+    /// particles enclosed by neighbours on all sides are not drawn.
     pub fn clay_visual(particle_spacing_m: f32) -> ParticleVisual {
         ParticleVisual {
             name: CLAY_SEGMENTATION_NAME.to_owned(),
             radius_m: CLAY_RENDER_RADIUS_PER_SPACING * particle_spacing_m,
             rgb: CLAY_COLOR,
+            packing_spacing_m: Some(particle_spacing_m),
         }
     }
 
