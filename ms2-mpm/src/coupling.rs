@@ -407,9 +407,13 @@ impl Coupling {
         substeps: usize,
     ) -> Result<(), MpmError> {
         self.sync_bodies(backend)?;
-        for _ in 0..substeps {
-            solver.substep_with_forces(self)?;
-        }
+        // All substeps on one pool thread (see `MpmSolver::substep_with_forces`).
+        rayon::scope(|_| -> Result<(), MpmError> {
+            for _ in 0..substeps {
+                solver.substep_with_forces(self)?;
+            }
+            Ok(())
+        })?;
         self.apply_wrenches(backend);
         Ok(())
     }

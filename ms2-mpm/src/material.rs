@@ -130,6 +130,8 @@ impl Material {
             mu,
             lambda,
             yield_strain: half_yield_over_mu,
+            // |dev ε| ≤ √(2/3)·(max εᵢ − min εᵢ), so below this stretch ratio nothing yields.
+            elastic_stretch_ratio: (half_yield_over_mu * (1.5f32).sqrt()).exp(),
         }
     }
 }
@@ -149,6 +151,9 @@ pub(crate) struct CompiledMaterial {
     pub lambda: f32,
     /// `yield_stress / (2·mu)`: the deviatoric Hencky strain norm where clay yields.
     pub yield_strain: f32,
+    /// Clay: `exp(√(3/2)·yield_strain)`; a trial state whose largest and smallest stretches
+    /// are closer than this ratio is inside the yield surface (no logarithms needed).
+    pub elastic_stretch_ratio: f32,
 }
 
 /// Smallest singular value clay keeps before taking the logarithm (guards inverted or
@@ -192,6 +197,11 @@ impl CompiledMaterial {
             CompiledKind::Elastic => (f, self.corotated_stress(d.u, d.sigma)),
             CompiledKind::Clay => {
                 let sig = d.sigma.max(Vec3::splat(CLAY_MIN_STRETCH));
+                // Sorted stretches (see `Svd3`): sig.x largest, sig.z smallest. Inside the yield
+                // surface and not clamped: F stays as it is.
+                if d.sigma.z >= CLAY_MIN_STRETCH && sig.x <= self.elastic_stretch_ratio * sig.z {
+                    return (f, self.corotated_stress(d.u, sig));
+                }
                 let eps = Vec3::new(sig.x.ln(), sig.y.ln(), sig.z.ln());
                 let dev = eps - Vec3::splat((eps.x + eps.y + eps.z) / 3.0);
                 let dev_norm = dev.length();
@@ -239,6 +249,41 @@ mod tests {
             assert!(max_abs(f - Mat3::IDENTITY) < 1e-6);
             assert!(max_abs(tau) < 1e-6 * m.youngs_modulus, "{m:?}: {tau:?}");
         }
+    }
+
+    #[test]
+    fn stretch_ratio_shortcut_never_skips_a_yield() {
+        use rand::{Rng, SeedableRng};
+        let clay = Material::clay(1000.0, 1e4, 0.3, 2e3).compile();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let (mut inside, mut yielded) = (0, 0);
+        for _ in 0..20_000 {
+            // Stretches spread up to twice the shortcut's ratio, in any order.
+            let r = clay.elastic_stretch_ratio.ln() * 2.0;
+            let sig = Vec3::new(
+                rng.random_range(0.0..r),
+                rng.random_range(0.0..r),
+                rng.random_range(0.0..r),
+            )
+            .map(|e| (e - r / 2.0).exp());
+            let rot = glam::Quat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 0.7);
+            let f = Mat3::from_quat(rot) * Mat3::from_diagonal(sig);
+            let eps = sig.map(f32::ln);
+            let dev = eps - Vec3::splat(eps.element_sum() / 3.0);
+            let (f_new, _) = clay.project_and_stress(f);
+            let unchanged = max_abs(f_new - f) < 1e-5;
+            if dev.length() <= clay.yield_strain * 0.999 {
+                assert!(unchanged, "inside the yield surface but projected: {sig:?}");
+                inside += 1;
+            } else if dev.length() > clay.yield_strain * 1.001 {
+                assert!(!unchanged, "outside the yield surface but kept: {sig:?}");
+                yielded += 1;
+            }
+        }
+        assert!(
+            inside > 1000 && yielded > 1000,
+            "{inside} inside, {yielded} yielded"
+        );
     }
 
     #[test]

@@ -8,7 +8,7 @@ use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
 use crate::grid::BLOCK;
-use crate::math::fast_floor;
+use crate::math::fast_floor3;
 
 /// Stable identity of a particle, kept through the solver's reordering.
 pub type ParticleId = u32;
@@ -99,7 +99,7 @@ pub(crate) struct Binning {
 #[inline(always)]
 pub(crate) fn base_node(x: Vec3, origin: Vec3, inv_dx: f32) -> [i32; 3] {
     let g = (x - origin) * inv_dx - Vec3::splat(0.5);
-    [fast_floor(g.x), fast_floor(g.y), fast_floor(g.z)]
+    fast_floor3(g)
 }
 
 /// Reusable buffers of [`sort_into_bins`].

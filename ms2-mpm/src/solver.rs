@@ -39,8 +39,9 @@ impl SolverConfig {
 }
 
 /// External forces on particles, evaluated once per substep (the rigid coupling implements
-/// this; see [`crate::coupling::Coupling`]).
-pub trait ParticleForces {
+/// this; see [`crate::coupling::Coupling`]). `Send` because the substep runs on a thread of
+/// the rayon pool.
+pub trait ParticleForces: Send {
     /// Writes the force (N, world frame) on each particle into `forces` (zeroed on entry,
     /// same order as `particles`). `dt` is the substep length (s).
     fn particle_forces(&mut self, particles: ParticleView<'_>, dt: f32, forces: &mut [Vec3]);
@@ -368,6 +369,15 @@ impl MpmSolver {
     }
 
     fn substep_inner(&mut self, external: Option<&mut dyn ParticleForces>) -> Result<(), MpmError> {
+        // Run the whole substep on a pool thread: its parallel passes then fork from inside
+        // the pool instead of each waking the pool from outside and sleeping until it is done.
+        rayon::scope(|_| self.substep_in_pool(external))
+    }
+
+    fn substep_in_pool(
+        &mut self,
+        external: Option<&mut dyn ParticleForces>,
+    ) -> Result<(), MpmError> {
         let dt = self.config.substep_dt;
         if self.needs_sort {
             self.sort_particles();
