@@ -166,4 +166,14 @@ impl NativeEnv {
     fn triangles_per_camera(&self) -> PyResult<usize> {
         self.read(|env| env.triangles_per_camera())
     }
+
+    /// Channel-1 segmentation ids by object name (`{"ground": 1, "cube": 2, ...}`; the soft
+    /// tasks' particles are `"clay"`). `ValueError` for envs without a 3D scene.
+    fn segmentation_ids(
+        &self,
+        py: Python<'_>,
+    ) -> PyResult<std::collections::BTreeMap<String, u32>> {
+        let pairs = self.with_env(py, |env| Ok(env.segmentation_ids()?))?;
+        Ok(pairs.into_iter().collect())
+    }
 }

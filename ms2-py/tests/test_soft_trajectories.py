@@ -83,12 +83,15 @@ def test_generated_soft_demos_replay_convert_and_render(tmp_path, capsys):
     assert main([*argv, "--workers", "2", "-q"]) == 0
     with open_trajectory(path) as traj:
         assert traj.env_info["env_kwargs"]["mpm_freq"] == 1000.0
+        # Soft-body demos default to the soft envs' rate-limited pd_joint_delta_pos.
+        assert traj.env_info["env_kwargs"]["control_mode"] == "pd_joint_delta_pos"
         assert all(traj.is_soft(i) for i in range(len(traj)))
     capsys.readouterr()
     assert main(["replay", "--traj-path", str(path), "--num-workers", "2", "-q"]) == 0
     assert "2 succeeded (100.0 %)" in capsys.readouterr().out
 
-    # Closed-loop conversion re-simulates the source; the copy is in the soft layout too.
+    # Closed-loop conversion re-simulates the source (a delta mode needs its joint positions at
+    # every step) and succeeds; the copy is in the soft layout too.
     converted = replay(
         path,
         target_control_mode="pd_ee_delta_pose",
@@ -97,6 +100,7 @@ def test_generated_soft_demos_replay_convert_and_render(tmp_path, capsys):
         count=1,
         progress=False,
     )
+    assert converted.num_succeeded == 1
     with open_trajectory(converted.output) as out:
         assert out.env_info["env_kwargs"]["control_mode"] == "pd_ee_delta_pose"
         episode = out.read_episode(0)

@@ -79,6 +79,19 @@ def test_render_rgb_array_is_a_512_view():
     env.close()
 
 
+def test_segmentation_ids_name_what_the_cameras_see():
+    env = gym.make("PickCube-v0", obs_mode="pointcloud")
+    ids = env.unwrapped.segmentation_ids()
+    assert {"ground", "cube", "panda_hand"} <= ids.keys()
+    assert len(set(ids.values())) == len(ids) and min(ids.values()) >= 1
+    obs, _ = env.reset(seed=1)
+    seen = set(np.unique(obs["pointcloud"]["Segmentation"][..., 1]).tolist())
+    assert ids["cube"] in seen and any(ids[f"panda_link{k}"] in seen for k in range(8))
+    assert seen - {0} <= set(ids.values()), "every id seen has a name"
+    with pytest.raises(ValueError, match="render"):
+        ms2.Ms2Env("Dummy-v0").segmentation_ids()
+
+
 def test_state_only_env_rejects_visual_modes():
     with pytest.raises(ValueError, match="render"):
         ms2.Ms2Env("Dummy-v0", obs_mode="rgbd")
@@ -221,6 +234,7 @@ def _clay_points(env_id: str, seed: int):
     nearest = np.min(np.linalg.norm(xyz[:, None, :] - particles[None, ::2, :], axis=2), axis=1)
     on_clay = nearest < 0.008
     clay_id = np.bincount(ids[on_clay, 1]).argmax()
+    assert env.unwrapped.segmentation_ids()["clay"] == clay_id
     clay = ids[:, 1] == clay_id
     assert not cloud["robot_seg"][valid][clay].any(), "clay points are not robot"
     assert len(np.unique(ids[clay, 0])) == 1, "the clay is one visual id"

@@ -1,8 +1,8 @@
 //! Runs the scripted solution of a soft-body env (`Excavate-v0`, `Fill-v0`) over seeds and
 //! prints each episode's final info, the success rate and env steps/s.
 //!
-//! `cargo run --release -p ms2-tasks --example soft_env_rates -- <env_id> [seeds] [control_mode]`
-//! (defaults: 50 seeds, pd_joint_delta_pos).
+//! `cargo run --release -p ms2-tasks --example soft_env_rates -- <env_id> [seeds] [control_mode]
+//! [mpm_freq]` (defaults: 50 seeds, pd_joint_delta_pos, the task's MPM frequency).
 
 use std::time::Instant;
 
@@ -16,6 +16,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(mode) = args.get(3) {
         cfg.control_mode = Some(mode.clone());
     }
+    cfg.mpm_freq = args.get(4).map(|s| s.parse()).transpose()?;
     let mut env = make_env(&cfg)?;
     let mut policy = make_scripted_policy(&env)?;
     let (mut successes, mut steps) = (0, 0u64);
@@ -39,8 +40,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("seed {seed}: {info:?}");
     }
     println!(
-        "{env_id} scripted ({}): {successes}/{seeds} successes, {:.2} env steps/s",
+        "{env_id} scripted ({}, MPM {} Hz): {successes}/{seeds} successes, {:.2} env steps/s",
         env.control_mode(),
+        env.config().mpm_freq.unwrap_or(f64::NAN),
         steps as f64 / t0.elapsed().as_secs_f64()
     );
     Ok(())

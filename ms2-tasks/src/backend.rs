@@ -67,6 +67,10 @@ pub(crate) trait EnvBackend: Send {
     fn render_human(&self) -> Result<ms2_render::CameraOutput, EnvError> {
         Err(self.not_renderable())
     }
+    /// Channel-1 segmentation ids by object name (robot tasks only).
+    fn segmentation_ids(&self) -> Result<Vec<(String, u32)>, EnvError> {
+        Err(self.not_renderable())
+    }
     /// Triangles drawn per observation camera (0 before the first render).
     fn triangles_per_camera(&self) -> usize {
         0

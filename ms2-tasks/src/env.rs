@@ -424,6 +424,14 @@ impl Env {
         })
     }
 
+    /// The objects of the segmentation images' channel 1 (actor/link ids) as `(name, id)`
+    /// pairs, in id order: the ground, each actor (e.g. `"cube"`), each robot link (e.g.
+    /// `"panda_hand"`) and each particle set (the soft-body tasks' `"clay"`). Builds the
+    /// env's sensors if no render happened yet; an error for envs without a 3D scene.
+    pub fn segmentation_ids(&self) -> Result<Vec<(String, u32)>, EnvError> {
+        self.backend.segmentation_ids()
+    }
+
     /// Triangles drawn per observation camera in the last render (0 before any render).
     pub fn triangles_per_camera(&self) -> usize {
         self.backend.triangles_per_camera()

@@ -344,6 +344,17 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
         self.with_sensors(|sensors, world| sensors.render_human(world, goal))
     }
 
+    fn segmentation_ids(&self) -> Result<Vec<(String, u32)>, EnvError> {
+        self.with_sensors(|sensors, _| {
+            Ok(sensors
+                .render_scene()
+                .objects()
+                .iter()
+                .map(|o| (o.name.clone(), o.id))
+                .collect())
+        })
+    }
+
     fn triangles_per_camera(&self) -> usize {
         self.sensors
             .lock()

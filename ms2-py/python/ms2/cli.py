@@ -20,6 +20,7 @@ import argparse
 import sys
 import time
 from collections.abc import Sequence
+from typing import Any
 
 
 def _cmd_envs(_args: argparse.Namespace) -> int:
@@ -137,6 +138,26 @@ def _cmd_demos_generate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _trajectory_size_summary(path: Any) -> str:
+    """The size of trajectory ``path`` and, for soft-body files, what per-step env_states would
+    take (float32 [T+1, S] per episode)."""
+    from .trajectory import open_trajectory
+
+    size = path.stat().st_size
+    with open_trajectory(path) as traj:
+        steps = [int(ep["elapsed_steps"]) for ep in traj.episodes]
+        soft = [i for i in range(len(traj)) if traj.is_soft(i)]
+        state_len = traj.read_episode(soft[0])["env_init_state"].size if soft else 0
+    text = f"{size / 1e6:.2f} MB for {len(steps)} episodes ({sum(steps)} steps)"
+    if soft:
+        per_step = sum(4 * (t + 1) * state_len for t in steps)
+        text += (
+            f"; soft-body layout (env_init_state of {state_len} floats): per-step env_states "
+            f"would take {per_step / 1e6:.1f} MB"
+        )
+    return text
+
+
 def _cmd_demos_bench(args: argparse.Namespace) -> int:
     import os
     import tempfile
@@ -155,12 +176,14 @@ def _cmd_demos_bench(args: argparse.Namespace) -> int:
             num_workers=args.workers,
             policy=args.policy,
             progress=False,
+            control_mode=args.control_mode,
         )
         print(
             f"{args.env_id}: {gen.seconds_per_episode:.3f} s per generated demo, "
-            f"{gen.cpu_seconds_per_episode:.3f} CPU-s ({args.policy}, {gen.num_episodes} demos, "
-            f"{gen.seeds_tried} seeds, {args.workers} workers)"
+            f"{gen.cpu_seconds_per_episode:.3f} CPU-s ({args.policy}, {gen.control_mode}, "
+            f"{gen.num_episodes} demos, {gen.seeds_tried} seeds, {args.workers} workers)"
         )
+        print(f"  file: {_trajectory_size_summary(path)}")
         for target in targets:
             rep = demos.replay(
                 path,
@@ -197,8 +220,9 @@ def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
     g.add_argument(
         "-c",
         "--control-mode",
-        default="pd_joint_pos",
-        help="control mode of the demos (default pd_joint_pos; other modes: --policy scripted)",
+        default=None,
+        help="control mode of the demos (default pd_joint_pos, for soft-body envs "
+        "pd_joint_delta_pos; other modes than pd_joint_pos need --policy scripted)",
     )
     g.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     g.set_defaults(func=_cmd_demos_generate)
@@ -207,6 +231,7 @@ def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
     b.add_argument("-n", "--num-episodes", type=int, default=20)
     b.add_argument("--workers", type=int, default=1)
     b.add_argument("--policy", choices=["solution", "scripted"], default="solution")
+    b.add_argument("-c", "--control-mode", default=None, help="control mode of the generated demos")
     b.add_argument("--max-retry", type=int, default=0)
     b.add_argument(
         "--target-control-modes",

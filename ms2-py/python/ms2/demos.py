@@ -32,6 +32,10 @@ from .trajectory import TrajectoryFileError, TrajectoryWriter, is_soft_episode, 
 
 #: Control mode the demonstration sources produce.
 SOURCE_CONTROL_MODE = "pd_joint_pos"
+#: Control mode of scripted soft-body demonstrations (the soft envs' default): its actions are
+#: rate-limited, so their conversion to end-effector modes follows the source's path (Fill-v0:
+#: 20/20 to ``pd_ee_delta_pose`` against 16/20 from ``pd_joint_pos`` sources).
+SOFT_SOURCE_CONTROL_MODE = "pd_joint_delta_pos"
 #: Demonstration sources of :func:`generate`.
 POLICIES = ("solution", "scripted")
 
@@ -83,6 +87,7 @@ class GenerateResult(_PerEpisodeCost):
     seconds: float
     failed_seeds: list[int] = field(default_factory=list)
     cpu_seconds: float = 0.0
+    control_mode: str = SOURCE_CONTROL_MODE
 
 
 def generate(
@@ -95,13 +100,15 @@ def generate(
     policy: str = "solution",
     chunk_size: int | None = None,
     progress: bool = True,
-    control_mode: str = SOURCE_CONTROL_MODE,
+    control_mode: str | None = None,
 ) -> GenerateResult:
     """Writes ``num_episodes`` successful demonstrations of ``env_id`` to ``output`` (``.h5``;
     the ``.json`` is written next to it), in ``pd_joint_pos`` (the motion-planning solutions'
     mode) or, with ``policy="scripted"``, in ``control_mode`` (any position-based mode the
-    scripted oracle drives). Soft-body envs are written in the soft-body layout
-    (``env_init_state``) with their ``mpm_freq`` in ``env_kwargs``.
+    scripted oracle drives; default ``pd_joint_pos``, but ``SOFT_SOURCE_CONTROL_MODE`` for
+    soft-body envs, whose rate-limited demos convert closed-loop to other modes better).
+    Soft-body envs are written in the soft-body layout (``env_init_state``) with their
+    ``mpm_freq`` in ``env_kwargs``.
 
     Seeds ``seed, seed + 1, ...`` are tried in chunks of ``chunk_size`` (default
     ``4 * num_workers``) until ``num_episodes`` succeed or ``max_seeds`` (default
@@ -124,6 +131,9 @@ def generate(
             f"no motion-planning solution for {env_id!r}; envs with one: "
             f"{sorted(_native.solution_env_ids())} (or use policy='scripted')"
         )
+    if control_mode is None:
+        soft = "mpm_freq" in _native.recorded_env_kwargs(env_id, {"obs_mode": "state"})
+        control_mode = SOFT_SOURCE_CONTROL_MODE if soft else SOURCE_CONTROL_MODE
     if policy == "solution" and control_mode != SOURCE_CONTROL_MODE:
         raise ValueError(
             f"the motion-planning solutions act in {SOURCE_CONTROL_MODE!r}, not {control_mode!r} "
@@ -140,7 +150,7 @@ def generate(
         "env_kwargs": recorded,
     }
     started, cpu_started = time.perf_counter(), time.process_time()
-    result = GenerateResult(Path(output), 0, 0, 0, 0.0)
+    result = GenerateResult(Path(output), 0, 0, 0, 0.0, control_mode=control_mode)
     with (
         TrajectoryWriter(output, env_info) as writer,
         _progress(num_episodes, f"{env_id} demos", progress) as bar,
@@ -383,6 +393,8 @@ def replay(
 __all__ = [
     "GenerateResult",
     "ReplayResult",
+    "SOFT_SOURCE_CONTROL_MODE",
+    "SOURCE_CONTROL_MODE",
     "generate",
     "replay",
     "replay_output_path",

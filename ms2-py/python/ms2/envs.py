@@ -159,6 +159,13 @@ class Ms2Env(gym.Env):
             raise ValueError(f"state must be a 1-D array, got shape {state.shape}")
         self._native.set_state(state)
 
+    def segmentation_ids(self) -> dict[str, int]:
+        """Ids of the segmentation images' channel 1 (actor/link) by object name: ``"ground"``,
+        each actor (e.g. ``"cube"``), each robot link (``"panda_hand"``, ...) and the soft-body
+        tasks' particles (``"clay"``). ``obs["camera"]["Segmentation"][..., 1] == ids["clay"]``
+        masks the clay."""
+        return dict(self._native.segmentation_ids())
+
     @property
     def elapsed_steps(self) -> int:
         """Env steps taken in this episode."""
