@@ -77,6 +77,10 @@ impl F8 {
         Self(self.0.signum(), self.1.signum())
     }
     #[inline(always)]
+    pub fn max(self, o: Self) -> Self {
+        Self(self.0.max(o.0), self.1.max(o.1))
+    }
+    #[inline(always)]
     pub fn recip(self) -> Self {
         Self(self.0.recip(), self.1.recip())
     }

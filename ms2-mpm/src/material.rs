@@ -7,9 +7,7 @@
 use glam::{Mat3, Vec3};
 
 use crate::error::MpmError;
-#[cfg(test)]
-use crate::math::svd3;
-use crate::math::Svd3;
+use crate::math::{svd3, LeftStretch, Svd3};
 
 /// Constitutive behaviour of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -156,6 +154,12 @@ pub(crate) struct CompiledMaterial {
     pub elastic_stretch_ratio: f32,
 }
 
+const IDENTITY_SVD: Svd3 = Svd3 {
+    u: Mat3::IDENTITY,
+    sigma: Vec3::ONE,
+    v: Mat3::IDENTITY,
+};
+
 /// Smallest singular value clay keeps before taking the logarithm (guards inverted or
 /// collapsed particles; PlasticineLab uses a similar floor).
 const CLAY_MIN_STRETCH: f32 = 0.05;
@@ -216,6 +220,38 @@ impl CompiledMaterial {
                 (f_new, self.corotated_stress(d.u, sig))
             }
         }
+    }
+
+    /// As [`Self::project_and_stress_svd`], given the left stretch `ls` of `f` instead of its
+    /// SVD (ignored by water): cheaper, since the common cases need no right rotation. An
+    /// elastic state stays `f`; a clay state beyond the yield surface is projected as
+    /// `U·diag(σ_new/σ)·Uᵀ·f` (= `U·diag(σ_new)·Vᵀ`). Inverted or collapsed states (det ≤ 0,
+    /// or clay stretches below its floor), rare, take the SVD path.
+    #[inline(always)]
+    pub fn project_and_stress_left(&self, f: Mat3, ls: &LeftStretch) -> (Mat3, Mat3) {
+        let sig = ls.sigma;
+        let usual = match self.kind {
+            CompiledKind::Water => return self.project_and_stress_svd(f, &IDENTITY_SVD),
+            CompiledKind::Elastic => sig.z > 0.0,
+            CompiledKind::Clay => sig.z >= CLAY_MIN_STRETCH,
+        };
+        if !usual || f.determinant() <= 0.0 {
+            return self.project_and_stress_svd(f, &svd3(f));
+        }
+        if self.kind == CompiledKind::Elastic || sig.x <= self.elastic_stretch_ratio * sig.z {
+            return (f, self.corotated_stress(ls.u, sig));
+        }
+        let eps = Vec3::new(sig.x.ln(), sig.y.ln(), sig.z.ln());
+        let dev = eps - Vec3::splat((eps.x + eps.y + eps.z) / 3.0);
+        let dev_norm = dev.length();
+        let excess = dev_norm - self.yield_strain;
+        if excess <= 0.0 {
+            return (f, self.corotated_stress(ls.u, sig));
+        }
+        let e = eps - dev * (excess / dev_norm);
+        let sig_new = Vec3::new(e.x.exp(), e.y.exp(), e.z.exp());
+        let f_new = ls.u * Mat3::from_diagonal(sig_new / sig) * ls.u.transpose() * f;
+        (f_new, self.corotated_stress(ls.u, sig_new))
     }
 
     /// Fixed-corotated Kirchhoff stress `2μ(F − R)Fᵀ + λ(J − 1)J·I` from `F = U·Σ·Vᵀ`.
@@ -284,6 +320,43 @@ mod tests {
             inside > 1000 && yielded > 1000,
             "{inside} inside, {yielded} yielded"
         );
+    }
+
+    #[test]
+    fn left_stretch_path_matches_the_svd_path() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        let materials = [
+            Material::clay(1000.0, 1e4, 0.3, 2e3),
+            Material::elastic(1000.0, 3e5, 0.3),
+            Material::water(1000.0, 1e4),
+        ];
+        for m in materials.map(|m| m.compile()) {
+            for round in 0..2000 {
+                let e: [f32; 9] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+                // Small, large, inverting and collapsing deformations.
+                let scale = [0.05, 0.5, 1.2, 0.3][round % 4];
+                let mut f = Mat3::IDENTITY + Mat3::from_cols_array(&e) * scale;
+                if round % 4 == 3 {
+                    f.z_axis *= 0.02;
+                }
+                let ls = crate::math::left_stretch_x8(&[f; 8])[0];
+                let (fa, ta) = m.project_and_stress_left(f, &ls);
+                let (fb, tb) = m.project_and_stress(f);
+                let tol = 1e-4 * (1.0 + max_abs(fb));
+                assert!(
+                    max_abs(fa - fb) < tol,
+                    "{:?} F {f:?}: {fa:?} vs {fb:?}",
+                    m.kind
+                );
+                let tol = 1e-4 * (m.mu + m.lambda) * (1.0 + max_abs(fb)).powi(2);
+                assert!(
+                    max_abs(ta - tb) < tol,
+                    "{:?} F {f:?}: {ta:?} vs {tb:?}",
+                    m.kind
+                );
+            }
+        }
     }
 
     #[test]

@@ -3,7 +3,7 @@
 
 use glam::{Mat3, Vec3};
 
-pub use crate::math_x8::svd3_x8;
+pub use crate::math_x8::{left_stretch_x8, svd3_x8};
 
 /// Singular value decomposition `A = U · diag(sigma) · Vᵀ` of a 3×3 matrix.
 ///
@@ -18,6 +18,16 @@ pub struct Svd3 {
     pub sigma: Vec3,
     /// Right rotation.
     pub v: Mat3,
+}
+
+/// The left stretch of a matrix `F`: `F·Fᵀ = U·diag(σ)²·Uᵀ` with `U` a rotation and
+/// `σ ≥ 0` sorted decreasing: the `U` and `|σ|` of the SVD without its right rotation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LeftStretch {
+    /// Left rotation (columns: left singular vectors).
+    pub u: Mat3,
+    /// Singular values, non-negative, `sigma.x >= sigma.y >= sigma.z`.
+    pub sigma: Vec3,
 }
 
 /// Most cyclic Jacobi sweeps on `AᵀA`. Convergence is quadratic; four sweeps reach f32

@@ -5,7 +5,7 @@
 use glam::{Mat3, Vec3};
 
 use crate::lanes::{F8, M8};
-use crate::math::Svd3;
+use crate::math::{LeftStretch, Svd3};
 
 /// Eight 3-vectors, component-wise in lanes.
 #[derive(Clone, Copy)]
@@ -121,36 +121,18 @@ fn jacobi_rotate_x8(
     *vq = oq.scale(c).sub(op.scale(s));
 }
 
-/// SVDs of eight matrices (see [`crate::math::svd3`] for the conventions).
-pub fn svd3_x8(a: &[Mat3; 8]) -> [Svd3; 8] {
-    let col = |c: usize| V3x8 {
-        x: F8::from_fn(|l| a[l].col(c).x),
-        y: F8::from_fn(|l| a[l].col(c).y),
-        z: F8::from_fn(|l| a[l].col(c).z),
-    };
-    let cols = [col(0), col(1), col(2)];
-    let mat_vec = |v: V3x8| -> V3x8 {
-        cols[0]
-            .scale(v.x)
-            .add(cols[1].scale(v.y))
-            .add(cols[2].scale(v.z))
-    };
-    let (mut s11, mut s22, mut s33) = (
-        cols[0].dot(cols[0]),
-        cols[1].dot(cols[1]),
-        cols[2].dot(cols[2]),
-    );
-    let (mut s12, mut s13, mut s23) = (
-        cols[0].dot(cols[1]),
-        cols[0].dot(cols[2]),
-        cols[1].dot(cols[2]),
-    );
+/// Cyclic Jacobi eigen-decomposition of eight symmetric 3×3 matrices given by their entries
+/// `[s11, s22, s33, s12, s13, s23]`: the eigenvalues (unsorted) and the eigenvectors, the
+/// columns of a rotation. Sweeps stop once every lane has converged (see
+/// `math::JACOBI_TOLERANCE`).
+#[inline(always)]
+fn jacobi_eigen_x8(s: [F8; 6]) -> ([F8; 3], [V3x8; 3]) {
+    let [mut s11, mut s22, mut s33, mut s12, mut s13, mut s23] = s;
     let mut v1 = V3x8::splat(Vec3::X);
     let mut v2 = V3x8::splat(Vec3::Y);
     let mut v3 = V3x8::splat(Vec3::Z);
     let tol2 = F8::splat(crate::math::JACOBI_TOLERANCE * crate::math::JACOBI_TOLERANCE);
     for _ in 0..crate::math::JACOBI_SWEEPS {
-        // Stop once every lane has converged (see `math::JACOBI_TOLERANCE`).
         let off = s12 * s12 + s13 * s13 + s23 * s23;
         let diag = s11 * s11 + s22 * s22 + s33 * s33;
         if off.cmple(tol2 * diag).all() {
@@ -166,6 +148,70 @@ pub fn svd3_x8(a: &[Mat3; 8]) -> [Svd3; 8] {
             &mut s22, &mut s33, &mut s23, &mut s12, &mut s13, &mut v2, &mut v3,
         );
     }
+    ([s11, s22, s33], [v1, v2, v3])
+}
+
+/// Left stretches of eight matrices (see [`LeftStretch`]): Jacobi on `F·Fᵀ`, whose
+/// eigenvectors are the left singular vectors and eigenvalues the squared singular values.
+/// No right rotation is formed, which is what makes it cheaper than [`svd3_x8`].
+pub fn left_stretch_x8(f: &[Mat3; 8]) -> [LeftStretch; 8] {
+    // Rows of F (glam stores columns).
+    let row = |r: usize| V3x8 {
+        x: F8::from_fn(|l| f[l].x_axis[r]),
+        y: F8::from_fn(|l| f[l].y_axis[r]),
+        z: F8::from_fn(|l| f[l].z_axis[r]),
+    };
+    let rows = [row(0), row(1), row(2)];
+    let (mut lam, mut uc) = jacobi_eigen_x8([
+        rows[0].dot(rows[0]),
+        rows[1].dot(rows[1]),
+        rows[2].dot(rows[2]),
+        rows[0].dot(rows[1]),
+        rows[0].dot(rows[2]),
+        rows[1].dot(rows[2]),
+    ]);
+    // Sort by decreasing eigenvalue; a swap negates one column to keep det U = +1.
+    let swap = |i: usize, j: usize, uc: &mut [V3x8; 3], lam: &mut [F8; 3]| {
+        let m = lam[i].cmplt(lam[j]);
+        let (ui, uj) = (uc[i], uc[j]);
+        uc[i] = V3x8::select(m, uj, ui);
+        uc[j] = V3x8::select(m, ui.neg(), uj);
+        let (li, lj) = (lam[i], lam[j]);
+        lam[i] = F8::select(m, lj, li);
+        lam[j] = F8::select(m, li, lj);
+    };
+    swap(0, 1, &mut uc, &mut lam);
+    swap(0, 2, &mut uc, &mut lam);
+    swap(1, 2, &mut uc, &mut lam);
+    let sigma = lam.map(|l| l.max(F8::ZERO).sqrt());
+    std::array::from_fn(|l| LeftStretch {
+        u: Mat3::from_cols(uc[0].lane(l), uc[1].lane(l), uc[2].lane(l)),
+        sigma: Vec3::new(sigma[0].lane(l), sigma[1].lane(l), sigma[2].lane(l)),
+    })
+}
+
+/// SVDs of eight matrices (see [`crate::math::svd3`] for the conventions).
+pub fn svd3_x8(a: &[Mat3; 8]) -> [Svd3; 8] {
+    let col = |c: usize| V3x8 {
+        x: F8::from_fn(|l| a[l].col(c).x),
+        y: F8::from_fn(|l| a[l].col(c).y),
+        z: F8::from_fn(|l| a[l].col(c).z),
+    };
+    let cols = [col(0), col(1), col(2)];
+    let mat_vec = |v: V3x8| -> V3x8 {
+        cols[0]
+            .scale(v.x)
+            .add(cols[1].scale(v.y))
+            .add(cols[2].scale(v.z))
+    };
+    let (_, [v1, v2, v3]) = jacobi_eigen_x8([
+        cols[0].dot(cols[0]),
+        cols[1].dot(cols[1]),
+        cols[2].dot(cols[2]),
+        cols[0].dot(cols[1]),
+        cols[0].dot(cols[2]),
+        cols[1].dot(cols[2]),
+    ]);
     let mut vc = [v1, v2, v3];
     let mut b = [mat_vec(vc[0]), mat_vec(vc[1]), mat_vec(vc[2])];
     let mut len2 = [b[0].dot(b[0]), b[1].dot(b[1]), b[2].dot(b[2])];
@@ -271,6 +317,37 @@ mod tests {
                 .to_cols_array()
                 .iter()
                 .all(|e| *e < 1e-6));
+        }
+    }
+
+    #[test]
+    fn left_stretches_match_the_svd() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(8);
+        for round in 0..300 {
+            let mats: [Mat3; 8] = std::array::from_fn(|l| {
+                if round % 5 == 0 && l == 3 {
+                    return Mat3::IDENTITY;
+                }
+                let e: [f32; 9] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+                Mat3::IDENTITY + Mat3::from_cols_array(&e) * if l % 2 == 0 { 0.05 } else { 0.4 }
+            });
+            for (l, ls) in left_stretch_x8(&mats).iter().enumerate() {
+                let d = crate::math::svd3(mats[l]);
+                assert!(
+                    (ls.sigma - d.sigma.abs()).abs().max_element() < 1e-4,
+                    "lane {l}"
+                );
+                // Same left stretch U·Σ·Uᵀ, whatever the basis within repeated values.
+                let a = ls.u * Mat3::from_diagonal(ls.sigma) * ls.u.transpose();
+                let b = d.u * Mat3::from_diagonal(d.sigma.abs()) * d.u.transpose();
+                let err = (a - b)
+                    .abs()
+                    .to_cols_array()
+                    .into_iter()
+                    .fold(0.0, f32::max);
+                assert!(err < 1e-4, "lane {l}: {err}");
+                assert!((ls.u.determinant() - 1.0).abs() < 1e-4);
+            }
         }
     }
 }

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use crate::grid::{GridSpec, GridStorage, BLOCK};
 use crate::material::CompiledMaterial;
-use crate::math::{quadratic_weights, svd3_x8, Svd3};
+use crate::math::{left_stretch_x8, quadratic_weights, LeftStretch};
 use crate::parallel::SyncPtr;
 use crate::particles::{Binning, Particles};
 
@@ -22,10 +22,9 @@ use crate::particles::{Binning, Particles};
 const LOCAL: usize = BLOCK + 4;
 const LOCAL_NODES: usize = LOCAL * LOCAL * LOCAL;
 
-const IDENTITY_SVD: Svd3 = Svd3 {
+const IDENTITY_STRETCH: LeftStretch = LeftStretch {
     u: Mat3::IDENTITY,
     sigma: Vec3::ONE,
-    v: Mat3::IDENTITY,
 };
 
 /// A bin's grid neighbourhood: momentum or velocity (xyz) and mass (w) per node, in SIMD
@@ -145,7 +144,8 @@ fn accumulate_unit(
     let stress_scale = -dt * 4.0 * inv_dx * inv_dx;
     let (x, v, c, mass, volume, material) = (&p.x, &p.v, &p.c, &p.mass, &p.volume, &p.material);
     let end = first + f_out.len();
-    // Particles go in groups of eight so that their SVDs run in the SIMD lanes.
+    // Particles go in groups of eight so that their stretch decompositions run in the SIMD
+    // lanes.
     for group in (first..end).step_by(8) {
         let n = (end - group).min(8);
         let mut trial = [Mat3::IDENTITY; 8];
@@ -155,15 +155,15 @@ fn accumulate_unit(
             *t = (Mat3::IDENTITY + dt * c[pi]) * p_f[pi];
             any_svd |= prm.materials[material[pi] as usize].needs_svd();
         }
-        let svds = if any_svd {
-            svd3_x8(&trial)
+        let stretches = if any_svd {
+            left_stretch_x8(&trial)
         } else {
-            [IDENTITY_SVD; 8]
+            [IDENTITY_STRETCH; 8]
         };
         for l in 0..n {
             let pi = group + l;
             let mat = &prm.materials[material[pi] as usize];
-            let (f_new, tau) = mat.project_and_stress_svd(trial[l], &svds[l]);
+            let (f_new, tau) = mat.project_and_stress_left(trial[l], &stretches[l]);
             f_out[pi - first] = f_new;
             let (base, fx, w) = quadratic_weights((x[pi] - origin) * inv_dx);
             let m = mass[pi];
