@@ -2,7 +2,7 @@
 //! fragments ray-trace an exact sphere (`vs_particle` / `fs_particle` in `shader.wgsl`), and a
 //! disk facing the light in the shadow pass. Two triangles per particle, whatever the radius.
 
-use crate::renderer::{instance_only_buffer_layout, DEPTH_FORMAT};
+use crate::renderer::{depth_less_write, instance_only_buffer_layout, SHADOW_DEPTH_BIAS};
 
 /// Vertices per particle (a two-triangle strip, no index buffer).
 pub(crate) const VERTICES_PER_PARTICLE: u32 = 4;
@@ -46,13 +46,7 @@ impl ParticleGpu {
                 buffers: &buffers,
             },
             primitive,
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
+            depth_stencil: depth_less_write(Default::default()),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: shader,
@@ -78,18 +72,7 @@ impl ParticleGpu {
                 buffers: &buffers,
             },
             primitive,
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                // As the mesh shadow pass (`shadow.rs`): against self-shadowing.
-                bias: wgpu::DepthBiasState {
-                    constant: 2,
-                    slope_scale: 2.0,
-                    clamp: 0.0,
-                },
-            }),
+            depth_stencil: depth_less_write(SHADOW_DEPTH_BIAS),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: shader,

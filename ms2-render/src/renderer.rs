@@ -133,6 +133,26 @@ pub(crate) const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8U
 pub(crate) const GBUFFER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 /// Depth-test format (never read back: GL cannot copy depth textures).
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Slope-scaled depth bias of the shadow passes (meshes and particles), against
+/// self-shadowing ("shadow acne").
+pub(crate) const SHADOW_DEPTH_BIAS: wgpu::DepthBiasState = wgpu::DepthBiasState {
+    constant: 2,
+    slope_scale: 2.0,
+    clamp: 0.0,
+};
+
+/// The depth state of every pipeline: test `Less` against and write [`DEPTH_FORMAT`], with
+/// `bias` (the default, or [`SHADOW_DEPTH_BIAS`] in shadow passes).
+pub(crate) fn depth_less_write(bias: wgpu::DepthBiasState) -> Option<wgpu::DepthStencilState> {
+    Some(wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias,
+    })
+}
 /// Size of the per-camera uniform block (see `shader.wgsl`).
 pub(crate) const CAMERA_BLOCK_BYTES: u64 = 320;
 /// Per-vertex attributes: position, normal, uv.
@@ -403,13 +423,7 @@ impl Gpu {
                 cull_mode: None,
                 ..Default::default()
             },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
+            depth_stencil: depth_less_write(Default::default()),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &shader,

@@ -1,7 +1,7 @@
 //! Shadow mapping for a scene's first directional light: a depth-only pass from the light into
 //! a per-scene shadow map, sampled with hardware comparison (2×2 filtered) in the main pass.
 
-use crate::renderer::{vertex_buffer_layouts, DEPTH_FORMAT};
+use crate::renderer::{depth_less_write, vertex_buffer_layouts, DEPTH_FORMAT, SHADOW_DEPTH_BIAS};
 use crate::scene::Shadow;
 use nalgebra::{Matrix4, Vector3};
 
@@ -72,18 +72,7 @@ impl ShadowGpu {
                 cull_mode: None,
                 ..Default::default()
             },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                // Slope-scaled bias against self-shadowing ("shadow acne").
-                bias: wgpu::DepthBiasState {
-                    constant: 2,
-                    slope_scale: 2.0,
-                    clamp: 0.0,
-                },
-            }),
+            depth_stencil: depth_less_write(SHADOW_DEPTH_BIAS),
             multisample: Default::default(),
             fragment: None,
             multiview_mask: None,

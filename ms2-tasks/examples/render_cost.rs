@@ -10,27 +10,13 @@
 //! cores; the wall-clock rate is what a training loop sees. PickCube-v0, pd_joint_delta_pos,
 //! a fixed small action, default cameras.
 
+mod common;
+
 use std::time::Instant;
 
-use ms2_tasks::{EnvConfig, VecEnv};
+use common::*;
 
-/// Process CPU time (user + system, all threads) in seconds; 0 where `/proc` is missing.
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let fields: Vec<&str> = stat
-        .rsplit(')')
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .collect();
-    let ticks = |k: usize| {
-        fields
-            .get(k)
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
-    (ticks(11) + ticks(12)) / 100.0
-}
+use ms2_tasks::{EnvConfig, VecEnv};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

@@ -12,35 +12,13 @@
 //! scripted policy's time per action (ms, not part of the env steps/s), the particle count and
 //! triangles per camera, and the load average.
 
+mod common;
+
 use std::time::Instant;
 
+use common::*;
+
 use ms2_tasks::{make_env, make_scripted_policy, EnvConfig};
-
-/// Process CPU time (user + system, all threads) in seconds; 0 where `/proc` is missing.
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let fields: Vec<&str> = stat
-        .rsplit(')')
-        .next()
-        .unwrap_or("")
-        .split_whitespace()
-        .collect();
-    let ticks = |k: usize| {
-        fields
-            .get(k)
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
-    (ticks(11) + ticks(12)) / 100.0
-}
-
-/// The 1-minute load average (NaN where `/proc` is missing).
-fn load() -> f64 {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse().ok())
-        .unwrap_or(f64::NAN)
-}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
