@@ -172,16 +172,27 @@ fn accumulate_unit(
             if let Some(forces) = prm.forces {
                 mv += dt * forces[pi];
             }
-            // Momentum at node offset (i, j, k): mv + affine·((i, j, k) − fx)·dx; the mass
-            // rides in the w lane (the affine columns have w = 0).
+            let blocked = prm.blocked.map_or(0, |b| b[pi]);
+            // Momentum at node offset (i, j, k): mv + affine·((i, j, k) − r)·dx; the mass
+            // rides in the w lane (the affine columns have w = 0). The affine part (stress
+            // and APIC) must carry no net momentum: internal forces cancel. Over the full
+            // stencil that holds for r = fx (the particle); over a stencil with blocked nodes,
+            // only for r = the weighted centroid of the nodes the particle reaches. About the
+            // particle, the stress would push clay off every surface it touches without
+            // touching it (a frictionless cushion), and the APIC term would add
+            // m·C·Σ w·(x_i − x_p) each substep (a force ∝ 1/Δt).
+            let r = if blocked != 0 {
+                reachable_centroid(&w, blocked).unwrap_or(fx)
+            } else {
+                fx
+            };
             let a = affine * dx;
-            let m0 = (mv - a * fx).extend(m);
+            let m0 = (mv - a * r).extend(m);
             let (ax, ay, az) = (
                 a.x_axis.extend(0.0),
                 a.y_axis.extend(0.0),
                 a.z_axis.extend(0.0),
             );
-            let blocked = prm.blocked.map_or(0, |b| b[pi]);
             let o = [
                 (base[0] - corner[0]) as usize,
                 (base[1] - corner[1]) as usize,
@@ -203,6 +214,26 @@ fn accumulate_unit(
             }
         }
     }
+}
+
+/// Weighted centroid (in node units from the stencil's base node) of the stencil nodes not
+/// in `blocked` (bit `(i·3 + j)·3 + k` for node `base + (i, j, k)`), with the quadratic
+/// B-spline weights `w`; `None` if every node is blocked.
+#[inline]
+fn reachable_centroid(w: &[[f32; 3]; 3], blocked: u32) -> Option<Vec3> {
+    let (mut sum_w, mut sum_wx) = (0.0f32, Vec3::ZERO);
+    for i in 0..3 {
+        for j in 0..3 {
+            for k in 0..3 {
+                if blocked & (1 << ((i * 3 + j) * 3 + k)) == 0 {
+                    let wk = w[0][i] * w[1][j] * w[2][k];
+                    sum_w += wk;
+                    sum_wx += wk * Vec3::new(i as f32, j as f32, k as f32);
+                }
+            }
+        }
+    }
+    (sum_w > 0.0).then(|| sum_wx / sum_w)
 }
 
 /// Outcome of a grid-to-particle pass.

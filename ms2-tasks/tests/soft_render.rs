@@ -319,9 +319,15 @@ fn fill_point_cloud_shows_the_clay_in_the_bucket_then_in_the_beaker() {
             "clay point {p} far from the bucket at {centre}"
         );
     }
+    // Pour until the episode ends in success (about 50 control steps); the arm then moves
+    // on and may hide the beaker from the camera.
     let mut obs = obs;
     for _ in 0..60 {
-        obs = e.step(&policy.act(&e)).unwrap().obs;
+        let out = e.step(&policy.act(&e)).unwrap();
+        obs = out.obs;
+        if out.terminated {
+            break;
+        }
     }
     let beaker = e.privileged_obs();
     let beaker = f32s(&beaker, "extra/beaker_pos");

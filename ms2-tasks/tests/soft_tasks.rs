@@ -136,7 +136,19 @@ fn scripted_sweep_collects_clay_in_the_bucket() {
 
 #[test]
 fn scripted_scoop_lifts_clay_above_the_target_height() {
-    let mut scene = ExcavateScene::new(11).unwrap();
+    assert_scripted_scoop_lifts_clay(ExcavateScene::new(11).unwrap());
+}
+
+#[test]
+fn scripted_scoop_lifts_clay_at_maniskill2s_2_khz_too() {
+    // At 2 kHz the clay used to slide out over the lip during the lift (0 particles left):
+    // on the stencil nodes the plate blocks, the clay's stress pushed it off the plate
+    // without contact (no friction), and the APIC term added momentum every substep.
+    assert_scripted_scoop_lifts_clay(ExcavateScene::with_substep(11, 5e-4).unwrap());
+}
+
+/// Runs the whole scripted scoop on `scene` and checks that clay ends in the lifted bucket.
+fn assert_scripted_scoop_lifts_clay(mut scene: ExcavateScene) {
     let plan = ScriptedScoop::plan(&scene);
     // Sweep, curl and lift (48 control steps), then 4 steps at rest.
     run_scoop(&mut scene, &plan, 0, 52);

@@ -11,8 +11,8 @@
 //! per rigid step; ManiSkill2 uses 2000 Hz). Clay: density 1000 kg/m³, E 1e4 Pa, Poisson 0.3,
 //! yield stress 2e3 Pa (the paper's soft clay). Stability: the clay's pressure-wave speed is
 //! `sqrt(E(1−ν)/((1+ν)(1−2ν))/ρ)` ≈ 3.7 m/s, so a substep moves a wave 3.7 mm, 0.37 of a cell
-//! (CFL < 1); tools move below 0.5 m/s (0.05 cell per substep). The coupling's penalty
-//! stiffness follows the substep ([`CouplingParams::for_substep`]).
+//! (CFL < 1); tools move below 0.5 m/s (0.05 cell per substep). The coupling's contact
+//! constants are those of a 1 ms substep at every faster rate ([`COUPLING_REFERENCE_SUBSTEP`]).
 //!
 //! [`excavate`] is the Excavate scene with a scripted kinematic bucket (bed, goal, success
 //! rules and the scripted scoop); [`excavate_env`] is `Excavate-v0`, the same task with the
@@ -33,6 +33,15 @@ use ms2_physics::{BodyId, World};
 use crate::adapters::mpm_rigid::{
     CoupledBodies, MpmAdapterError, MpmRigidWorld, MpmRigidWorldView,
 };
+
+/// Substep (s) whose [`CouplingParams::for_substep`] contact constants every soft scene uses
+/// when its own substep is this short or shorter: the penalty stiffness and damping are then
+/// the same physical constants at every MPM rate (1 kHz, ManiSkill2's 2 kHz, ...), so the
+/// clay's behaviour does not change with `mpm_freq` (scaled as `0.2/Δt²`, a 2 kHz contact
+/// was four times stiffer and twice as damped, and the scripted scoop's yield fell by a
+/// fifth). Shorter substeps only make these constants more stable; longer ones get softer
+/// constants ([`CouplingParams::for_substep`] of their own length).
+pub const COUPLING_REFERENCE_SUBSTEP: f32 = 1e-3;
 
 /// Why a soft scene failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -120,7 +129,7 @@ impl SoftWorld {
         let bodies = CoupledBodies::new(world, bodies)?;
         let coupling = Coupling::new(
             &MpmRigidWorldView::new(world, &bodies),
-            CouplingParams::for_substep(dt),
+            CouplingParams::for_substep(dt.max(COUPLING_REFERENCE_SUBSTEP)),
         )?;
         Ok(Self {
             solver,
