@@ -97,12 +97,14 @@ def test_generated_soft_demos_replay_convert_and_render(tmp_path, capsys):
         target_control_mode="pd_ee_delta_pose",
         save_traj=True,
         allow_failure=True,
-        count=1,
         progress=False,
     )
-    assert converted.num_succeeded == 1
+    # Most Fill demos convert (docs/trajectory_format.md has the rate); seed-dependent ones
+    # spill, so one of the two is enough here.
+    assert converted.num_episodes == 2 and converted.num_succeeded >= 1
     with open_trajectory(converted.output) as out:
         assert out.env_info["env_kwargs"]["control_mode"] == "pd_ee_delta_pose"
+        assert all(out.is_soft(i) for i in range(len(out)))
         episode = out.read_episode(0)
     with open_trajectory(path) as src:
         source = src.read_episode(0)
