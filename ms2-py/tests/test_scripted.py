@@ -15,9 +15,13 @@ MIN_SUCCESS_RATE = 0.8
 
 
 def test_scripted_policy_success_rate(env_id):
-    env = make(env_id, obs_mode="state", control_mode=preferred_control_mode(env_id))
+    soft = "particles" in ms2.Ms2Env(env_id).supported_obs_modes
+    # The soft-body solutions are tuned in their envs' default pd_joint_delta_pos (in
+    # pd_ee_delta_pose the Fill pour currently misses the beaker: see docs/tasks.md).
+    mode = None if soft else preferred_control_mode(env_id)
+    env = make(env_id, obs_mode="state", control_mode=mode)
     policy = ms2.ScriptedPolicy(env)
-    episodes = SOFT_EPISODES if "particles" in env.unwrapped.supported_obs_modes else EPISODES
+    episodes = SOFT_EPISODES if soft else EPISODES
     successes = 0
     for seed in range(episodes):
         env.reset(seed=seed)
