@@ -133,15 +133,11 @@ pub fn recorded_env_kwargs<'py>(
     let resolved = py.detach(|| {
         crate::errors::catch_panics(|| Ok(ms2_tasks::make_env(&cfg)?.config().clone()))
     })?;
-    let dict = PyDict::new(py);
-    dict.set_item("obs_mode", &resolved.obs_mode)?;
-    dict.set_item("control_mode", &resolved.control_mode)?;
-    dict.set_item("reward_mode", &resolved.reward_mode)?;
-    dict.set_item("sim_freq", resolved.sim_freq)?;
-    dict.set_item("control_freq", resolved.control_freq)?;
-    dict.set_item("max_episode_steps", resolved.max_episode_steps)?;
-    if let Some(hz) = resolved.mpm_freq {
-        dict.set_item("mpm_freq", hz)?;
+    let dict = crate::config::config_to_py(py, &resolved)?;
+    dict.del_item("env_id")?;
+    dict.del_item("render_mode")?;
+    if resolved.mpm_freq.is_none() {
+        dict.del_item("mpm_freq")?;
     }
     Ok(dict)
 }
