@@ -11,9 +11,10 @@ use crate::cameras::cameras_from_py;
 /// The keyword arguments every native env constructor and demonstration binding accepts, with
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
 /// ([`EnvConfig::new`]: `state_dict`, the task's control/reward mode, 500 Hz / 20 Hz, the task's
-/// episode limit, no render mode, the task's cameras, the soft-body task's MPM frequency).
-pub const ENV_KWARGS: [&str; 9] = [
+/// episode limit, no render mode, the task's default robot and cameras, the soft-body task's MPM frequency).
+pub const ENV_KWARGS: [&str; 10] = [
     "obs_mode",
+    "robot",
     "control_mode",
     "reward_mode",
     "render_mode",
@@ -56,6 +57,7 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
         }
         match key.as_str() {
             "obs_mode" => cfg.obs_mode = extract_kwarg(&key, &value, "a str")?,
+            "robot" => cfg.robot = Some(extract_kwarg(&key, &value, "a str")?),
             "control_mode" => cfg.control_mode = Some(extract_kwarg(&key, &value, "a str")?),
             "reward_mode" => cfg.reward_mode = Some(extract_kwarg(&key, &value, "a str")?),
             "render_mode" => cfg.render_mode = Some(extract_kwarg(&key, &value, "a str")?),
@@ -90,6 +92,7 @@ pub fn config_to_py<'py>(py: Python<'py>, cfg: &EnvConfig) -> PyResult<Bound<'py
     let dict = PyDict::new(py);
     dict.set_item("env_id", &cfg.env_id)?;
     dict.set_item("obs_mode", &cfg.obs_mode)?;
+    dict.set_item("robot", &cfg.robot)?;
     dict.set_item("control_mode", &cfg.control_mode)?;
     dict.set_item("reward_mode", &cfg.reward_mode)?;
     dict.set_item("render_mode", &cfg.render_mode)?;

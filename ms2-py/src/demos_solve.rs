@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use crate::config::config_from_kwargs;
 use crate::demos_common::{demo_error_to_py, episode_to_py, in_pool};
-use crate::errors::catch_panics;
+use crate::errors::{catch_panics, NativeError};
 
 /// Env ids that have a motion-planning solution.
 #[pyfunction]
@@ -37,20 +37,22 @@ pub fn solve_episodes<'py>(
         catch_panics(|| {
             in_pool(num_workers, || {
                 // Seeds go out in chunks (a few per worker, for balance); each chunk builds one
-                // solver (env + planners) and reuses it for its seeds.
+                // solver (env + planners) and reuses it for its seeds. A solver that cannot be
+                // built fails the whole call with its error.
                 let chunk = seeds.len().div_ceil(4 * num_workers.max(1)).max(1);
-                let chunks: Vec<Vec<Result<DemoEpisode, DemoError>>> = seeds
+                seeds
                     .par_chunks(chunk)
-                    .map(|chunk| match DemoSolver::new(&cfg) {
-                        Ok(mut solver) => chunk
+                    .map(|chunk| {
+                        let mut solver = DemoSolver::new(&cfg)?;
+                        Ok(chunk
                             .iter()
                             .map(|&seed| solver.solve(seed).map(|(episode, _)| episode))
-                            .collect(),
-                        Err(err) => vec![Err(err); chunk.len()],
+                            .collect::<Vec<_>>())
                     })
-                    .collect();
-                chunks.into_iter().flatten().collect()
-            })
+                    .collect::<Result<Vec<_>, DemoError>>()
+                    .map(|chunks| chunks.into_iter().flatten().collect())
+            })?
+            .map_err(NativeError::from)
         })
     })?;
     let out = PyList::empty(py);

@@ -71,6 +71,8 @@ fn is_input_error(err: &EnvError) -> bool {
         EnvError::UnknownEnvId { .. }
             | EnvError::UnknownObsMode { .. }
             | EnvError::UnknownControlMode { .. }
+            | EnvError::UnknownRobot { .. }
+            | EnvError::FeatureDisabled { .. }
             | EnvError::UnknownRewardMode { .. }
             | EnvError::UnknownRenderMode { .. }
             | EnvError::ActionShape { .. }

@@ -32,13 +32,40 @@ fn env_ids() -> PyResult<Vec<String>> {
     Ok(ids.into_iter().map(str::to_owned).collect())
 }
 
-/// The default episode limit (env steps) of task `env_id` (`ValueError` for an unknown id).
+/// The default episode limit (env steps) of task `env_id` (`ValueError` for an unknown id),
+/// read from its spec: no env is built.
 #[pyfunction]
-fn default_max_episode_steps(py: Python<'_>, env_id: String) -> PyResult<u32> {
-    let cfg = ms2_tasks::EnvConfig::new(&env_id);
-    let steps =
-        py.detach(|| errors::catch_panics(|| Ok(ms2_tasks::make_env(&cfg)?.max_episode_steps())))?;
+fn default_max_episode_steps(env_id: String) -> PyResult<u32> {
+    let steps = errors::catch_panics(|| Ok(ms2_tasks::task_spec(&env_id)?.max_episode_steps))?;
     Ok(steps)
+}
+
+/// Every registered task's spec as a dict: `env_id`, `family`, `summary`,
+/// `max_episode_steps`, `robots` (the `robot=` uids, default first), `control_modes` (empty:
+/// every mode of the robot), `default_control_mode`, `obs_modes`, `soft_bodies`. Reading them
+/// builds no env.
+#[pyfunction]
+fn task_specs(py: Python<'_>) -> PyResult<Vec<Bound<'_, pyo3::types::PyDict>>> {
+    let specs = errors::infallible(ms2_tasks::task_specs)?;
+    specs
+        .iter()
+        .map(|s| {
+            let d = pyo3::types::PyDict::new(py);
+            d.set_item("env_id", s.env_id)?;
+            d.set_item("family", s.family)?;
+            d.set_item("summary", s.summary)?;
+            d.set_item("max_episode_steps", s.max_episode_steps)?;
+            d.set_item("robots", s.robots.iter().map(|r| r.uid).collect::<Vec<_>>())?;
+            d.set_item("control_modes", s.control_modes.to_vec())?;
+            d.set_item("default_control_mode", s.default_control_mode)?;
+            d.set_item(
+                "obs_modes",
+                s.obs_modes.iter().map(|m| m.as_str()).collect::<Vec<_>>(),
+            )?;
+            d.set_item("soft_bodies", s.soft_bodies)?;
+            Ok(d)
+        })
+        .collect()
 }
 
 /// Panics inside a guarded native call with `message`: a test hook showing that a Rust panic
@@ -78,6 +105,7 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(render_adapter, m)?)?;
     m.add_function(wrap_pyfunction!(default_max_episode_steps, m)?)?;
+    m.add_function(wrap_pyfunction!(task_specs, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add_function(wrap_pyfunction!(demos_solve::solve_episodes, m)?)?;
     m.add_function(wrap_pyfunction!(demos_replay::replay_episodes, m)?)?;

@@ -13,11 +13,11 @@
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-use ms2_control::{ControlMode, ControlTiming, RobotConfig};
+use ms2_control::{ControlMode, ControlTiming};
 use ms2_physics::{World, WorldConfig};
-use ms2_tasks::agent::PandaAgent;
+use ms2_tasks::agents::{Agent, PandaAgent};
+use ms2_tasks::families::rigid::common::{add_cube, CUBE_HALF_SIZE};
 use ms2_tasks::seeding::episode_rng;
-use ms2_tasks::tasks::common::{add_cube, CUBE_HALF_SIZE};
 use ms2_tasks::{make_env, EnvConfig, VecEnv};
 use rand::Rng;
 
@@ -92,7 +92,7 @@ fn overhead_pair(mode: &str, seed: u64, steps: usize) -> (f64, f64) {
     let scene = env.task_scene().expect("robot task");
     let world_len = scene.world.state_len();
     let initial = env.get_state()[..world_len].to_vec();
-    let art = scene.agent.articulation;
+    let art = scene.agent.articulation();
     let dim = env.action_space().size();
     let mut rng = episode_rng(seed);
     let actions: Vec<Vec<f32>> = (0..steps)
@@ -108,20 +108,24 @@ fn overhead_pair(mode: &str, seed: u64, steps: usize) -> (f64, f64) {
         targets.push(w.drive_targets(art).expect("targets"));
     }
 
-    let robot = RobotConfig::panda(ms2_assets::PANDA_URDF).expect("panda");
     let mut world = World::new(WorldConfig::default()).expect("world");
     let mode_enum = ControlMode::ALL
         .into_iter()
         .find(|m| m.name() == mode)
         .expect("mode");
-    let agent =
-        PandaAgent::build(&mut world, &robot, mode_enum, ControlTiming::MANISKILL2).expect("agent");
+    let agent = PandaAgent::build_from_urdf(
+        &mut world,
+        mode_enum,
+        ControlTiming::MANISKILL2,
+        ms2_assets::PANDA_URDF,
+    )
+    .expect("agent");
     add_cube(&mut world, "cube", CUBE_HALF_SIZE, [1.0, 0.0, 0.0, 1.0]).expect("cube");
     world.set_state(&initial).expect("same scene layout");
     let start = Instant::now();
     for t in &targets {
         world
-            .set_drive_targets(agent.articulation, t)
+            .set_drive_targets(agent.articulation(), t)
             .expect("targets");
         for _ in 0..SUBSTEPS {
             world.step();

@@ -5,7 +5,7 @@
 
 use std::time::Instant;
 
-use ms2_tasks::tasks::soft::excavate::{ExcavateScene, ScriptedScoop};
+use ms2_tasks::families::soft::excavate_scene::{ExcavateScene, ScriptedScoop};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

@@ -95,8 +95,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 /// Particles of a soft env's current episode (from its task).
 fn particle_count(env: &ms2_tasks::Env) -> usize {
-    use ms2_tasks::tasks::soft::{excavate_env::Excavate, fill::Fill};
-    let any = env.task_any();
+    use ms2_tasks::families::soft::{excavate::Excavate, fill::Fill};
+    let any = env.task();
     any.and_then(|t| t.downcast_ref::<Excavate>())
         .map(|t| t.arm().particle_count())
         .or_else(|| {

@@ -5,8 +5,6 @@
 //! task runtime ([`crate::task_env::TaskEnv`] over a [`crate::Task`]) or the physics-free test
 //! env `Dummy-v0`.
 
-use std::any::Any;
-
 use crate::error::EnvError;
 use crate::info::Evaluation;
 use crate::obs::ObsValue;
@@ -16,8 +14,6 @@ use crate::task::TaskScene;
 
 /// A simulation the [`crate::Env`] runtime drives.
 pub(crate) trait EnvBackend: Send {
-    /// The task's default episode length in env steps.
-    fn default_max_episode_steps(&self) -> u32;
     /// Control modes supported by the robot.
     fn control_modes(&self) -> Vec<String>;
     /// The active control mode.
@@ -60,11 +56,18 @@ pub(crate) trait EnvBackend: Send {
     /// rendering across envs (robot tasks only).
     fn sensors_mut(
         &mut self,
-    ) -> Result<(&mut crate::sensors::Sensors, &ms2_physics::World), EnvError> {
+    ) -> Result<
+        (
+            &mut crate::sensors::Sensors,
+            &dyn crate::rigid_world::RigidWorld,
+        ),
+        EnvError,
+    > {
         Err(self.not_renderable())
     }
-    /// Renders the human view, goal marker shown (robot tasks only).
-    fn render_human(&self) -> Result<ms2_render::CameraOutput, EnvError> {
+    /// Renders the human view with a goal marker at the `extra` entry `goal_key` (robot tasks
+    /// only).
+    fn render_human(&self, _goal_key: Option<&str>) -> Result<ms2_render::CameraOutput, EnvError> {
         Err(self.not_renderable())
     }
     /// Channel-1 segmentation ids by object name (robot tasks only).
@@ -87,7 +90,7 @@ pub(crate) trait EnvBackend: Send {
         None
     }
     /// The task, for robot tasks (scripted policies downcast it).
-    fn task_any(&self) -> Option<&dyn Any> {
+    fn task(&self) -> Option<&dyn crate::task::Task> {
         None
     }
 }

@@ -15,6 +15,9 @@ pub struct EnvConfig {
     /// Observation mode: `"state_dict"`, `"state"`, `"rgbd"`, `"pointcloud"`,
     /// `"rgbd_robot_seg"` or `"pointcloud_robot_seg"`.
     pub obs_mode: String,
+    /// Robot uid (ManiSkill2's `robot=`, e.g. `"panda"`); `None` = the task's default (see
+    /// [`crate::spec::TaskSpec::robots`]).
+    pub robot: Option<String>,
     /// Control mode of the robot; `None` = the task's default (`"pd_joint_delta_pos"`).
     pub control_mode: Option<String>,
     /// Reward mode: `"sparse"`, `"dense"` or `"normalized_dense"`; `None` = `"normalized_dense"`.
@@ -41,6 +44,7 @@ impl Default for EnvConfig {
         Self {
             env_id: "PickCube-v0".to_owned(),
             obs_mode: ObsMode::StateDict.as_str().to_owned(),
+            robot: None,
             control_mode: None,
             reward_mode: None,
             render_mode: None,

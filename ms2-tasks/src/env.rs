@@ -1,13 +1,18 @@
 //! [`Env`]: the gymnasium-style environment runtime shared by every task.
 
+use std::sync::Arc;
+
 use crate::backend::EnvBackend;
 use crate::config::{EnvConfig, ObsMode, RewardMode, RENDER_MODES};
 use crate::error::EnvError;
 use crate::info::{Evaluation, Info, InfoValue};
 use crate::obs::{Array, ArrayData, ObsValue};
-use crate::registry;
+use crate::registry::{self, Simulation};
+use crate::rigid_world::{default_engine, RigidEngine};
 use crate::seeding::{episode_rng, Seeding};
 use crate::spaces::{BoxSpace, Space};
+use crate::spec::TaskSpec;
+use crate::task_env::TaskEnv;
 
 /// Episode seed used to build the scene and sample a first episode when an env is made (as
 /// ManiSkill2 does to derive its observation space). The env is usable (steppable) right away.
@@ -41,6 +46,7 @@ pub struct StepOutput {
 /// ```
 pub struct Env {
     cfg: EnvConfig,
+    spec: TaskSpec,
     obs_mode: ObsMode,
     reward_mode: RewardMode,
     backend: Box<dyn EnvBackend>,
@@ -66,9 +72,30 @@ pub fn make_env(cfg: &EnvConfig) -> Result<Env, EnvError> {
 }
 
 impl Env {
-    /// Makes the environment `cfg.env_id`, builds its scene and samples a first episode.
+    /// Makes the environment `cfg.env_id` on the default rigid engine (rapier, feature
+    /// `rapier`), builds its scene and samples a first episode.
     pub fn new(cfg: &EnvConfig) -> Result<Env, EnvError> {
+        let engine = default_engine().ok_or(EnvError::NoRigidEngine)?;
+        Env::with_engine(cfg, engine)
+    }
+
+    /// [`Env::new`] on another rigid engine (see [`crate::rigid_world`]).
+    pub fn with_engine(cfg: &EnvConfig, engine: Arc<dyn RigidEngine>) -> Result<Env, EnvError> {
+        let registration = registry::registration(&cfg.env_id)?;
+        let spec = registration.spec;
         let obs_mode = ObsMode::parse(&cfg.obs_mode)?;
+        if !spec.supports_obs_mode(obs_mode) {
+            return Err(EnvError::UnknownObsMode {
+                got: cfg.obs_mode.clone(),
+                valid: supported_obs_modes(&spec),
+            });
+        }
+        if obs_mode.visual().is_some() && !cfg!(feature = "render") {
+            return Err(EnvError::FeatureDisabled {
+                what: format!("obs_mode {:?}", cfg.obs_mode),
+                feature: "render",
+            });
+        }
         let reward_mode =
             RewardMode::parse(cfg.reward_mode.as_deref().unwrap_or("normalized_dense"))?;
         if let Some(rm) = &cfg.render_mode {
@@ -84,27 +111,45 @@ impl Env {
                 "max_episode_steps must be at least 1, got 0".to_owned(),
             ));
         }
-        let substeps = cfg.substeps()?;
-        let backend = registry::make_backend(cfg, substeps)?;
-        if let (Some(hz), None) = (cfg.mpm_freq, backend.mpm_freq()) {
+        let robot = match cfg.robot.as_deref() {
+            None => spec.robots.first().map(|r| r.uid),
+            Some(uid) => {
+                Some(
+                    spec.robot(uid)
+                        .map(|r| r.uid)
+                        .ok_or_else(|| EnvError::UnknownRobot {
+                            got: uid.to_owned(),
+                            valid: spec.robots.iter().map(|r| r.uid.to_owned()).collect(),
+                        })?,
+                )
+            }
+        };
+        if let (Some(hz), false) = (cfg.mpm_freq, spec.soft_bodies) {
             return Err(EnvError::InvalidConfig(format!(
                 "mpm_freq ({hz} Hz) applies only to envs with soft bodies; {} has none",
                 cfg.env_id
             )));
         }
+        let substeps = cfg.substeps()?;
+        let backend: Box<dyn EnvBackend> = match registration.simulation {
+            Simulation::Task(make) => {
+                let task = make(cfg)?;
+                Box::new(TaskEnv::new(cfg, substeps, &spec, robot, task, engine)?)
+            }
+            Simulation::Backend(make) => make(cfg, substeps)?,
+        };
         let resolved = EnvConfig {
             mpm_freq: backend.mpm_freq(),
+            robot: robot.map(str::to_owned),
             control_mode: Some(backend.control_mode().to_owned()),
             reward_mode: Some(reward_mode.as_str().to_owned()),
-            max_episode_steps: Some(
-                cfg.max_episode_steps
-                    .unwrap_or_else(|| backend.default_max_episode_steps()),
-            ),
+            max_episode_steps: Some(cfg.max_episode_steps.unwrap_or(spec.max_episode_steps)),
             ..cfg.clone()
         };
         let mut env = Env {
             max_episode_steps: resolved.max_episode_steps.unwrap_or(1),
             cfg: resolved,
+            spec,
             obs_mode,
             reward_mode,
             backend,
@@ -115,16 +160,6 @@ impl Env {
         // The backend built its scene when it was made; sample a first episode.
         let mut rng = episode_rng(CONSTRUCTION_SEED);
         env.backend.initialize_episode(&mut rng)?;
-        if obs_mode == ObsMode::Particles && env.backend.observe_particles().is_none() {
-            return Err(EnvError::UnknownObsMode {
-                got: env.cfg.obs_mode.clone(),
-                valid: ObsMode::ALL
-                    .iter()
-                    .filter(|m| **m != ObsMode::Particles)
-                    .map(|m| m.as_str().to_owned())
-                    .collect(),
-            });
-        }
         env.observation_space = Space::unbounded_like(&env.try_observe()?);
         Ok(env)
     }
@@ -271,6 +306,7 @@ impl Env {
                 let frame = self.backend.capture_cameras()?;
                 Ok(crate::sensors::visual_obs::assemble(
                     self.backend.observe_state_dict(),
+                    self.spec.non_privileged_extra_keys,
                     frame,
                     layout,
                     robot_seg,
@@ -289,9 +325,10 @@ impl Env {
             ObsMode::Rgbd
             | ObsMode::PointCloud
             | ObsMode::RgbdRobotSeg
-            | ObsMode::PointCloudRobotSeg => {
-                ObsValue::Dict(crate::sensors::visual_obs::non_privileged_state(dict))
-            }
+            | ObsMode::PointCloudRobotSeg => ObsValue::Dict(crate::obs::non_privileged_state(
+                dict,
+                self.spec.non_privileged_extra_keys,
+            )),
             ObsMode::StateDict => dict,
             ObsMode::Particles => match (dict, self.backend.observe_particles()) {
                 (ObsValue::Dict(mut entries), Some(particles)) => {
@@ -383,17 +420,15 @@ impl Env {
         self.backend.control_modes()
     }
 
-    /// Supported observation modes (visual modes only for envs with a 3D scene, `particles`
-    /// only for soft-body envs).
+    /// Supported observation modes (the task spec's: visual modes only for envs with a 3D
+    /// scene, `particles` only for soft-body envs).
     pub fn obs_modes(&self) -> Vec<String> {
-        let renderable = self.backend.task_scene().is_some();
-        let has_particles = self.backend.observe_particles().is_some();
-        ObsMode::ALL
-            .iter()
-            .filter(|m| renderable || m.visual().is_none())
-            .filter(|m| has_particles || **m != ObsMode::Particles)
-            .map(|m| m.as_str().to_owned())
-            .collect()
+        supported_obs_modes(&self.spec)
+    }
+
+    /// The task's static description.
+    pub fn spec(&self) -> &TaskSpec {
+        &self.spec
     }
 
     /// Supported reward modes.
@@ -409,15 +444,16 @@ impl Env {
         self.backend.task_scene()
     }
 
-    /// The task object of a robot task (downcast with `Any::downcast_ref`).
-    pub fn task_any(&self) -> Option<&dyn std::any::Any> {
-        self.backend.task_any()
+    /// The task object of a robot task (read task data with `downcast_ref`, e.g.
+    /// `env.task().and_then(|t| t.downcast_ref::<StackCube>())`).
+    pub fn task(&self) -> Option<&dyn crate::task::Task> {
+        self.backend.task()
     }
 
     /// The human view for `render_mode = "rgb_array"`: uint8 [512, 512, 3] from the render
     /// camera, goal markers shown (they never appear in observation images).
     pub fn render(&self) -> Result<Array, EnvError> {
-        let out = self.backend.render_human()?;
+        let out = self.backend.render_human(self.spec.goal_marker)?;
         Ok(Array {
             shape: vec![out.height() as usize, out.width() as usize, 3],
             data: ArrayData::U8(out.rgb),
@@ -441,6 +477,15 @@ impl Env {
     pub fn max_dense_reward(&self) -> f64 {
         self.backend.max_dense_reward()
     }
+}
+
+/// The names of the obs modes `spec` supports, in [`ObsMode::ALL`] order.
+fn supported_obs_modes(spec: &TaskSpec) -> Vec<String> {
+    ObsMode::ALL
+        .iter()
+        .filter(|m| spec.supports_obs_mode(**m))
+        .map(|m| m.as_str().to_owned())
+        .collect()
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 /// Everything that can go wrong when making, resetting or stepping an environment.
 ///
 /// Messages name the bad value and list what was expected.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum EnvError {
     /// `env_id` is not registered.
     #[error("unknown env id {got:?}; registered ids: {valid:?}")]
@@ -19,6 +19,14 @@ pub enum EnvError {
         /// The mode that was asked for.
         got: String,
         /// The supported modes.
+        valid: Vec<String>,
+    },
+    /// `robot` is not supported by this environment (or not registered).
+    #[error("unknown robot {got:?}; valid robots: {valid:?}")]
+    UnknownRobot {
+        /// The robot that was asked for.
+        got: String,
+        /// The supported robots.
         valid: Vec<String>,
     },
     /// `control_mode` is not supported by this environment's robot.
@@ -94,9 +102,28 @@ pub enum EnvError {
     /// The configuration is inconsistent (message says what and why).
     #[error("invalid env config: {0}")]
     InvalidConfig(String),
-    /// The physics backend failed (message from the physics crate).
+    /// The rigid engine refused an input or failed.
     #[error("physics error: {0}")]
-    Physics(String),
+    Physics(#[from] ms2_physics::PhysicsError),
+    /// A robot or object description (URDF) could not be read.
+    #[error("description error: {0}")]
+    Urdf(#[from] ms2_physics::UrdfError),
+    /// A soft-body scene failed.
+    #[cfg(feature = "soft")]
+    #[error("soft body: {0}")]
+    Soft(#[from] crate::soft::SoftSceneError),
+    /// The crate was built without a rigid engine (feature `rapier`): pass one to
+    /// [`crate::Env::with_engine`].
+    #[error("no rigid engine: ms2-tasks was built without the `rapier` feature; pass an engine to Env::with_engine")]
+    NoRigidEngine,
+    /// The request needs a cargo feature this build of ms2-tasks lacks.
+    #[error("{what} needs ms2-tasks' `{feature}` feature, which this build lacks")]
+    FeatureDisabled {
+        /// What was asked for.
+        what: String,
+        /// The missing feature.
+        feature: &'static str,
+    },
     /// The controller failed (message from the control crate).
     #[error("controller error: {0}")]
     Controller(String),
@@ -122,4 +149,13 @@ pub enum EnvError {
         /// Why not.
         reason: String,
     },
+}
+
+/// Two errors are equal when they are the same variant with the same message (sources such as
+/// [`ms2_physics::PhysicsError`] are compared through their messages, which name every value).
+impl PartialEq for EnvError {
+    fn eq(&self, other: &Self) -> bool {
+        std::mem::discriminant(self) == std::mem::discriminant(other)
+            && self.to_string() == other.to_string()
+    }
 }

@@ -24,24 +24,34 @@
 
 #![warn(missing_docs)]
 
+// Family folders name the crate `ms2_tasks::…`, so the same folder compiles in this crate or in
+// a crate of one's own that registers it with `register_family`.
+extern crate self as ms2_tasks;
+
 pub mod adapters;
-pub mod agent;
+pub mod agents;
 mod backend;
 pub mod config;
+#[cfg(feature = "demos")]
 pub mod demos;
 mod env;
 pub mod error;
+pub mod families;
 pub mod geometry;
 pub mod info;
 pub mod obs;
-mod registry;
+pub mod particles;
+pub mod registry;
+pub mod rigid_world;
 pub mod scripted;
 pub mod seeding;
 pub mod sensors;
+#[cfg(feature = "soft")]
+pub mod soft;
 pub mod spaces;
+pub mod spec;
 pub mod task;
 mod task_env;
-pub mod tasks;
 mod vec_env;
 
 pub use config::{EnvConfig, ObsMode, RewardMode};
@@ -49,9 +59,11 @@ pub use env::{make_env, Env, StepOutput};
 pub use error::EnvError;
 pub use info::{info_get, Evaluation, Info, InfoValue};
 pub use obs::{Array, ArrayData, DType, DictBuilder, ObsValue};
-pub use registry::env_ids;
+pub use registry::{env_ids, register_family, task_spec, task_specs};
+pub use rigid_world::{RigidEngine, RigidWorld};
 pub use scripted::{make_scripted_policy, ScriptedPolicy};
 pub use seeding::EpisodeRng;
 pub use spaces::{BoxSpace, Space};
-pub use task::{Task, TaskScene};
+pub use spec::TaskSpec;
+pub use task::{SoftComponent, Task, TaskScene};
 pub use vec_env::{EnvCommand, VecEnv};

@@ -202,8 +202,53 @@ impl DictBuilder {
     }
 }
 
+/// `state_dict` reduced to the entries a visual mode keeps: `agent` as is, `extra` filtered to
+/// `keys` (a task spec's `non_privileged_extra_keys`: what a real robot would know).
+pub fn non_privileged_state(state_dict: ObsValue, keys: &[&str]) -> Vec<(String, ObsValue)> {
+    let ObsValue::Dict(entries) = state_dict else {
+        return Vec::new();
+    };
+    entries
+        .into_iter()
+        .map(|(key, value)| match (key.as_str(), value) {
+            ("extra", ObsValue::Dict(extra)) => (
+                key,
+                ObsValue::Dict(
+                    extra
+                        .into_iter()
+                        .filter(|(k, _)| keys.contains(&k.as_str()))
+                        .collect(),
+                ),
+            ),
+            (_, value) => (key, value),
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn extra_keeps_only_non_privileged_keys() {
+        let state = ObsValue::Dict(vec![
+            (
+                "agent".into(),
+                DictBuilder::new().vector("qpos", &[0.0]).build(),
+            ),
+            (
+                "extra".into(),
+                DictBuilder::new()
+                    .vector("tcp_pose", &[0.0; 7])
+                    .vector("goal_pos", &[0.0; 3])
+                    .vector("obj_pose", &[0.0; 7])
+                    .build(),
+            ),
+        ]);
+        let kept = ObsValue::Dict(non_privileged_state(state, &["tcp_pose", "goal_pos"]));
+        assert!(kept.get("agent/qpos").is_some());
+        assert!(kept.get("extra/tcp_pose").is_some() && kept.get("extra/goal_pos").is_some());
+        assert!(kept.get("extra/obj_pose").is_none());
+    }
+
     use super::*;
 
     #[test]

@@ -1,33 +1,36 @@
 //! [`TaskEnv`]: the shared runtime of the robot tasks (world + robot + controller + step loop),
 //! driving a [`Task`]'s hooks.
 
-use std::any::Any;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
-use ms2_control::{ControlMode, ControlTiming, RobotConfig};
-use ms2_physics::{World, WorldConfig};
+use ms2_control::{ControlMode, ControlTiming};
+use ms2_physics::WorldConfig;
 
 use crate::adapters::RenderContext;
-use crate::agent::{physics_err, PandaAgent};
+use crate::agents::{robot_spec, RobotSpec};
 use crate::backend::EnvBackend;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
 use crate::geometry::vectorize_pose;
 use crate::info::Evaluation;
 use crate::obs::{DictBuilder, ObsValue};
+use crate::rigid_world::RigidEngine;
+use crate::rigid_world::RigidWorld;
 use crate::seeding::{episode_rng, EpisodeRng};
 use crate::sensors::{CameraConfig, CameraFrame, Sensors};
 use crate::spaces::BoxSpace;
+use crate::spec::TaskSpec;
 use crate::task::{Task, TaskScene};
 
 /// Seed of the scene built when an env is made.
 const BUILD_SEED: u64 = 2022;
 
-/// The robot-task runtime over task `T`.
-pub(crate) struct TaskEnv<T: Task> {
-    task: T,
+/// The robot-task runtime over a task's hooks.
+pub(crate) struct TaskEnv {
+    task: Box<dyn Task>,
     scene: TaskScene,
-    robot: RobotConfig,
+    robot: &'static RobotSpec,
+    engine: Arc<dyn RigidEngine>,
     world_config: WorldConfig,
     timing: ControlTiming,
     substeps: u32,
@@ -38,22 +41,36 @@ pub(crate) struct TaskEnv<T: Task> {
     sensors: Mutex<Option<Sensors>>,
 }
 
-impl<T: Task> TaskEnv<T> {
-    /// Builds the runtime for `cfg` (control mode resolved here) around `task`.
-    pub(crate) fn new(cfg: &EnvConfig, substeps: u32, mut task: T) -> Result<Self, EnvError> {
-        let robot = RobotConfig::panda(ms2_assets::PANDA_URDF)
-            .map_err(|e| EnvError::Controller(e.to_string()))?;
-        let control_modes: Vec<String> = robot
-            .supported_modes
-            .iter()
-            .map(|m| m.name().to_owned())
+impl TaskEnv {
+    /// Builds the runtime for `cfg` around `task`: the robot chosen by `robot_uid` (a uid of
+    /// `spec.robots`, already checked), the control mode resolved against the spec and the
+    /// robot, the world made by `engine`.
+    pub(crate) fn new(
+        cfg: &EnvConfig,
+        substeps: u32,
+        spec: &TaskSpec,
+        robot_uid: Option<&str>,
+        mut task: Box<dyn Task>,
+        engine: Arc<dyn RigidEngine>,
+    ) -> Result<Self, EnvError> {
+        let agent_name = robot_uid
+            .and_then(|uid| spec.robot(uid))
+            .map(|r| r.agent)
+            .ok_or_else(|| EnvError::UnknownRobot {
+                got: robot_uid.unwrap_or("None").to_owned(),
+                valid: spec.robots.iter().map(|r| r.uid.to_owned()).collect(),
+            })?;
+        let robot = robot_spec(agent_name)?;
+        let supported: Vec<ControlMode> = (robot.control_modes)()
+            .into_iter()
+            .filter(|m| spec.control_modes.is_empty() || spec.control_modes.contains(&m.name()))
             .collect();
+        let control_modes: Vec<String> = supported.iter().map(|m| m.name().to_owned()).collect();
         let mode_name = cfg
             .control_mode
             .as_deref()
-            .unwrap_or(ControlMode::DEFAULT.name());
-        let mode = robot
-            .supported_modes
+            .unwrap_or(spec.default_control_mode);
+        let mode = supported
             .iter()
             .copied()
             .find(|m| m.name() == mode_name)
@@ -70,8 +87,16 @@ impl<T: Task> TaskEnv<T> {
             ..WorldConfig::default()
         };
         let mut rng = episode_rng(BUILD_SEED);
-        let scene = build_scene(&world_config, &robot, mode, timing, &mut task, &mut rng)?;
-        let ctrl = &scene.agent.controller;
+        let scene = build_scene(
+            engine.as_ref(),
+            &world_config,
+            robot,
+            mode,
+            timing,
+            task.as_mut(),
+            &mut rng,
+        )?;
+        let ctrl = scene.agent.controller();
         let action_space = BoxSpace::vector(
             ctrl.action_low().iter().map(|&v| v as f32).collect(),
             ctrl.action_high().iter().map(|&v| v as f32).collect(),
@@ -87,6 +112,7 @@ impl<T: Task> TaskEnv<T> {
             task,
             scene,
             robot,
+            engine,
             world_config,
             timing,
             substeps,
@@ -100,7 +126,7 @@ impl<T: Task> TaskEnv<T> {
     /// Runs `f` on the env's sensors (built on first use) and world.
     fn with_sensors<R>(
         &self,
-        f: impl FnOnce(&mut Sensors, &ms2_physics::World) -> Result<R, EnvError>,
+        f: impl FnOnce(&mut Sensors, &dyn RigidWorld) -> Result<R, EnvError>,
     ) -> Result<R, EnvError> {
         let mut guard = self
             .sensors
@@ -110,8 +136,8 @@ impl<T: Task> TaskEnv<T> {
             Some(sensors) => sensors,
             slot @ None => slot.insert(self.new_sensors()?),
         };
-        sync_particles(&self.task, sensors)?;
-        f(sensors, &self.scene.world)
+        sync_particles(self.task.as_ref(), sensors)?;
+        f(sensors, self.scene.world.as_ref())
     }
 
     /// The env's cameras and render scene (with the task's particle sets), drawing through the
@@ -119,12 +145,17 @@ impl<T: Task> TaskEnv<T> {
     fn new_sensors(&self) -> Result<Sensors, EnvError> {
         let mut sensors = Sensors::new(
             RenderContext::shared()?,
-            &self.scene.world,
-            Some(self.scene.agent.articulation),
+            self.scene.world.as_ref(),
+            Some(self.scene.agent.articulation()),
             self.camera_cfgs.clone(),
             CameraConfig::render_camera(),
         )?;
-        for visual in self.task.particle_visuals() {
+        for visual in self
+            .task
+            .soft()
+            .map(|s| s.particle_visuals())
+            .unwrap_or_default()
+        {
             sensors.add_particle_set(&visual)?;
         }
         Ok(sensors)
@@ -133,7 +164,7 @@ impl<T: Task> TaskEnv<T> {
     fn controller_state(&self) -> Vec<f32> {
         self.scene
             .agent
-            .controller
+            .controller()
             .state()
             .iter()
             .flat_map(|(_, v)| v.iter().map(|&x| x as f32))
@@ -142,9 +173,12 @@ impl<T: Task> TaskEnv<T> {
 }
 
 /// Copies the task's current particle positions into the sensors' particle sets.
-fn sync_particles<T: Task>(task: &T, sensors: &mut Sensors) -> Result<(), EnvError> {
+fn sync_particles(task: &dyn Task, sensors: &mut Sensors) -> Result<(), EnvError> {
+    let Some(soft) = task.soft() else {
+        return Ok(());
+    };
     for set in 0..sensors.particle_set_count() {
-        sensors.set_particle_positions(set, task.particle_positions(set))?;
+        sensors.set_particle_positions(set, soft.particle_positions(set))?;
     }
     Ok(())
 }
@@ -155,31 +189,28 @@ fn poisoned<T>(_: std::sync::PoisonError<T>) -> EnvError {
 }
 
 /// A fresh world with the ground, the robot and the task's actors.
-fn build_scene<T: Task>(
+fn build_scene(
+    engine: &dyn RigidEngine,
     world_config: &WorldConfig,
-    robot: &RobotConfig,
+    robot: &RobotSpec,
     mode: ControlMode,
     timing: ControlTiming,
-    task: &mut T,
+    task: &mut dyn Task,
     rng: &mut EpisodeRng,
 ) -> Result<TaskScene, EnvError> {
-    let mut world = World::new(world_config.clone()).map_err(physics_err)?;
-    let agent = PandaAgent::build_from_urdf(&mut world, robot, mode, timing, task.robot_urdf())?;
-    task.build_scene(&mut world, rng)?;
+    let mut world = engine.new_world(world_config)?;
+    let agent = (robot.build)(world.as_mut(), mode, timing)?;
+    task.build_scene(world.as_mut(), rng)?;
     Ok(TaskScene { world, agent })
 }
 
-impl<T: Task> EnvBackend for TaskEnv<T> {
-    fn default_max_episode_steps(&self) -> u32 {
-        self.task.max_episode_steps()
-    }
-
+impl EnvBackend for TaskEnv {
     fn control_modes(&self) -> Vec<String> {
         self.control_modes.clone()
     }
 
     fn control_mode(&self) -> &str {
-        self.scene.agent.control_mode.name()
+        self.scene.agent.control_mode().name()
     }
 
     fn action_space(&self) -> &BoxSpace {
@@ -191,13 +222,14 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
     }
 
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
-        let mode = self.scene.agent.control_mode;
+        let mode = self.scene.agent.control_mode();
         self.scene = build_scene(
+            self.engine.as_ref(),
             &self.world_config,
-            &self.robot,
+            self.robot,
             mode,
             self.timing,
-            &mut self.task,
+            self.task.as_mut(),
             rng,
         )?;
         // The new world has new bodies: the render scene is rebuilt on the next render.
@@ -208,39 +240,41 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
     fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         self.task.initialize_actors(&mut self.scene, rng)?;
         let TaskScene { world, agent } = &mut self.scene;
-        agent.initialize(world, rng)?;
-        self.task.initialize_task(&self.scene, rng);
+        agent.initialize(world.as_mut(), rng)?;
+        self.task.initialize_task(&self.scene, rng)?;
         // The previous episode's contact caches must not leak into this one: an episode is
         // determined by its seed alone.
-        self.scene
-            .world
-            .forget_solver_history()
-            .map_err(physics_err)?;
+        self.scene.world.forget_solver_history()?;
         Ok(())
     }
 
     fn apply_action(&mut self, action: &[f32]) -> Result<(), EnvError> {
         let TaskScene { world, agent } = &mut self.scene;
+        let world = world.as_mut();
         agent.set_action(world, action)?;
+        let mut soft = self.task.soft_mut();
         for _ in 0..self.substeps {
             agent.before_substep(world);
             world.step();
-            self.task.after_physics_step(world)?;
+            if let Some(soft) = soft.as_mut() {
+                soft.after_physics_step(world)?;
+            }
         }
         Ok(())
     }
 
     fn observe_state_dict(&self) -> ObsValue {
         let TaskScene { world, agent } = &self.scene;
+        let world = world.as_ref();
         let mut agent_obs = DictBuilder::new();
         agent_obs.push_vector("qpos", &agent.qpos(world));
         agent_obs.push_vector("qvel", &agent.qvel(world));
         // Target-accumulating modes also report their targets, as ManiSkill2 does.
-        let ctrl_state = agent.controller.state();
+        let ctrl_state = agent.controller().state();
         if !ctrl_state.is_empty() {
             let mut ctrl = DictBuilder::new();
             for (part, values) in ctrl_state {
-                let key = if agent.control_mode.name().starts_with("pd_ee") && part == "arm" {
+                let key = if agent.control_mode().name().starts_with("pd_ee") && part == "arm" {
                     "target_pose"
                 } else {
                     "target_qpos"
@@ -264,11 +298,11 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
     }
 
     fn observe_particles(&self) -> Option<ObsValue> {
-        self.task.particles_obs()
+        self.task.soft().and_then(|s| s.particles_obs())
     }
 
     fn mpm_freq(&self) -> Option<f64> {
-        self.task.mpm_freq()
+        self.task.soft().map(|s| s.mpm_freq())
     }
 
     fn dense_reward(&self, eval: &Evaluation, _action: &[f32]) -> f64 {
@@ -288,14 +322,11 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
 
     fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError> {
         let world_len = self.scene.world.state_len();
-        let parts = self.scene.agent.controller.state();
+        let parts = self.scene.agent.controller().state();
         let ctrl_len: usize = parts.iter().map(|(_, v)| v.len()).sum();
         let (world_state, rest) = state.split_at(world_len);
         let (ctrl_state, task_state) = rest.split_at(ctrl_len);
-        self.scene
-            .world
-            .set_state(world_state)
-            .map_err(physics_err)?;
+        self.scene.world.set_state(world_state)?;
         let mut offset = 0;
         let restored: Vec<(String, Vec<f64>)> = parts
             .into_iter()
@@ -310,7 +341,7 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
             .collect();
         self.scene
             .agent
-            .controller
+            .controller_mut()
             .set_state(&restored)
             .map_err(EnvError::Controller)?;
         self.task.set_task_state(task_state);
@@ -321,7 +352,7 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
         self.with_sensors(|sensors, world| sensors.capture(world))
     }
 
-    fn sensors_mut(&mut self) -> Result<(&mut Sensors, &World), EnvError> {
+    fn sensors_mut(&mut self) -> Result<(&mut Sensors, &dyn RigidWorld), EnvError> {
         if self.sensors.get_mut().map_err(poisoned)?.is_none() {
             let built = self.new_sensors()?;
             *self.sensors.get_mut().map_err(poisoned)? = Some(built);
@@ -332,14 +363,15 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
             .map_err(poisoned)?
             .as_mut()
             .ok_or_else(|| EnvError::Render("sensors missing after being built".to_owned()))?;
-        sync_particles(&self.task, sensors)?;
-        Ok((sensors, &self.scene.world))
+        sync_particles(self.task.as_ref(), sensors)?;
+        Ok((sensors, self.scene.world.as_ref()))
     }
 
-    fn render_human(&self) -> Result<ms2_render::CameraOutput, EnvError> {
-        let goal = self
-            .observe_state_dict()
-            .get("extra/goal_pos")
+    fn render_human(&self, goal_key: Option<&str>) -> Result<ms2_render::CameraOutput, EnvError> {
+        let state = goal_key.map(|_| self.observe_state_dict());
+        let goal = goal_key
+            .zip(state.as_ref())
+            .and_then(|(key, state)| state.get(&format!("extra/{key}")))
             .and_then(|g| g.as_f32().map(|v| nalgebra::Vector3::new(v[0], v[1], v[2])));
         self.with_sensors(|sensors, world| sensors.render_human(world, goal))
     }
@@ -367,7 +399,7 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
         Some(&self.scene)
     }
 
-    fn task_any(&self) -> Option<&dyn Any> {
-        Some(self.task.as_any())
+    fn task(&self) -> Option<&dyn Task> {
+        Some(self.task.as_ref())
     }
 }

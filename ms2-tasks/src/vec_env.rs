@@ -168,8 +168,15 @@ impl VecEnv {
         let first_batch = submit(first_envs, &first)?;
         let second = simulate(second_envs, second_commands, true)?;
         let second_batch = submit(second_envs, &second)?;
-        let mut outs = assemble(first, first_batch.wait()?, layout, robot_seg);
-        outs.extend(assemble(second, second_batch.wait()?, layout, robot_seg));
+        let keys = self.envs[0].spec().non_privileged_extra_keys;
+        let mut outs = assemble(first, first_batch.wait()?, keys, layout, robot_seg);
+        outs.extend(assemble(
+            second,
+            second_batch.wait()?,
+            keys,
+            layout,
+            robot_seg,
+        ));
         Ok(outs)
     }
 }
@@ -228,6 +235,7 @@ fn submit(envs: &mut [Env], simulated: &[Simulated]) -> Result<PendingBatch, Env
 fn assemble(
     simulated: Vec<Simulated>,
     frames: Vec<CameraFrame>,
+    keys: &[&str],
     layout: VisualLayout,
     robot_seg: bool,
 ) -> Vec<Option<StepOutput>> {
@@ -242,7 +250,7 @@ fn assemble(
         .map(|(s, frame)| {
             let (mut out, _) = s?;
             let state_dict = std::mem::replace(&mut out.obs, ObsValue::Dict(Vec::new()));
-            out.obs = visual_obs::assemble(state_dict, frame?, layout, robot_seg);
+            out.obs = visual_obs::assemble(state_dict, keys, frame?, layout, robot_seg);
             Some(out)
         })
         .collect()

@@ -4,11 +4,11 @@
 
 use glam::Vec3;
 use ms2_tasks::adapters::{RenderContext, WorldRenderScene};
-use ms2_tasks::tasks::soft::bucket_arm::CLAY_SEGMENTATION_NAME;
-use ms2_tasks::tasks::soft::excavate_env::Excavate;
-use ms2_tasks::tasks::soft::fill::{Fill, BEAKER_HEIGHT, BEAKER_INNER_HALF};
+use ms2_tasks::families::soft::bucket_arm::CLAY_SEGMENTATION_NAME;
+use ms2_tasks::families::soft::excavate::Excavate;
+use ms2_tasks::families::soft::fill::{BEAKER_HEIGHT, BEAKER_INNER_HALF};
 use ms2_tasks::{
-    make_env, make_scripted_policy, ArrayData, Env, EnvConfig, ObsValue, Task, VecEnv,
+    make_env, make_scripted_policy, ArrayData, Env, EnvConfig, ObsValue, SoftComponent, VecEnv,
 };
 
 fn env(id: &str, obs_mode: &str) -> Env {
@@ -33,21 +33,17 @@ fn f32s<'a>(obs: &'a ObsValue, path: &str) -> &'a [f32] {
     }
 }
 
-/// The task of a soft env (Excavate-v0 or Fill-v0) as `Task`.
-fn task(env: &Env) -> &dyn Task {
-    let any = env.task_any().unwrap();
-    if let Some(t) = any.downcast_ref::<Excavate>() {
-        t
-    } else {
-        any.downcast_ref::<Fill>().unwrap()
-    }
+/// The soft component of a soft env (Excavate-v0 or Fill-v0).
+fn task(env: &Env) -> &dyn SoftComponent {
+    env.task().unwrap().soft().unwrap()
 }
 
 /// The clay's segmentation ids (visual id, actor/link id), as the env's sensors assign them:
 /// the world's objects, then the task's particle sets.
 fn clay_ids(env: &Env) -> (u32, u32) {
     let ctx = RenderContext::shared().unwrap();
-    let mut scene = WorldRenderScene::build(&ctx, &env.task_scene().unwrap().world).unwrap();
+    let mut scene =
+        WorldRenderScene::build(&ctx, env.task_scene().unwrap().world.as_ref()).unwrap();
     let visuals = task(env).particle_visuals();
     assert_eq!(visuals.len(), 1, "one particle set: the clay");
     scene.add_particle_set(&visuals[0]);
@@ -274,7 +270,7 @@ fn excavate_point_cloud_shows_the_clay_bed_then_the_scooped_clay() {
     let (obs, _) = e.reset(Some(1), false).unwrap();
     policy.reset(&e);
     let bed = e
-        .task_any()
+        .task()
         .unwrap()
         .downcast_ref::<Excavate>()
         .unwrap()

@@ -109,7 +109,7 @@ fn unsupported_shapes_are_refused_by_name() {
     ));
 }
 
-use ms2_tasks::tasks::soft::excavate::{ExcavateScene, ScriptedScoop};
+use ms2_tasks::families::soft::excavate_scene::{ExcavateScene, ScriptedScoop};
 
 /// Runs the scripted scoop for `steps` control steps.
 fn run_scoop(scene: &mut ExcavateScene, plan: &ScriptedScoop, from: u32, steps: u32) {
@@ -196,7 +196,7 @@ fn excavate_is_deterministic_and_state_round_trips() {
 
 #[test]
 fn kinematic_plate_lifts_a_clay_block() {
-    use ms2_tasks::tasks::soft::{SoftConfig, SoftWorld};
+    use ms2_tasks::soft::{SoftConfig, SoftWorld};
     let (mut solver, clay) = SoftWorld::solver_for(&SoftConfig::default()).unwrap();
     let plate_top = solver.usable_domain().0.z + 0.03;
     let pts = sampling::sample_box(
@@ -248,7 +248,9 @@ fn kinematic_plate_lifts_a_clay_block() {
 
 #[test]
 fn every_excavate_bed_has_the_same_particle_count_and_its_own_surface() {
-    use ms2_tasks::tasks::soft::excavate::{excavate_soft_config, ExcavateBed, BED_PARTICLES};
+    use ms2_tasks::families::soft::excavate_scene::{
+        excavate_soft_config, ExcavateBed, BED_PARTICLES,
+    };
     let config = excavate_soft_config(Vec3::new(-0.18, -0.16, -0.03));
     let mut left_counts = Vec::new();
     for seed in 0..12 {
@@ -425,8 +427,8 @@ mod soft_envs {
 
     /// MPM substeps the clay of `env` has taken so far.
     fn mpm_substeps_taken(env: &ms2_tasks::Env) -> u64 {
-        use ms2_tasks::tasks::soft::{excavate_env::Excavate, fill::Fill};
-        let task = env.task_any().unwrap();
+        use ms2_tasks::families::soft::{excavate::Excavate, fill::Fill};
+        let task = env.task().unwrap();
         let arm = match task.downcast_ref::<Excavate>() {
             Some(e) => e.arm(),
             None => task.downcast_ref::<Fill>().unwrap().arm(),

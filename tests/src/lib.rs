@@ -1,9 +1,9 @@
 //! Helpers of ms2's cross-crate simulated tests: a Panda in a physics world driven by an
 //! ms2-control controller, stepped at 500 Hz.
 
-use ms2_control::{ControlMode, ControlTiming, RobotConfig};
+use ms2_control::{ControlMode, ControlTiming};
 use ms2_physics::{World, WorldConfig};
-use ms2_tasks::agent::PandaAgent;
+use ms2_tasks::agents::{Agent, PandaAgent};
 use ms2_tasks::geometry::Pose3;
 use ms2_tasks::seeding::episode_rng;
 
@@ -21,10 +21,11 @@ impl Rig {
     /// A Panda at ManiSkill2's base pose and rest qpos (noise from `seed`), controlled in `mode`
     /// at 20 Hz with 500 Hz physics.
     pub fn new(mode: ControlMode, seed: u64) -> Rig {
-        let robot = RobotConfig::panda(ms2_assets::PANDA_URDF).expect("Panda config");
         let mut world = World::new(WorldConfig::default()).expect("world");
         let timing = ControlTiming::MANISKILL2;
-        let mut agent = PandaAgent::build(&mut world, &robot, mode, timing).expect("agent");
+        let mut agent =
+            PandaAgent::build_from_urdf(&mut world, mode, timing, ms2_assets::PANDA_URDF)
+                .expect("agent");
         agent
             .initialize(&mut world, &mut episode_rng(seed))
             .expect("initialize");
@@ -69,7 +70,7 @@ impl Rig {
     /// Drive position targets.
     pub fn drive_targets(&self) -> Vec<f32> {
         self.world
-            .drive_targets(self.agent.articulation)
+            .drive_targets(self.agent.articulation())
             .expect("articulation")
     }
 }

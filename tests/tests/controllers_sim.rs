@@ -148,7 +148,7 @@ fn joint_pos_trajectory_converted_to_ee_delta_pose_ends_within_5mm() {
         .task_scene()
         .unwrap()
         .agent
-        .qpos(&src.task_scene().unwrap().world);
+        .qpos(src.task_scene().unwrap().world.as_ref());
     let goal_offsets = [0.3f32, 0.2, -0.2, 0.3, 0.2, -0.3, 0.4];
     let steps = 40;
     for k in 1..=steps {
@@ -158,12 +158,12 @@ fn joint_pos_trajectory_converted_to_ee_delta_pose_ends_within_5mm() {
         src.step(&action).unwrap();
         // Closed-loop conversion: the dst action that makes its targets equal the src targets.
         let scene = dst.task_scene().unwrap();
-        let snap = snapshot_articulation(&scene.world, scene.agent.articulation);
+        let snap = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation());
         let mut desired: Vec<f64> = action[..7].iter().map(|&v| f64::from(v)).collect();
         desired.extend([0.04, 0.04]);
         let converted = scene
             .agent
-            .controller
+            .controller()
             .action_for_joint_targets(&snap, &desired)
             .unwrap();
         let a: Vec<f32> = converted.action.iter().map(|&v| v as f32).collect();
@@ -172,13 +172,13 @@ fn joint_pos_trajectory_converted_to_ee_delta_pose_ends_within_5mm() {
     for _ in 0..10 {
         let hold: Vec<f32> = {
             let scene = dst.task_scene().unwrap();
-            let snap = snapshot_articulation(&scene.world, scene.agent.articulation);
+            let snap = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation());
             let mut desired: Vec<f64> =
                 (0..7).map(|i| f64::from(q0[i] + goal_offsets[i])).collect();
             desired.extend([0.04, 0.04]);
             let c = scene
                 .agent
-                .controller
+                .controller()
                 .action_for_joint_targets(&snap, &desired)
                 .unwrap();
             c.action.iter().map(|&v| v as f32).collect()
@@ -190,7 +190,7 @@ fn joint_pos_trajectory_converted_to_ee_delta_pose_ends_within_5mm() {
     }
     let tcp = |env: &ms2_tasks::Env| {
         let s = env.task_scene().unwrap();
-        s.agent.tcp_pose(&s.world).translation.vector
+        s.agent.tcp_pose(s.world.as_ref()).translation.vector
     };
     let gap: Vector3<f32> = tcp(&src) - tcp(&dst);
     assert!(

@@ -120,14 +120,14 @@ fn robot_mask_covers_exactly_the_robots_pixels() {
     let mut e = env("PickCube-v0", "rgbd_robot_seg");
     let (obs, _) = e.reset(Some(3), false).unwrap();
     let scene = e.task_scene().unwrap();
-    let robot = scene.agent.articulation;
+    let robot = scene.agent.articulation();
     // The same scene rendered again without the robot: depth changes exactly where the robot was.
     let ctx = RenderContext::shared().unwrap();
-    let mut without = WorldRenderScene::build(&ctx, &scene.world).unwrap();
+    let mut without = WorldRenderScene::build(&ctx, scene.world.as_ref()).unwrap();
     without.set_articulation_visible(robot, false).unwrap();
     let mut robot_pixels_total = 0;
     for cfg in CameraConfig::panda_defaults() {
-        let camera = cfg.camera_at(&scene.world, Some(robot)).unwrap();
+        let camera = cfg.camera_at(scene.world.as_ref(), Some(robot)).unwrap();
         let bare = &ctx
             .renderer()
             .render(&[(without.scene(), &[camera][..])])
@@ -184,7 +184,7 @@ fn point_cloud_is_in_the_world_frame() {
     };
     let scene = WorldRenderScene::build(
         &RenderContext::shared().unwrap(),
-        &e.task_scene().unwrap().world,
+        e.task_scene().unwrap().world.as_ref(),
     )
     .unwrap();
     let cube_id = scene
@@ -193,7 +193,7 @@ fn point_cloud_is_in_the_world_frame() {
         .find(|o| o.name == "cube")
         .unwrap()
         .id;
-    let robot_ids = scene.articulation_ids(e.task_scene().unwrap().agent.articulation);
+    let robot_ids = scene.articulation_ids(e.task_scene().unwrap().agent.articulation());
     let (mut cube_points, mut valid) = (0, 0);
     for (i, p) in xyzw.chunks_exact(4).enumerate() {
         let s = &seg[i * 4..i * 4 + 4];

@@ -30,12 +30,28 @@ try:
 except PackageNotFoundError:  # running from a source tree
     __version__ = "0.0.0"
 
-__all__ = ["Ms2Env", "Ms2VectorEnv", "ScriptedPolicy", "env_ids", "make_vec", "register_envs"]
+__all__ = [
+    "Ms2Env",
+    "Ms2VectorEnv",
+    "ScriptedPolicy",
+    "env_ids",
+    "make_vec",
+    "register_envs",
+    "task_specs",
+]
 
 
 def env_ids() -> list[str]:
     """The ids of all ms2 tasks, e.g. ``["PickCube-v0", "LiftCube-v0", "StackCube-v0"]``."""
     return list(_native.env_ids())
+
+
+def task_specs() -> list[dict]:
+    """Every task's static description (read without building an env): ``env_id``,
+    ``family``, ``summary``, ``max_episode_steps``, ``robots`` (``robot=`` values, default
+    first), ``control_modes`` (empty: all of the robot's), ``default_control_mode``,
+    ``obs_modes`` and ``soft_bodies``."""
+    return list(_native.task_specs())
 
 
 def register_envs() -> None:
@@ -45,21 +61,17 @@ def register_envs() -> None:
     wrapper enforces the limit, defaulting to the task's); ``gymnasium.make_vec(id, num_envs=N,
     vectorization_mode="vector_entry_point")`` gives the native :class:`Ms2VectorEnv`.
     """
-    for env_id in env_ids():
+    for spec in task_specs():
+        env_id = spec["env_id"]
         if env_id in gym.registry:
             continue
         gym.register(
             id=env_id,
             entry_point="ms2.envs:make_registered",
             vector_entry_point="ms2.vector:make_vec",
-            max_episode_steps=_default_max_episode_steps(env_id),
+            max_episode_steps=int(spec["max_episode_steps"]),
             kwargs={"env_id": env_id},
         )
-
-
-def _default_max_episode_steps(env_id: str) -> int:
-    """The task's default episode limit in env steps."""
-    return int(_native.default_max_episode_steps(env_id))
 
 
 register_envs()

@@ -28,6 +28,7 @@ def adopt_config(env: Any, config: dict[str, Any]) -> None:
     for key in (
         "env_id",
         "obs_mode",
+        "robot",
         "control_mode",
         "reward_mode",
         "render_mode",
@@ -49,6 +50,8 @@ class Ms2Env(gym.Env):
     Args:
         env_id: registered task id (``ms2.env_ids()`` lists them).
         obs_mode: ``"state_dict"`` (nested dict of arrays) or ``"state"`` (one flat float32 array).
+        robot: robot uid, ManiSkill2's keyword (``"panda"``); ``None`` = the task's default.
+            A robot the task does not support raises ``ValueError`` listing the valid ones.
         control_mode: e.g. ``"pd_ee_delta_pose"``; ``None`` = ``"pd_joint_delta_pos"``.
         reward_mode: ``"sparse"``, ``"dense"`` or ``"normalized_dense"`` (``None``).
         render_mode: ``None`` or ``"rgb_array"``.
@@ -75,6 +78,7 @@ class Ms2Env(gym.Env):
         self,
         env_id: str = "PickCube-v0",
         obs_mode: str = "state_dict",
+        robot: str | None = None,
         control_mode: str | None = None,
         reward_mode: str | None = None,
         render_mode: str | None = None,
@@ -87,6 +91,7 @@ class Ms2Env(gym.Env):
         self._native = _native.NativeEnv(
             env_id,
             obs_mode=obs_mode,
+            robot=robot,
             control_mode=control_mode,
             reward_mode=reward_mode,
             render_mode=render_mode,

@@ -1,7 +1,7 @@
 //! [`ms2_mpm::RigidBackend`] for the ms2-physics [`World`]: two-way coupling of MPM soft
 //! bodies with rapier actors and articulation links.
 //!
-//! [`MpmRigidWorld`] is a newtype over `&mut World` plus the list of bodies that may touch
+//! [`MpmRigidWorld`] is a newtype over `&mut dyn RigidWorld` plus the list of bodies that may touch
 //! soft material ([`CoupledBodies`]). Coupled body `i` of the MPM side is `bodies[i]`.
 //! Shapes are converted once at setup ([`CoupledBodies::new`] refuses shapes the coupling
 //! cannot represent); poses, velocities and centres of mass are read from the world each rigid
@@ -15,7 +15,7 @@
 //!
 //! ```
 //! use ms2_mpm::{Coupling, CouplingParams, RigidBackend};
-//! use ms2_physics::{ActorDesc, ActorKind, ShapeDesc, ShapeSpec, World, WorldConfig};
+//! use ms2_physics::{ActorDesc, ActorKind, ShapeDesc, ShapeSpec, WorldConfig};
 //! use ms2_tasks::adapters::mpm_rigid::{CoupledBodies, MpmRigidWorld};
 //! use nalgebra::Vector3;
 //! let mut world = World::new(WorldConfig::default()).unwrap();
@@ -33,8 +33,10 @@
 
 use glam::{Quat, Vec3};
 use ms2_mpm::{BodyState, CollisionShape, RigidBackend, ShapeGeometry, TriMesh};
-use ms2_physics::{BodyId, Pose3, ShapeDesc, World};
+use ms2_physics::{BodyId, Pose3, ShapeDesc};
 use nalgebra::{Point3, Vector3};
+
+use crate::rigid_world::RigidWorld;
 
 /// Why a set of bodies cannot be coupled to soft material.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -82,7 +84,7 @@ pub struct CoupledBodies {
 impl CoupledBodies {
     /// Converts the collision shapes of `bodies` (dynamic, kinematic or static actors, or
     /// articulation links of `world`).
-    pub fn new(world: &World, bodies: Vec<BodyId>) -> Result<Self, MpmAdapterError> {
+    pub fn new(world: &dyn RigidWorld, bodies: Vec<BodyId>) -> Result<Self, MpmAdapterError> {
         let mut shapes = Vec::with_capacity(bodies.len());
         for &body in &bodies {
             let specs = world
@@ -114,18 +116,18 @@ impl CoupledBodies {
 
 /// The ms2-physics world seen as a [`RigidBackend`] (see the [module docs](self)).
 pub struct MpmRigidWorld<'a> {
-    world: &'a mut World,
+    world: &'a mut dyn RigidWorld,
     bodies: &'a CoupledBodies,
 }
 
 impl<'a> MpmRigidWorld<'a> {
     /// Wraps `world` for one coupling call; `bodies` must come from the same world.
-    pub fn new(world: &'a mut World, bodies: &'a CoupledBodies) -> Self {
+    pub fn new(world: &'a mut dyn RigidWorld, bodies: &'a CoupledBodies) -> Self {
         Self { world, bodies }
     }
 
     /// The wrapped world.
-    pub fn world(&mut self) -> &mut World {
+    pub fn world(&mut self) -> &mut dyn RigidWorld {
         self.world
     }
 }
@@ -156,13 +158,13 @@ impl RigidBackend for MpmRigidWorld<'_> {
 /// A read-only [`RigidBackend`] view of the world, for setting up a [`ms2_mpm::Coupling`]
 /// (which reads shapes and poses only); wrenches handed to it are dropped.
 pub struct MpmRigidWorldView<'a> {
-    world: &'a World,
+    world: &'a dyn RigidWorld,
     bodies: &'a CoupledBodies,
 }
 
 impl<'a> MpmRigidWorldView<'a> {
     /// Views `world`; `bodies` must come from the same world.
-    pub fn new(world: &'a World, bodies: &'a CoupledBodies) -> Self {
+    pub fn new(world: &'a dyn RigidWorld, bodies: &'a CoupledBodies) -> Self {
         Self { world, bodies }
     }
 }
@@ -183,7 +185,7 @@ impl RigidBackend for MpmRigidWorldView<'_> {
     fn apply_coupling_wrench(&mut self, _body: usize, _force: Vec3, _torque: Vec3) {}
 }
 
-fn body_state(w: &World, bodies: &CoupledBodies, body: usize) -> BodyState {
+fn body_state(w: &dyn RigidWorld, bodies: &CoupledBodies, body: usize) -> BodyState {
     {
         let id = bodies.bodies[body];
         // Ids were checked in `CoupledBodies::new`; bodies are never removed from a world.

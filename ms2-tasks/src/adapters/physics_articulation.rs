@@ -5,7 +5,9 @@
 //! this boundary. Joint order is the articulation's dof order on both sides.
 
 use ms2_control::{Articulation, DriveGains, PerfectTrackingArticulation};
-use ms2_physics::{ArticulationId, DriveParams, World};
+use ms2_physics::{ArticulationId, DriveParams};
+
+use crate::rigid_world::RigidWorld;
 
 /// A mutable view of one articulation of a world, implementing [`Articulation`].
 ///
@@ -13,13 +15,13 @@ use ms2_physics::{ArticulationId, DriveParams, World};
 /// runtime builds both); physics errors on a write (impossible for a valid id and finite
 /// values, which the controllers guarantee) are reported through `debug_assert!` only.
 pub struct PhysicsArticulation<'w> {
-    world: &'w mut World,
+    world: &'w mut dyn RigidWorld,
     id: ArticulationId,
 }
 
 impl<'w> PhysicsArticulation<'w> {
     /// Wraps articulation `id` of `world`.
-    pub fn new(world: &'w mut World, id: ArticulationId) -> Self {
+    pub fn new(world: &'w mut dyn RigidWorld, id: ArticulationId) -> Self {
         Self { world, id }
     }
 
@@ -105,8 +107,11 @@ impl Articulation for PhysicsArticulation<'_> {
 
 /// A read-only copy of an articulation's joint state (names, qpos, qvel, drive targets) as an
 /// [`Articulation`], for controller queries that only read state (e.g. demonstration
-/// conversion) when only `&World` is at hand.
-pub fn snapshot_articulation(world: &World, id: ArticulationId) -> PerfectTrackingArticulation {
+/// conversion) when only `&dyn RigidWorld` is at hand.
+pub fn snapshot_articulation(
+    world: &dyn RigidWorld,
+    id: ArticulationId,
+) -> PerfectTrackingArticulation {
     let names = world
         .joint_names(id)
         .map(|v| v.into_iter().map(str::to_owned).collect())

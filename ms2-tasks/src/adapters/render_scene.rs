@@ -19,7 +19,7 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use ms2_physics::{ArticulationId, BodyId, BodyKind, Pose3, ShapeDesc, World};
+use ms2_physics::{ArticulationId, BodyId, BodyKind, Pose3, ShapeDesc};
 use ms2_render::{
     Instance, InstanceId, Material, MeshData, MeshHandle, ParticleSet, ParticleSetId, Renderer,
     RendererConfig, Scene, SegmentationIds,
@@ -27,6 +27,8 @@ use ms2_render::{
 use nalgebra::Vector3;
 
 use crate::error::EnvError;
+use crate::particles::ParticleVisual;
+use crate::rigid_world::RigidWorld;
 
 /// Segments around the axis of procedural spheres, cylinders and capsules.
 const ROUND_SEGMENTS: u32 = 24;
@@ -234,45 +236,6 @@ pub struct SegmentedObject {
     pub articulation: Option<ArticulationId>,
 }
 
-/// A set of particles the cameras draw (e.g. a soft body's clay): one sphere per particle, all
-/// of one radius and colour, segmented as one object named `name`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParticleVisual {
-    /// Name of the set's segmentation object (e.g. `"clay"`).
-    pub name: String,
-    /// Radius of each particle's sphere, metres (> 0).
-    pub radius_m: f32,
-    /// Linear RGB colour, each channel in `[0, 1]`.
-    pub rgb: [f32; 3],
-    /// `Some(s)` when the particles are a dense packing of spacing `s` m (MPM particles) and
-    /// `radius_m > s / √2`: particles enclosed by neighbours on all sides are then not drawn
-    /// (`sensors::particle_culling`). `None` draws every particle.
-    pub packing_spacing_m: Option<f32>,
-}
-
-impl ParticleVisual {
-    /// Checks the radius (finite, > 0) and the packing spacing (finite, > 0 and below √2 × the
-    /// radius, so that neighbouring spheres hide enclosed particles).
-    pub fn validate(&self) -> Result<(), EnvError> {
-        if !(self.radius_m.is_finite() && self.radius_m > 0.0) {
-            return Err(EnvError::InvalidConfig(format!(
-                "particle set {:?}: radius {} m must be finite and > 0",
-                self.name, self.radius_m
-            )));
-        }
-        if let Some(s) = self.packing_spacing_m {
-            if !(s.is_finite() && s > 0.0 && self.radius_m > s * std::f32::consts::FRAC_1_SQRT_2) {
-                return Err(EnvError::InvalidConfig(format!(
-                    "particle set {:?}: packing spacing {s} m must be finite, > 0 and below \
-                     √2 × the radius {} m (so neighbouring spheres hide enclosed particles)",
-                    self.name, self.radius_m
-                )));
-            }
-        }
-        Ok(())
-    }
-}
-
 /// A render [`Scene`] mirroring a physics [`World`]'s visual shapes.
 #[derive(Debug)]
 pub struct WorldRenderScene {
@@ -285,14 +248,17 @@ pub struct WorldRenderScene {
 impl WorldRenderScene {
     /// Builds instances for every visual of every actor and articulation link of `world` (and
     /// a ground square when the world has a ground), at the world's current poses.
-    pub fn build(ctx: &RenderContext, world: &World) -> Result<WorldRenderScene, EnvError> {
+    pub fn build(
+        ctx: &RenderContext,
+        world: &dyn RigidWorld,
+    ) -> Result<WorldRenderScene, EnvError> {
         let mut out = WorldRenderScene {
             scene: Scene::new(),
             bindings: Vec::new(),
             objects: Vec::new(),
             visual_count: 0,
         };
-        let physics = |e: ms2_physics::PhysicsError| EnvError::Physics(e.to_string());
+        let physics = EnvError::from;
         let mut articulations: Vec<ArticulationId> = Vec::new();
         let mut ground = None;
         for body in world.bodies() {
@@ -362,7 +328,7 @@ impl WorldRenderScene {
     fn add_visual(
         &mut self,
         ctx: &RenderContext,
-        world: &World,
+        world: &dyn RigidWorld,
         visual: &ms2_physics::VisualShape,
         source: PoseSource,
         object_id: u32,
@@ -422,7 +388,7 @@ impl WorldRenderScene {
     }
 
     /// Copies the current body and link poses of `world` into the scene.
-    pub fn sync_poses(&mut self, world: &World) -> Result<(), EnvError> {
+    pub fn sync_poses(&mut self, world: &dyn RigidWorld) -> Result<(), EnvError> {
         for b in &self.bindings {
             let pose = source_pose(world, b.source)? * b.pose_source_from_mesh;
             self.scene.set_pose(b.instance, pose).map_err(render_err)?;
@@ -477,8 +443,8 @@ impl WorldRenderScene {
     }
 }
 
-fn source_pose(world: &World, source: PoseSource) -> Result<Pose3, EnvError> {
-    let physics = |e: ms2_physics::PhysicsError| EnvError::Physics(e.to_string());
+fn source_pose(world: &dyn RigidWorld, source: PoseSource) -> Result<Pose3, EnvError> {
+    let physics = EnvError::from;
     match source {
         PoseSource::Body(body) => world.body_pose(body).map_err(physics),
         PoseSource::Link(art, link) => world.link_pose(art, link).map_err(physics),

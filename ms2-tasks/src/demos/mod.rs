@@ -25,7 +25,7 @@ pub use scripted::scripted_episode;
 use crate::error::EnvError;
 
 /// Everything that can go wrong while making or replaying demonstrations.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum DemoError {
     /// No motion-planning solution exists for this env.
     #[error("no demonstration solution for env {env_id:?}; envs with a solution: {valid:?}")]

@@ -274,7 +274,11 @@ fn tcp_position(env: &Env) -> Result<nalgebra::Vector3<f32>, DemoError> {
     let scene = env
         .task_scene()
         .expect("checked by SourceJointTargets::new");
-    Ok(scene.agent.tcp_pose(&scene.world).translation.vector)
+    Ok(scene
+        .agent
+        .tcp_pose(scene.world.as_ref())
+        .translation
+        .vector)
 }
 
 /// One target step with the action that makes the target controller's drive targets reproduce
@@ -291,10 +295,10 @@ fn step_toward(
         let scene = env
             .task_scene()
             .expect("checked by SourceJointTargets::new");
-        let snapshot = snapshot_articulation(&scene.world, scene.agent.articulation);
+        let snapshot = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation());
         scene
             .agent
-            .controller
+            .controller()
             .action_for_joint_targets(&snapshot, desired)
             .map_err(|e| DemoError::InvalidEpisode {
                 seed: source.episode_seed,
@@ -306,7 +310,7 @@ fn step_toward(
     obs.push(env, Some(out.obs))?;
     let ik_failed = env
         .task_scene()
-        .and_then(|s| s.agent.controller.last_ik_report())
+        .and_then(|s| s.agent.controller().last_ik_report())
         .is_some_and(|r| !r.converged);
     Ok(converted.saturated_parts.is_empty() && !ik_failed)
 }

@@ -57,7 +57,7 @@ impl SourceJointTargets {
         let scene = target_env
             .task_scene()
             .ok_or_else(|| unsupported(source, cfg, "the env has no robot"))?;
-        let articulation = snapshot_articulation(&scene.world, scene.agent.articulation);
+        let articulation = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation());
         let robot = RobotConfig::panda(ms2_assets::PANDA_URDF)
             .map_err(|e| DemoError::Env(EnvError::Controller(e.to_string())))?;
         let timing = ControlTiming {
@@ -123,7 +123,7 @@ impl SourceJointTargets {
         let scene = env
             .task_scene()
             .expect("state env was made like the target env");
-        self.articulation = snapshot_articulation(&scene.world, scene.agent.articulation);
+        self.articulation = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation());
         Ok(())
     }
 
@@ -137,7 +137,11 @@ impl SourceJointTargets {
         let scene = env
             .task_scene()
             .expect("state env was made like the target env");
-        Ok(scene.agent.tcp_pose(&scene.world).translation.vector)
+        Ok(scene
+            .agent
+            .tcp_pose(scene.world.as_ref())
+            .translation
+            .vector)
     }
 
     /// The joint targets (articulation dof order: 7 arm joints in rad, 2 fingers in m) that

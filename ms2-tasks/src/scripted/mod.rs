@@ -1,15 +1,16 @@
 //! Scripted (oracle) policies: privileged state in, controller actions out.
 //!
-//! The cube policies ([`pick_place`]) plan TCP waypoints from the true object poses and turn each
+//! A task registers its policy with its family; the cube policies
+//! (`families/rigid/scripted.rs`) plan TCP waypoints from the true object poses and turn each
 //! into an action of the env's control mode through [`oracle::TcpOracle`]: IK of the waypoint
 //! (ms2-control), then the controller's own closed-loop conversion of the desired joint targets
 //! into an action. So one policy serves every position-based control mode.
 
 pub mod oracle;
-pub mod pick_place;
 
 use crate::env::Env;
 use crate::error::EnvError;
+use crate::registry;
 
 /// An oracle policy using privileged state through the env's controllers.
 pub trait ScriptedPolicy: Send {
@@ -19,40 +20,36 @@ pub trait ScriptedPolicy: Send {
     fn act(&mut self, env: &Env) -> Vec<f32>;
 }
 
-/// The scripted policy of `env`'s task for its control mode.
+/// The scripted policy of `env`'s task for its control mode (registered with the task,
+/// [`crate::registry::TaskRegistration::scripted`]).
 pub fn make_scripted_policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
     let env_id = env.config().env_id.as_str();
-    let unsupported = |reason: &str| EnvError::NoScriptedPolicy {
-        env_id: env_id.to_owned(),
+    let make = registry::registration(env_id)?
+        .scripted_policy
+        .ok_or_else(|| no_policy(env, "no scripted policy is registered for this env"))?;
+    make(env)
+}
+
+/// The error of a scripted policy that cannot drive `env`, saying why.
+pub fn no_policy(env: &Env, reason: &str) -> EnvError {
+    EnvError::NoScriptedPolicy {
+        env_id: env.config().env_id.clone(),
         control_mode: env.control_mode().to_owned(),
         reason: reason.to_owned(),
-    };
-    if env_id == "Excavate-v0" || env_id == "Fill-v0" {
-        if !oracle::SUPPORTED_MODES.contains(&env.control_mode()) {
-            return Err(unsupported("the oracle drives position-based modes only"));
-        }
-        let oracle = oracle::TcpOracle::new(env).map_err(|e| unsupported(&e))?;
-        return Ok(if env_id == "Fill-v0" {
-            Box::new(crate::tasks::soft::fill::FillPolicy::new(oracle))
-        } else {
-            Box::new(crate::tasks::soft::excavate_env::ExcavatePolicy::new(
-                oracle,
-            ))
-        });
     }
-    let plan = match env_id {
-        "Dummy-v0" => return Ok(Box::new(crate::tasks::dummy::DummyReachPolicy)),
-        "PickCube-v0" => pick_place::Plan::PickToGoal,
-        "LiftCube-v0" => pick_place::Plan::Lift,
-        "StackCube-v0" => pick_place::Plan::Stack,
-        _ => return Err(unsupported("no scripted policy is registered for this env")),
-    };
+}
+
+/// The [`oracle::TcpOracle`] of `env`, for policies that plan TCP poses; an error when the
+/// env's control mode is not one the oracle drives ([`oracle::SUPPORTED_MODES`]).
+pub fn tcp_oracle(env: &Env) -> Result<oracle::TcpOracle, EnvError> {
     if !oracle::SUPPORTED_MODES.contains(&env.control_mode()) {
-        return Err(unsupported(&format!(
-            "the oracle drives position-based modes only: {:?}",
-            oracle::SUPPORTED_MODES
-        )));
+        return Err(no_policy(
+            env,
+            &format!(
+                "the oracle drives position-based modes only: {:?}",
+                oracle::SUPPORTED_MODES
+            ),
+        ));
     }
-    let oracle = oracle::TcpOracle::new(env).map_err(|e| unsupported(&e))?;
-    Ok(Box::new(pick_place::PickPlacePolicy::new(plan, oracle)))
+    oracle::TcpOracle::new(env)
 }

@@ -5,9 +5,11 @@ use ms2_control::{DlsIk, IkOptions, KinematicChain, RobotConfig};
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
 use crate::adapters::snapshot_articulation;
-use crate::agent::ARM_DOF;
+use crate::agents::ARM_DOF;
 use crate::env::Env;
+use crate::error::EnvError;
 use crate::geometry::Pose3;
+use crate::scripted::no_policy;
 
 /// Control modes the oracle can drive (those whose controllers convert joint targets).
 pub const SUPPORTED_MODES: [&str; 8] = [
@@ -34,15 +36,16 @@ pub struct TcpOracle {
 }
 
 impl TcpOracle {
-    /// An oracle for `env`'s robot; errors for envs without a robot.
-    pub fn new(env: &Env) -> Result<Self, String> {
-        let scene = env.task_scene().ok_or("the env has no robot")?;
-        let robot = RobotConfig::panda(ms2_assets::PANDA_URDF).map_err(|e| e.to_string())?;
-        let chain = robot.tcp_chain().map_err(|e| e.to_string())?;
-        let names = scene
-            .world
-            .joint_names(scene.agent.articulation)
-            .map_err(|e| e.to_string())?;
+    /// An oracle for `env`'s robot; an error ([`EnvError::NoScriptedPolicy`]) for envs
+    /// without a Panda.
+    pub fn new(env: &Env) -> Result<Self, EnvError> {
+        let no = |reason: String| no_policy(env, &reason);
+        let scene = env
+            .task_scene()
+            .ok_or_else(|| no("the env has no robot".to_owned()))?;
+        let robot = RobotConfig::panda(ms2_assets::PANDA_URDF).map_err(|e| no(e.to_string()))?;
+        let chain = robot.tcp_chain().map_err(|e| no(e.to_string()))?;
+        let names = scene.world.joint_names(scene.agent.articulation())?;
         let chain_to_articulation = chain
             .joint_names()
             .iter()
@@ -50,7 +53,7 @@ impl TcpOracle {
                 names
                     .iter()
                     .position(|m| m == n)
-                    .ok_or(format!("joint {n} not in the articulation"))
+                    .ok_or_else(|| no(format!("joint {n} not in the articulation")))
             })
             .collect::<Result<Vec<_>, _>>()?;
         let ik = DlsIk::new(IkOptions {
@@ -72,7 +75,7 @@ impl TcpOracle {
         let Some(scene) = env.task_scene() else {
             return vec![0.0; env.action_space().size()];
         };
-        let snap = snapshot_articulation(&scene.world, scene.agent.articulation);
+        let snap = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation());
         let q = snap.qpos.clone();
         let seed: Vec<f64> = self.chain_to_articulation.iter().map(|&i| q[i]).collect();
         let base: Isometry3<f64> = scene.agent.base_pose().cast();
@@ -90,7 +93,7 @@ impl TcpOracle {
         }
         match scene
             .agent
-            .controller
+            .controller()
             .action_for_joint_targets(&snap, &desired)
         {
             Ok(converted) => converted.action.iter().map(|&a| a as f32).collect(),

@@ -1,10 +1,11 @@
 //! Camera configurations: ManiSkill2's `base_camera`, `hand_camera` and human render camera.
 
-use ms2_physics::{ArticulationId, Pose3, World};
+use ms2_physics::{ArticulationId, Pose3};
 use ms2_render::Camera;
 use nalgebra::{Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 use crate::error::EnvError;
+use crate::rigid_world::RigidWorld;
 
 /// Where a camera is: fixed in the world, or riding on a link of the robot.
 ///
@@ -166,7 +167,7 @@ impl CameraConfig {
     /// link-mounted cameras).
     pub fn camera_at(
         &self,
-        world: &World,
+        world: &dyn RigidWorld,
         robot: Option<ArticulationId>,
     ) -> Result<Camera, EnvError> {
         let pose_world_from_camera = match &self.mount {

@@ -16,7 +16,7 @@ pub mod visual_obs;
 
 use std::sync::Arc;
 
-use ms2_physics::{ArticulationId, World};
+use ms2_physics::ArticulationId;
 use ms2_render::{
     Camera, CameraOutput, Instance, InstanceId, Material, ParticleSetId, Scene, SegmentationIds,
 };
@@ -25,12 +25,13 @@ use nalgebra::{Isometry3, Vector3};
 pub use batch::capture_batch;
 pub use camera::{look_at_robotics, CameraConfig, CameraMount};
 pub use camera_update::{CameraCfgUpdates, CameraUpdate, CAMERA_UPDATE_KEYS};
-pub use visual_obs::{CameraFrame, VisualLayout, NON_PRIVILEGED_EXTRA_KEYS};
+pub use visual_obs::{CameraFrame, VisualLayout};
 
 use crate::adapters::render_scene::render_err;
 pub use crate::adapters::ParticleVisual;
 use crate::adapters::{RenderContext, WorldRenderScene};
 use crate::error::EnvError;
+use crate::rigid_world::RigidWorld;
 
 /// Radius (m) of the goal marker sphere of human renders (ManiSkill2: the goal threshold).
 pub const GOAL_MARKER_RADIUS_M: f32 = 0.025;
@@ -64,7 +65,7 @@ impl Sensors {
     /// mask.
     pub fn new(
         ctx: Arc<RenderContext>,
-        world: &World,
+        world: &dyn RigidWorld,
         robot: Option<ArticulationId>,
         cameras: Vec<CameraConfig>,
         render_camera: CameraConfig,
@@ -160,7 +161,7 @@ impl Sensors {
     }
 
     /// Copies poses from `world` and renders every observation camera in one submission.
-    pub fn capture(&mut self, world: &World) -> Result<CameraFrame, EnvError> {
+    pub fn capture(&mut self, world: &dyn RigidWorld) -> Result<CameraFrame, EnvError> {
         let cams = self.prepare(world)?;
         let outputs = self
             .ctx
@@ -173,7 +174,7 @@ impl Sensors {
     /// Copies poses from `world` into the render scene and returns the observation cameras at
     /// their current poses (in config order), ready to be drawn with [`Sensors::scene`] — alone
     /// or batched with other envs' scenes ([`capture_batch`]).
-    pub fn prepare(&mut self, world: &World) -> Result<Vec<Camera>, EnvError> {
+    pub fn prepare(&mut self, world: &dyn RigidWorld) -> Result<Vec<Camera>, EnvError> {
         self.scene.sync_poses(world)?;
         self.cameras
             .iter()
@@ -204,7 +205,7 @@ impl Sensors {
     /// given; the marker is hidden again afterwards, so observation cameras never see it.
     pub fn render_human(
         &mut self,
-        world: &World,
+        world: &dyn RigidWorld,
         goal_world: Option<Vector3<f32>>,
     ) -> Result<CameraOutput, EnvError> {
         self.scene.sync_poses(world)?;

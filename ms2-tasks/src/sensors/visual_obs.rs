@@ -11,14 +11,12 @@
 //!   adds `pointcloud["robot_seg"]` bool [N,1].
 //! - `Segmentation` channels: 0 = visual-shape id, 1 = actor/link id (see
 //!   [`crate::adapters::render_scene`]), 2 and 3 = 0 (as in ManiSkill2).
-//! - `extra` keeps only what a real robot would know: [`NON_PRIVILEGED_EXTRA_KEYS`].
+//! - `extra` keeps only what a real robot would know: the task spec's
+//!   `non_privileged_extra_keys` ([`crate::spec::TaskSpec`]).
 
 use ms2_render::CameraOutput;
 
-use crate::obs::{Array, ArrayData, ObsValue};
-
-/// `extra` entries kept in visual modes (robot proprioception and the task's goal).
-pub const NON_PRIVILEGED_EXTRA_KEYS: [&str; 2] = ["tcp_pose", "goal_pos"];
+use crate::obs::{non_privileged_state, Array, ArrayData, ObsValue};
 
 /// A visual observation layout.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -51,39 +49,17 @@ fn matrix_rows<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f32, R, C>)
     array(vec![R, C], ArrayData::F32(data))
 }
 
-/// `state_dict` reduced to the entries a visual mode keeps: `agent` as is, `extra` filtered to
-/// [`NON_PRIVILEGED_EXTRA_KEYS`].
-pub fn non_privileged_state(state_dict: ObsValue) -> Vec<(String, ObsValue)> {
-    let ObsValue::Dict(entries) = state_dict else {
-        return Vec::new();
-    };
-    entries
-        .into_iter()
-        .map(|(key, value)| match (key.as_str(), value) {
-            ("extra", ObsValue::Dict(extra)) => (
-                key,
-                ObsValue::Dict(
-                    extra
-                        .into_iter()
-                        .filter(|(k, _)| NON_PRIVILEGED_EXTRA_KEYS.contains(&k.as_str()))
-                        .collect(),
-                ),
-            ),
-            (_, value) => (key, value),
-        })
-        .collect()
-}
-
-/// The full visual observation: `state_dict`'s non-privileged part plus the camera data in
-/// `layout`, with a robot mask when `robot_seg`. Takes the frame by value: its images move
-/// into the observation without copies.
+/// The full visual observation: `state_dict`'s non-privileged part (`extra` filtered to
+/// `non_privileged_extra_keys`) plus the camera data in `layout`, with a robot mask when
+/// `robot_seg`. Takes the frame by value: its images move into the observation without copies.
 pub fn assemble(
     state_dict: ObsValue,
+    non_privileged_extra_keys: &[&str],
     frame: CameraFrame,
     layout: VisualLayout,
     robot_seg: bool,
 ) -> ObsValue {
-    let mut root = non_privileged_state(state_dict);
+    let mut root = non_privileged_state(state_dict, non_privileged_extra_keys);
     let is_robot = |link_id: &u32| frame.robot_ids.contains(link_id);
     match layout {
         VisualLayout::Rgbd => {
@@ -158,32 +134,4 @@ pub fn assemble(
         }
     }
     ObsValue::Dict(root)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::obs::DictBuilder;
-
-    #[test]
-    fn extra_keeps_only_non_privileged_keys() {
-        let state = ObsValue::Dict(vec![
-            (
-                "agent".into(),
-                DictBuilder::new().vector("qpos", &[0.0]).build(),
-            ),
-            (
-                "extra".into(),
-                DictBuilder::new()
-                    .vector("tcp_pose", &[0.0; 7])
-                    .vector("goal_pos", &[0.0; 3])
-                    .vector("obj_pose", &[0.0; 7])
-                    .build(),
-            ),
-        ]);
-        let kept = ObsValue::Dict(non_privileged_state(state));
-        assert!(kept.get("agent/qpos").is_some());
-        assert!(kept.get("extra/tcp_pose").is_some() && kept.get("extra/goal_pos").is_some());
-        assert!(kept.get("extra/obj_pose").is_none());
-    }
 }

@@ -4,7 +4,7 @@
 use ms2_plan::JointTrajectory;
 
 use super::SolveError;
-use crate::agent::ARM_DOF;
+use crate::agents::ARM_DOF;
 use crate::demos::{DemoEpisode, EpisodeRecorder};
 use crate::env::Env;
 
@@ -68,7 +68,7 @@ impl<'e> JointTargetDriver<'e> {
         let scene = env
             .task_scene()
             .ok_or_else(|| SolveError::Sensing("the env has no robot".to_owned()))?;
-        let qpos = scene.agent.qpos(&scene.world);
+        let qpos = scene.agent.qpos(scene.world.as_ref());
         if qpos.len() < ARM_DOF {
             return Err(SolveError::Sensing(format!(
                 "the robot has {} joints, expected at least {ARM_DOF}",
@@ -182,7 +182,7 @@ impl<'e> JointTargetDriver<'e> {
         };
         scene
             .agent
-            .qpos(&scene.world)
+            .qpos(scene.world.as_ref())
             .iter()
             .zip(&self.arm_target)
             .map(|(&q, &t)| (f64::from(q) - t).abs())

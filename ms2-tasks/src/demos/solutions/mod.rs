@@ -1,11 +1,11 @@
 //! Motion-planning solutions: sense–plan–act with privileged state, driving `pd_joint_pos`.
 //!
-//! Each solution reads the true cube poses and goal after reset ([`scene`]), plans with
+//! Each solution reads the true object poses and goal after reset ([`scene`]), plans with
 //! [ms2-plan](ms2_plan) (a top-down grasp from the cube's bounding box at the yaw closest to the
 //! hand's, screw motions and RRT-Connect, TOPP-RA timing at the control frequency, the ground
 //! and the other cubes as obstacles) and plays the planned joint targets as `pd_joint_pos`
-//! actions, recording the episode ([`driver`]). The three cube tasks share one
-//! pick-and-place skeleton ([`pick_place`]); a task is a [`CubeTaskSolution`] value.
+//! actions, recording the episode ([`driver`]). A task registers its [`Solution`] with its
+//! family (the cube tasks: `families/rigid/solutions.rs`).
 //!
 //! ```no_run
 //! use ms2_tasks::demos::solutions::{solution_env_ids, solve_episode};
@@ -17,76 +17,39 @@
 //! ```
 
 pub mod driver;
-pub mod pick_place;
 pub mod scene;
 
 use std::sync::OnceLock;
 use std::time::Instant;
 
 use ms2_plan::{KinematicRobot, PlanError, PlanningRobot};
-use nalgebra::Vector3;
 
-use crate::agent::ARM_DOF;
+use crate::agents::ARM_DOF;
 use crate::config::{EnvConfig, ObsMode};
 use crate::demos::{DemoEpisode, DemoError};
 use crate::env::{make_env, Env};
 use crate::error::EnvError;
-use crate::tasks::common::CUBE_HALF_SIZE;
-use crate::tasks::lift_cube::GOAL_HEIGHT;
+use crate::registry;
 pub use driver::{Gripper, JointTargetDriver, CONTROL_MODE};
-pub use pick_place::{CubeTaskSolution, Finish};
 pub use scene::{SensedCube, SensedState};
 
-/// Height (m) LiftCube's cube is carried to above its success height (cube centre at
-/// `GOAL_HEIGHT + half size`), so that it stays above it while the robot settles.
-const LIFT_MARGIN: f64 = 0.03;
-/// Height (m) of the moved cube's bottom above the other cube's top when StackCube releases it.
-const STACK_GAP: f64 = 0.002;
-
-/// How far (m) PickCube's cube may be carried short of the goal when the upright hand cannot
-/// reach it (success needs 0.025 m; an upright hand keeps the episode convertible to
-/// `pd_ee_delta_pos`, whose hand orientation is fixed).
-const PICK_GOAL_TOLERANCE: f64 = 0.02;
-
-/// The registered solutions.
-const SOLUTIONS: [CubeTaskSolution; 3] = [
-    CubeTaskSolution {
-        env_id: "PickCube-v0",
-        cube: "obj",
-        obstacles: &[],
-        goal_world: |s| {
-            let g = scene::privileged_vector(&s.obs, "extra/goal_pos", 3)?;
-            Ok(Vector3::new(g[0], g[1], g[2]).cast())
-        },
-        goal_tolerance: PICK_GOAL_TOLERANCE,
-        finish: Finish::HoldStill,
-    },
-    CubeTaskSolution {
-        env_id: "LiftCube-v0",
-        cube: "obj",
-        obstacles: &[],
-        goal_world: |s| {
-            let cube = s.pose_world_from_base * s.cube("obj")?.pose_base_from_cube;
-            let mut goal = cube.translation.vector;
-            goal.z = f64::from(GOAL_HEIGHT + CUBE_HALF_SIZE) + LIFT_MARGIN;
-            Ok(goal)
-        },
-        goal_tolerance: 0.0,
-        finish: Finish::HoldStill,
-    },
-    CubeTaskSolution {
-        env_id: "StackCube-v0",
-        cube: "cubeA",
-        obstacles: &["cubeB"],
-        goal_world: |s| {
-            let b = s.cube("cubeB")?;
-            let on_top = s.pose_world_from_base * b.pose_base_from_cube;
-            Ok(on_top.translation.vector + Vector3::new(0.0, 0.0, 2.0 * b.half_size + STACK_GAP))
-        },
-        goal_tolerance: 0.0,
-        finish: Finish::PlaceAndRelease,
-    },
-];
+/// A task's motion-planning solution, registered with the task
+/// ([`crate::registry::TaskRegistration::solution`]).
+pub trait Solution: Sync {
+    /// Runs the solution on `driver`'s freshly reset env (driving [`CONTROL_MODE`]); `panda`
+    /// is the planning model of the robot, `seed` seeds the planners.
+    ///
+    /// # Errors
+    /// [`SolveError::OutOfSteps`] when the episode limit ends the motion, planning and env
+    /// errors otherwise.
+    fn run(
+        &self,
+        driver: &mut JointTargetDriver<'_>,
+        panda: &KinematicRobot,
+        seed: u64,
+        timings: &mut SolveTimings,
+    ) -> Result<(), SolveError>;
+}
 
 /// Why a solution stopped early (internal; mapped to [`DemoError`] or a failed episode).
 #[derive(Debug, thiserror::Error)]
@@ -123,7 +86,11 @@ pub struct SolveTimings {
 
 /// Env ids that have a motion-planning solution.
 pub fn solution_env_ids() -> Vec<&'static str> {
-    SOLUTIONS.iter().map(|s| s.env_id).collect()
+    registry::task_registrations()
+        .into_iter()
+        .filter(|r| r.solution.is_some())
+        .map(|r| r.spec.env_id)
+        .collect()
 }
 
 /// ms2's Panda for planning, built once.
@@ -138,7 +105,7 @@ fn planning_panda() -> Result<&'static KinematicRobot, PlanError> {
 /// Solves episodes of one env, reusing the env between seeds.
 pub struct DemoSolver {
     env: Env,
-    solution: CubeTaskSolution,
+    solution: &'static dyn Solution,
     panda: &'static KinematicRobot,
 }
 
@@ -151,13 +118,14 @@ impl DemoSolver {
     /// [`DemoError::NoSolution`] for an env without a solution, [`DemoError::Env`] for a bad
     /// config, [`DemoError::Planning`] if the planning robot cannot be built.
     pub fn new(cfg: &EnvConfig) -> Result<Self, DemoError> {
-        let solution = *SOLUTIONS
-            .iter()
-            .find(|s| s.env_id == cfg.env_id)
-            .ok_or_else(|| DemoError::NoSolution {
-                env_id: cfg.env_id.clone(),
-                valid: solution_env_ids().into_iter().map(str::to_owned).collect(),
-            })?;
+        let no_solution = || DemoError::NoSolution {
+            env_id: cfg.env_id.clone(),
+            valid: solution_env_ids().into_iter().map(str::to_owned).collect(),
+        };
+        let solution = registry::registration(&cfg.env_id)
+            .ok()
+            .and_then(|r| r.solution)
+            .ok_or_else(no_solution)?;
         if let Some(mode) = cfg.control_mode.as_deref() {
             if mode != CONTROL_MODE {
                 return Err(DemoError::Env(EnvError::InvalidConfig(format!(
@@ -237,8 +205,8 @@ fn check_joint_order(env: &Env, panda: &KinematicRobot) -> Result<(), DemoError>
     })?;
     let names = scene
         .world
-        .joint_names(scene.agent.articulation)
-        .map_err(|e| DemoError::Env(EnvError::Physics(e.to_string())))?;
+        .joint_names(scene.agent.articulation())
+        .map_err(|e| DemoError::Env(EnvError::from(e)))?;
     if planned.len() != ARM_DOF || names.len() < ARM_DOF || planned[..] != names[..ARM_DOF] {
         return Err(DemoError::Planning {
             seed: 0,

@@ -6,11 +6,11 @@ use ms2_plan::{parry3d::shape::SharedShape, CollisionScene, OrientedBox, PlanErr
 use nalgebra::{Isometry3, Vector3};
 
 use super::SolveError;
-use crate::agent::ARM_DOF;
+use crate::agents::ARM_DOF;
 use crate::env::Env;
+use crate::families::rigid::common::CUBE_HALF_SIZE;
 use crate::geometry::pose_from_vec7;
 use crate::obs::ObsValue;
-use crate::tasks::common::CUBE_HALF_SIZE;
 
 /// Name of the ground plane in the collision scene.
 pub const GROUND: &str = "ground";
@@ -62,7 +62,7 @@ impl SensedState {
             .task_scene()
             .ok_or_else(|| SolveError::Sensing("the env has no robot".to_owned()))?;
         let pose_world_from_base: Isometry3<f64> = scene.agent.base_pose().cast();
-        let qpos = scene.agent.qpos(&scene.world);
+        let qpos = scene.agent.qpos(scene.world.as_ref());
         if qpos.len() < ARM_DOF {
             return Err(SolveError::Sensing(format!(
                 "the robot reports {} joint positions, expected at least {ARM_DOF}",

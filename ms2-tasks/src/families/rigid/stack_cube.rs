@@ -10,9 +10,7 @@
 //!   cubeA_to_cubeB_pos (`state` = 55 floats). No task state.
 //! - `info` keys keep ManiSkill2's spelling, including `is_cubaA_grasped`.
 
-use std::any::Any;
-
-use ms2_physics::{BodyId, World};
+use ms2_physics::BodyId;
 use nalgebra::Vector3;
 
 use super::common::{
@@ -23,6 +21,7 @@ use crate::error::EnvError;
 use crate::geometry::{top_down_grasp_rotation_loss, vectorize_pose};
 use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
+use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
 use crate::task::{Task, TaskScene};
 
@@ -54,7 +53,7 @@ impl StackCube {
     }
 
     /// ManiSkill2's `_check_cubeA_on_cubeB`.
-    pub fn is_a_on_b(&self, world: &World) -> bool {
+    pub fn is_a_on_b(&self, world: &dyn RigidWorld) -> bool {
         let offset = body_pose(world, self.a()).translation.vector
             - body_pose(world, self.b()).translation.vector;
         let half_xy = (2.0f32).sqrt() * CUBE_HALF_SIZE;
@@ -87,7 +86,11 @@ impl Task for StackCube {
         MAX_DENSE_REWARD
     }
 
-    fn build_scene(&mut self, world: &mut World, _rng: &mut EpisodeRng) -> Result<(), EnvError> {
+    fn build_scene(
+        &mut self,
+        world: &mut dyn RigidWorld,
+        _rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
         self.cube_a = Some(add_cube(
             world,
             "cubeA",
@@ -111,12 +114,12 @@ impl Task for StackCube {
         let (xy_a, xy_b) = sample_two_positions(rng);
         let pose_a = cube_pose_on_ground(xy_a, CUBE_HALF_SIZE, rng);
         let pose_b = cube_pose_on_ground(xy_b, CUBE_HALF_SIZE, rng);
-        place_at_rest(&mut scene.world, self.a(), &pose_a)?;
-        place_at_rest(&mut scene.world, self.b(), &pose_b)
+        place_at_rest(scene.world.as_mut(), self.a(), &pose_a)?;
+        place_at_rest(scene.world.as_mut(), self.b(), &pose_b)
     }
 
     fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
-        let world = &scene.world;
+        let world = scene.world.as_ref();
         let tcp = scene.agent.tcp_pose(world);
         let (a, b) = (body_pose(world, self.a()), body_pose(world, self.b()));
         let (tp, ap, bp) = (
@@ -133,7 +136,7 @@ impl Task for StackCube {
     }
 
     fn evaluate(&self, scene: &TaskScene) -> Evaluation {
-        let world = &scene.world;
+        let world = scene.world.as_ref();
         let on_b = self.is_a_on_b(world);
         let a_static = is_actor_static(world, self.a());
         let grasped = scene
@@ -153,7 +156,7 @@ impl Task for StackCube {
         if eval.success {
             return MAX_DENSE_REWARD;
         }
-        let world = &scene.world;
+        let world = scene.world.as_ref();
         let agent = &scene.agent;
         let tcp = agent.tcp_pose(world);
         let (a, b) = (body_pose(world, self.a()), body_pose(world, self.b()));
@@ -198,9 +201,5 @@ impl Task for StackCube {
             reward += carry.max(0.0);
         }
         reward
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
     }
 }

@@ -18,11 +18,40 @@ use crate::env::Env;
 use crate::error::EnvError;
 use crate::info::{Evaluation, InfoValue};
 use crate::obs::{DictBuilder, ObsValue};
+use crate::registry::{Registrar, TaskRegistration};
 use crate::scripted::ScriptedPolicy;
 use crate::seeding::EpisodeRng;
 use crate::spaces::BoxSpace;
+use crate::spec::TaskSpec;
 
 const CONTROL_MODE: &str = "pd_joint_delta_pos";
+
+/// `Dummy-v0`'s spec.
+pub const DUMMY: TaskSpec = TaskSpec {
+    env_id: "Dummy-v0",
+    family: "dummy",
+    summary: "a physics-free point reaches a goal (test env)",
+    max_episode_steps: 50,
+    robots: &[],
+    control_modes: &[CONTROL_MODE],
+    default_control_mode: CONTROL_MODE,
+    obs_modes: &[
+        crate::config::ObsMode::State,
+        crate::config::ObsMode::StateDict,
+    ],
+    non_privileged_extra_keys: &["tcp_pose", "goal_pos"],
+    goal_marker: None,
+    soft_bodies: false,
+    assets: &[],
+};
+
+/// Registers `Dummy-v0` with its scripted policy.
+pub fn register(r: &mut Registrar) {
+    let make = |cfg: &EnvConfig, substeps| -> Result<Box<dyn EnvBackend>, EnvError> {
+        Ok(Box::new(DummyEnv::new(cfg, substeps)?))
+    };
+    r.add(TaskRegistration::with_backend(DUMMY, make).scripted(|_| Ok(Box::new(DummyReachPolicy))));
+}
 const MAX_DELTA: f32 = 0.05;
 const GOAL_THRESHOLD: f32 = 0.025;
 const SAMPLE_HALF_RANGE: f32 = 0.2;
@@ -75,9 +104,6 @@ fn sample_point(rng: &mut EpisodeRng) -> [f32; 3] {
 }
 
 impl EnvBackend for DummyEnv {
-    fn default_max_episode_steps(&self) -> u32 {
-        50
-    }
     fn control_modes(&self) -> Vec<String> {
         vec![CONTROL_MODE.to_owned()]
     }

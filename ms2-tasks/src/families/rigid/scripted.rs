@@ -4,12 +4,20 @@
 
 use nalgebra::Vector3;
 
-use super::oracle::{tcp_yaw, top_down_tcp_pose, TcpOracle, GRIPPER_CLOSED, GRIPPER_OPEN};
-use super::ScriptedPolicy;
+use super::common::CUBE_HALF_SIZE;
 use crate::env::Env;
+use crate::error::EnvError;
 use crate::geometry::{nearest_quarter_turn_yaw, pose_from_vec7, Pose3};
 use crate::obs::ObsValue;
-use crate::tasks::common::CUBE_HALF_SIZE;
+use crate::scripted::oracle::{
+    tcp_yaw, top_down_tcp_pose, TcpOracle, GRIPPER_CLOSED, GRIPPER_OPEN,
+};
+use crate::scripted::{tcp_oracle, ScriptedPolicy};
+
+/// The cube tasks' scripted policy for `plan`, in `env`'s control mode.
+pub fn policy(env: &Env, plan: Plan) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
+    Ok(Box::new(PickPlacePolicy::new(plan, tcp_oracle(env)?)))
+}
 
 /// What the policy has to achieve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

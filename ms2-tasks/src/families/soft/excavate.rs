@@ -6,7 +6,7 @@
 //! (z = 0). The coupled rigid body is the Panda's hand, which carries the bucket's four boxes
 //! (fixed links are merged into their parent body): the clay pushes back on the arm through
 //! its joint drives. After every 500 Hz physics step the coupled MPM substeps run
-//! ([`Task::after_physics_step`]).
+//! (its [`SoftComponent`], [`BucketArm`]).
 //!
 //! - Episode (seeded): the bed's height map and the target amount ([`ExcavateBed::sample`]);
 //!   the robot at its rest pose plus the runtime's joint noise.
@@ -18,37 +18,25 @@
 //!   velocity (3), deformation gradient (9, column-major) and affine matrix (9). A state
 //!   restores into an episode with the same particle count (the same seed).
 
-use std::any::Any;
-
 use glam::Vec3;
-use ms2_physics::World;
 use rand::Rng;
 
-use super::bucket_arm::{soft_err, tcp_for_bucket, BucketArm, FLOATS_PER_PARTICLE};
-use super::excavate::{
-    excavate_soft_config, in_bucket_local, ExcavateBed, ExcavateEvaluation, ScriptedScoop,
-    MAX_EPISODE_STEPS,
+use super::bucket_arm::BucketArm;
+use super::excavate_scene::{
+    excavate_soft_config, in_bucket_local, ExcavateBed, ExcavateEvaluation,
 };
 use crate::adapters::mpm_rigid::pose_to_glam;
-use crate::adapters::ParticleVisual;
 use crate::config::EnvConfig;
-use crate::env::Env;
 use crate::error::EnvError;
-use crate::geometry::vectorize_pose;
 use crate::info::{Evaluation, InfoValue};
-use crate::obs::{DictBuilder, ObsValue};
-use crate::scripted::oracle::{TcpOracle, GRIPPER_OPEN};
-use crate::scripted::ScriptedPolicy;
+use crate::obs::DictBuilder;
+use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
-use crate::task::{Task, TaskScene};
+use crate::task::{SoftComponent, Task, TaskScene};
 
 /// World position (m) of the soft grid's node (0, 0, 0): the bed's footprint is then centred
 /// on the world origin and the soft floor is the table.
 pub const GRID_ORIGIN: Vec3 = Vec3::new(-0.18, -0.16, -0.03);
-
-/// Control steps the scripted policy gives the arm to bring the bucket from its rest pose to
-/// the bed's near edge.
-const APPROACH_STEPS: u32 = 14;
 
 /// Floats of task state before the particles.
 const STATE_HEADER: usize = 6;
@@ -64,7 +52,7 @@ impl Excavate {
     /// The task for `cfg` (its `mpm_freq`, see [`BucketArm::from_config`]).
     pub fn new(cfg: &EnvConfig) -> Result<Self, EnvError> {
         Ok(Self {
-            arm: BucketArm::from_config(cfg)?,
+            arm: BucketArm::from_config(cfg, excavate_soft_config(GRID_ORIGIN).particle_spacing)?,
             bed: None,
         })
     }
@@ -79,7 +67,7 @@ impl Excavate {
         &self.arm
     }
 
-    fn excavate_eval(&self, world: &World) -> Option<ExcavateEvaluation> {
+    fn excavate_eval(&self, world: &dyn RigidWorld) -> Option<ExcavateEvaluation> {
         let (soft, bed) = (self.arm.soft()?, self.bed.as_ref()?);
         let (pos, rot) = pose_to_glam(&self.arm.bucket_pose(world));
         let inv = rot.inverse();
@@ -92,19 +80,15 @@ impl Excavate {
 }
 
 impl Task for Excavate {
-    fn max_episode_steps(&self) -> u32 {
-        MAX_EPISODE_STEPS
-    }
-
     fn max_dense_reward(&self) -> f64 {
         1.0
     }
 
-    fn robot_urdf(&self) -> &'static str {
-        ms2_assets::PANDA_BUCKET_URDF
-    }
-
-    fn build_scene(&mut self, _world: &mut World, _rng: &mut EpisodeRng) -> Result<(), EnvError> {
+    fn build_scene(
+        &mut self,
+        _world: &mut dyn RigidWorld,
+        _rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
         // The table is the world's ground; the clay is built per episode.
         self.arm.clear();
         Ok(())
@@ -119,21 +103,14 @@ impl Task for Excavate {
         let (solver, bed) = ExcavateBed::sample(
             &self.arm.soft_config(excavate_soft_config(GRID_ORIGIN)),
             rng.random(),
-        )
-        .map_err(soft_err)?;
-        self.arm.couple(solver, &scene.world, &[])?;
+        )?;
+        self.arm.couple(solver, scene.world.as_ref(), &[])?;
         self.bed = Some(bed);
         Ok(())
     }
 
-    fn after_physics_step(&mut self, world: &mut World) -> Result<(), EnvError> {
-        self.arm.after_physics_step(world)
-    }
-
     fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
-        let world = &scene.world;
-        extra.push_vector("tcp_pose", &vectorize_pose(&scene.agent.tcp_pose(world)));
-        extra.push_vector("bucket_pose", &vectorize_pose(&self.arm.bucket_pose(world)));
+        self.arm.push_pose_obs(scene, extra);
         let bed = self.bed.as_ref();
         extra.push_vector(
             "target_particles",
@@ -143,7 +120,7 @@ impl Task for Excavate {
     }
 
     fn evaluate(&self, scene: &TaskScene) -> Evaluation {
-        let Some(e) = self.excavate_eval(&scene.world) else {
+        let Some(e) = self.excavate_eval(scene.world.as_ref()) else {
             return Evaluation::default();
         };
         let lowest = if e.lowest_in_bucket.is_finite() {
@@ -176,7 +153,7 @@ impl Task for Excavate {
     }
 
     fn dense_reward(&self, scene: &TaskScene, _eval: &Evaluation) -> f64 {
-        match (self.excavate_eval(&scene.world), &self.bed) {
+        match (self.excavate_eval(scene.world.as_ref()), &self.bed) {
             (Some(e), Some(bed)) => bed.dense_reward(&e),
             _ => 0.0,
         }
@@ -186,22 +163,18 @@ impl Task for Excavate {
         let Some(bed) = &self.bed else {
             return vec![0.0; STATE_HEADER];
         };
-        let n = self.arm.particle_count();
-        let mut out = Vec::with_capacity(STATE_HEADER + FLOATS_PER_PARTICLE * n);
-        out.extend([
+        self.arm.task_state(&[
             bed.target_particles as f32,
             bed.floor_z,
             bed.bed_top_z,
             bed.mean_bed_z,
-            n as f32,
+            self.arm.particle_count() as f32,
             0.0,
-        ]);
-        self.arm.push_particle_state(&mut out);
-        out
+        ])
     }
 
     fn task_state_len(&self) -> usize {
-        STATE_HEADER + FLOATS_PER_PARTICLE * self.arm.particle_count()
+        self.arm.task_state_len(STATE_HEADER)
     }
 
     fn set_task_state(&mut self, state: &[f32]) {
@@ -212,62 +185,11 @@ impl Task for Excavate {
         self.arm.set_particle_state(&state[STATE_HEADER..]);
     }
 
-    fn particles_obs(&self) -> Option<ObsValue> {
-        self.arm.particles_obs()
+    fn soft(&self) -> Option<&dyn SoftComponent> {
+        Some(&self.arm)
     }
 
-    fn mpm_freq(&self) -> Option<f64> {
-        Some(self.arm.mpm_freq())
-    }
-
-    fn particle_visuals(&self) -> Vec<ParticleVisual> {
-        vec![BucketArm::clay_visual(
-            excavate_soft_config(GRID_ORIGIN).particle_spacing,
-        )]
-    }
-
-    fn particle_positions(&self, _set: usize) -> &[Vec3] {
-        self.arm.particle_positions()
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-}
-
-/// Scripted solution of `Excavate-v0`: the kinematic scene's scoop ([`ScriptedScoop`]),
-/// planned from the bucket's pose at reset, with each bucket waypoint turned into a TCP target
-/// ([`tcp_for_bucket`]) and then into an action of the env's control mode ([`TcpOracle`]).
-pub struct ExcavatePolicy {
-    oracle: TcpOracle,
-    plan: Option<ScriptedScoop>,
-}
-
-impl ExcavatePolicy {
-    /// A policy driving through `oracle`.
-    pub fn new(oracle: TcpOracle) -> Self {
-        Self { oracle, plan: None }
-    }
-}
-
-impl ScriptedPolicy for ExcavatePolicy {
-    fn reset(&mut self, env: &Env) {
-        let task = env.task_any().and_then(|t| t.downcast_ref::<Excavate>());
-        self.plan = match (task, env.task_scene()) {
-            (Some(task), Some(scene)) => task.bed().map(|bed| {
-                let mut start = task.arm().bucket_command_pose(&scene.world);
-                start.pitch = 0.0;
-                ScriptedScoop::plan_from(start, bed, APPROACH_STEPS)
-            }),
-            _ => None,
-        };
-    }
-
-    fn act(&mut self, env: &Env) -> Vec<f32> {
-        let Some(plan) = &self.plan else {
-            return vec![0.0; env.action_space().size()];
-        };
-        let target = tcp_for_bucket(&plan.command(env.elapsed_steps()));
-        self.oracle.action(env, &target, GRIPPER_OPEN)
+    fn soft_mut(&mut self) -> Option<&mut dyn SoftComponent> {
+        Some(&mut self.arm)
     }
 }

@@ -14,29 +14,23 @@
 //!   The `particles` obs mode adds `particles/x`.
 //! - Task state: beaker x, y (m), particle count, 0, then the particle state.
 
-use std::any::Any;
-
 use glam::{Vec2, Vec3};
 use ms2_mpm::sampling;
-use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, VisualShape, World};
+use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, VisualShape};
 use nalgebra::Vector3;
 use rand::Rng;
 
-use super::bucket_arm::{soft_err, tcp_for_bucket, BucketArm, FLOATS_PER_PARTICLE};
-use super::excavate::{BucketPose, BUCKET_INNER_HALF, BUCKET_WALL_HALF, MAX_SOFT_SPEED};
-use super::{SoftConfig, SoftWorld};
+use super::bucket_arm::BucketArm;
+use super::excavate_scene::{BUCKET_INNER_HALF, BUCKET_WALL_HALF, MAX_SOFT_SPEED};
 use crate::adapters::mpm_rigid::pose_to_glam;
-use crate::adapters::ParticleVisual;
 use crate::config::EnvConfig;
-use crate::env::Env;
 use crate::error::EnvError;
-use crate::geometry::vectorize_pose;
 use crate::info::{Evaluation, InfoValue};
-use crate::obs::{DictBuilder, ObsValue};
-use crate::scripted::oracle::{TcpOracle, GRIPPER_OPEN};
-use crate::scripted::ScriptedPolicy;
+use crate::obs::DictBuilder;
+use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
-use crate::task::{Task, TaskScene};
+use crate::soft::{SoftConfig, SoftSceneError, SoftWorld};
+use crate::task::{SoftComponent, Task, TaskScene};
 
 /// Episode limit, as ManiSkill2's Fill.
 pub const MAX_EPISODE_STEPS: u32 = 250;
@@ -54,7 +48,7 @@ pub const GRID_ORIGIN: Vec3 = Vec3::new(-0.14, -0.16, -0.03);
 const BEAKER_X: (f32, f32) = (0.07, 0.10);
 const BEAKER_Y: (f32, f32) = (-0.05, 0.05);
 /// The pour point is this far (m) above the beaker's rim, over its centre.
-const POUR_HEIGHT: f32 = 0.04;
+pub const POUR_HEIGHT: f32 = 0.04;
 /// Floats of task state before the particles.
 const STATE_HEADER: usize = 4;
 
@@ -64,7 +58,6 @@ pub struct Fill {
     arm: BucketArm,
     beaker: Option<BodyId>,
     beaker_xy: Vec2,
-    setup_error: Option<String>,
 }
 
 /// Evaluation terms of `Fill-v0`.
@@ -84,7 +77,7 @@ impl Fill {
     /// The task for `cfg` (its `mpm_freq`, see [`BucketArm::from_config`]).
     pub fn new(cfg: &EnvConfig) -> Result<Self, EnvError> {
         Ok(Self {
-            arm: BucketArm::from_config(cfg)?,
+            arm: BucketArm::from_config(cfg, SoftConfig::default().particle_spacing)?,
             ..Self::default()
         })
     }
@@ -106,7 +99,7 @@ impl Fill {
     }
 
     /// The evaluation terms of the current state.
-    pub fn fill_eval(&self, world: &World) -> Option<FillEvaluation> {
+    pub fn fill_eval(&self, world: &dyn RigidWorld) -> Option<FillEvaluation> {
         let soft = self.arm.soft()?;
         let x = soft.solver().positions();
         let inside = x.iter().filter(|p| self.in_beaker(**p)).count();
@@ -123,7 +116,7 @@ impl Fill {
     }
 
     /// Clay filling the bucket's interior at its current pose (bucket frame lattice).
-    fn clay_in_bucket(&self, world: &World, spacing: f32) -> Vec<Vec3> {
+    fn clay_in_bucket(&self, world: &dyn RigidWorld, spacing: f32) -> Vec<Vec3> {
         let [hx, hy, _] = BUCKET_INNER_HALF;
         let w = BUCKET_WALL_HALF;
         let (pos, rot) = pose_to_glam(&self.arm.bucket_pose(world));
@@ -161,32 +154,26 @@ fn beaker_shape() -> ShapeDesc {
 }
 
 impl Task for Fill {
-    fn max_episode_steps(&self) -> u32 {
-        MAX_EPISODE_STEPS
-    }
-
     fn max_dense_reward(&self) -> f64 {
         1.0
     }
 
-    fn robot_urdf(&self) -> &'static str {
-        ms2_assets::PANDA_BUCKET_URDF
-    }
-
-    fn build_scene(&mut self, world: &mut World, _rng: &mut EpisodeRng) -> Result<(), EnvError> {
+    fn build_scene(
+        &mut self,
+        world: &mut dyn RigidWorld,
+        _rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
         self.arm.clear();
-        let beaker = world
-            .add_actor(
-                ActorDesc::new("beaker", ActorKind::Kinematic)
-                    .with_pose(Pose3::translation(BEAKER_X.0, 0.0, 0.0))
-                    .with_shape(ShapeSpec::new(beaker_shape()))
-                    .with_visual(VisualShape {
-                        shape: beaker_shape(),
-                        pose_body_from_shape: Pose3::identity(),
-                        rgba: BEAKER_COLOR,
-                    }),
-            )
-            .map_err(|e| EnvError::Physics(e.to_string()))?;
+        let beaker = world.add_actor(
+            ActorDesc::new("beaker", ActorKind::Kinematic)
+                .with_pose(Pose3::translation(BEAKER_X.0, 0.0, 0.0))
+                .with_shape(ShapeSpec::new(beaker_shape()))
+                .with_visual(VisualShape {
+                    shape: beaker_shape(),
+                    pose_body_from_shape: Pose3::identity(),
+                    rgba: BEAKER_COLOR,
+                }),
+        )?;
         self.beaker = Some(beaker);
         Ok(())
     }
@@ -202,53 +189,41 @@ impl Task for Fill {
             rng.random_range(BEAKER_Y.0..BEAKER_Y.1),
         );
         if let Some(beaker) = self.beaker {
-            scene
-                .world
-                .set_body_pose(
-                    beaker,
-                    &Pose3::translation(self.beaker_xy.x, self.beaker_xy.y, 0.0),
-                )
-                .map_err(|e| EnvError::Physics(e.to_string()))?;
+            scene.world.set_body_pose(
+                beaker,
+                &Pose3::translation(self.beaker_xy.x, self.beaker_xy.y, 0.0),
+            )?;
         }
         Ok(())
     }
 
-    fn initialize_task(&mut self, scene: &TaskScene, _rng: &mut EpisodeRng) {
+    fn initialize_task(
+        &mut self,
+        scene: &TaskScene,
+        _rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
         // The clay goes into the bucket where the robot's reset put it.
         let config = self.arm.soft_config(SoftConfig {
             grid_origin: GRID_ORIGIN,
             ..SoftConfig::default()
         });
-        let result = (|| -> Result<(), EnvError> {
-            let (mut solver, clay) = SoftWorld::solver_for(&config).map_err(soft_err)?;
-            let spacing = config.particle_spacing;
-            let points = self.clay_in_bucket(&scene.world, spacing);
-            solver
-                .add_particles(&points, clay, spacing.powi(3), Vec3::ZERO)
-                .map_err(|e| soft_err(e.into()))?;
-            let others: Vec<BodyId> = self.beaker.into_iter().collect();
-            self.arm.couple(solver, &scene.world, &others)
-        })();
-        // `initialize_task` cannot fail; the error surfaces at the first physics step.
-        self.setup_error = result.err().map(|e| e.to_string());
-    }
-
-    fn after_physics_step(&mut self, world: &mut World) -> Result<(), EnvError> {
-        if let Some(e) = &self.setup_error {
-            return Err(EnvError::Physics(e.clone()));
-        }
-        self.arm.after_physics_step(world)
+        let (mut solver, clay) = SoftWorld::solver_for(&config)?;
+        let spacing = config.particle_spacing;
+        let points = self.clay_in_bucket(scene.world.as_ref(), spacing);
+        solver
+            .add_particles(&points, clay, spacing.powi(3), Vec3::ZERO)
+            .map_err(SoftSceneError::from)?;
+        let others: Vec<BodyId> = self.beaker.into_iter().collect();
+        self.arm.couple(solver, scene.world.as_ref(), &others)
     }
 
     fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
-        let world = &scene.world;
-        extra.push_vector("tcp_pose", &vectorize_pose(&scene.agent.tcp_pose(world)));
-        extra.push_vector("bucket_pose", &vectorize_pose(&self.arm.bucket_pose(world)));
+        self.arm.push_pose_obs(scene, extra);
         extra.push_vector("beaker_pos", &self.beaker_xy.extend(0.0).to_array());
     }
 
     fn evaluate(&self, scene: &TaskScene) -> Evaluation {
-        let Some(e) = self.fill_eval(&scene.world) else {
+        let Some(e) = self.fill_eval(scene.world.as_ref()) else {
             return Evaluation::default();
         };
         Evaluation {
@@ -267,7 +242,7 @@ impl Task for Fill {
     }
 
     fn dense_reward(&self, scene: &TaskScene, _eval: &Evaluation) -> f64 {
-        let Some(e) = self.fill_eval(&scene.world) else {
+        let Some(e) = self.fill_eval(scene.world.as_ref()) else {
             return 0.0;
         };
         if e.success {
@@ -279,15 +254,13 @@ impl Task for Fill {
     }
 
     fn task_state(&self) -> Vec<f32> {
-        let n = self.arm.particle_count();
-        let mut out = Vec::with_capacity(STATE_HEADER + FLOATS_PER_PARTICLE * n);
-        out.extend([self.beaker_xy.x, self.beaker_xy.y, n as f32, 0.0]);
-        self.arm.push_particle_state(&mut out);
-        out
+        let n = self.arm.particle_count() as f32;
+        self.arm
+            .task_state(&[self.beaker_xy.x, self.beaker_xy.y, n, 0.0])
     }
 
     fn task_state_len(&self) -> usize {
-        STATE_HEADER + FLOATS_PER_PARTICLE * self.arm.particle_count()
+        self.arm.task_state_len(STATE_HEADER)
     }
 
     fn set_task_state(&mut self, state: &[f32]) {
@@ -295,104 +268,11 @@ impl Task for Fill {
         self.arm.set_particle_state(&state[STATE_HEADER..]);
     }
 
-    fn particles_obs(&self) -> Option<ObsValue> {
-        self.arm.particles_obs()
+    fn soft(&self) -> Option<&dyn SoftComponent> {
+        Some(&self.arm)
     }
 
-    fn mpm_freq(&self) -> Option<f64> {
-        Some(self.arm.mpm_freq())
-    }
-
-    fn particle_visuals(&self) -> Vec<ParticleVisual> {
-        vec![BucketArm::clay_visual(
-            SoftConfig::default().particle_spacing,
-        )]
-    }
-
-    fn particle_positions(&self, _set: usize) -> &[Vec3] {
-        self.arm.particle_positions()
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-}
-
-/// Bucket waypoints of the scripted pour: lift, carry the lip over the beaker, tilt the
-/// opening down about the lip, hold.
-#[derive(Clone, Debug)]
-pub struct PourPlan {
-    waypoints: Vec<(u32, BucketPose)>,
-}
-
-/// Pitch (rad) of the pour: the opening 75° down.
-const POUR_PITCH: f32 = -75.0 * std::f32::consts::PI / 180.0;
-
-impl PourPlan {
-    /// Plans the pour from the bucket's pose `start` to the pour point `pour` (m, world).
-    pub fn new(start: BucketPose, pour: Vec3) -> Self {
-        let hx = BUCKET_INNER_HALF[0];
-        // Plate centre that puts the lip at `pour` for a given pitch.
-        let centre = |pitch: f32| BucketPose {
-            position: pour - Vec3::new(hx * pitch.cos(), 0.0, hx * pitch.sin()),
-            pitch,
-        };
-        let lifted = BucketPose {
-            position: start.position + Vec3::new(0.0, 0.0, 0.04),
-            pitch: 0.0,
-        };
-        let mut above = centre(0.0);
-        above.position.z += 0.02;
-        Self {
-            waypoints: vec![
-                (0, start),
-                (6, lifted),
-                (16, above),
-                (20, centre(0.0)),
-                (24, centre(0.3 * POUR_PITCH)),
-                (36, centre(POUR_PITCH)),
-                (MAX_EPISODE_STEPS, centre(POUR_PITCH)),
-            ],
-        }
-    }
-
-    /// The command for control step `step` (0-based: the pose to reach at its end).
-    pub fn command(&self, step: u32) -> BucketPose {
-        super::excavate::interpolate_waypoints(&self.waypoints, step)
-    }
-}
-
-/// Scripted solution of `Fill-v0` ([`PourPlan`] through [`TcpOracle`]).
-pub struct FillPolicy {
-    oracle: TcpOracle,
-    plan: Option<PourPlan>,
-}
-
-impl FillPolicy {
-    /// A policy driving through `oracle`.
-    pub fn new(oracle: TcpOracle) -> Self {
-        Self { oracle, plan: None }
-    }
-}
-
-impl ScriptedPolicy for FillPolicy {
-    fn reset(&mut self, env: &Env) {
-        let task = env.task_any().and_then(|t| t.downcast_ref::<Fill>());
-        self.plan = match (task, env.task_scene()) {
-            (Some(task), Some(scene)) => {
-                let mut start = task.arm().bucket_command_pose(&scene.world);
-                start.pitch = 0.0;
-                Some(PourPlan::new(start, task.pour_point()))
-            }
-            _ => None,
-        };
-    }
-
-    fn act(&mut self, env: &Env) -> Vec<f32> {
-        let Some(plan) = &self.plan else {
-            return vec![0.0; env.action_space().size()];
-        };
-        let target = tcp_for_bucket(&plan.command(env.elapsed_steps()));
-        self.oracle.action(env, &target, GRIPPER_OPEN)
+    fn soft_mut(&mut self) -> Option<&mut dyn SoftComponent> {
+        Some(&mut self.arm)
     }
 }

@@ -1,7 +1,8 @@
-//! Soft-body task scenes: an ms2-physics world coupled two-way to an ms2-mpm clay solver.
+//! Soft-body scenes: a rigid world (any [`RigidWorld`]) coupled two-way to an ms2-mpm clay
+//! solver.
 //!
 //! [`SoftWorld`] owns the MPM solver, the coupling and the list of coupled rigid bodies, and
-//! steps them together with the rigid [`World`]: per rigid step (500 Hz) the world steps, then
+//! steps them together with the rigid world: per rigid step (500 Hz) the world steps, then
 //! [`SoftWorld::substeps_per_rigid_step`] soft substeps run with the coupling forces, and the
 //! reaction wrenches are handed to the world for its next step.
 //!
@@ -14,25 +15,19 @@
 //! (CFL < 1); tools move below 0.5 m/s (0.05 cell per substep). The coupling's contact
 //! constants are those of a 1 ms substep at every faster rate ([`COUPLING_REFERENCE_SUBSTEP`]).
 //!
-//! [`excavate`] is the Excavate scene with a scripted kinematic bucket (bed, goal, success
-//! rules and the scripted scoop); [`excavate_env`] is `Excavate-v0`, the same task with the
-//! bucket on the Panda's hand, on the shared robot-task runtime.
-
-pub mod bucket_arm;
-pub mod excavate;
-pub mod excavate_env;
-pub mod fill;
+//! The soft-body tasks built on it live in their family folder (`families/soft`).
 
 use glam::Vec3;
 use ms2_mpm::{
     Boundary, Coupling, CouplingParams, GridSpec, Material, MaterialId, MpmError, MpmSolver,
     MpmState, SolverConfig,
 };
-use ms2_physics::{BodyId, World};
+use ms2_physics::BodyId;
 
 use crate::adapters::mpm_rigid::{
     CoupledBodies, MpmAdapterError, MpmRigidWorld, MpmRigidWorldView,
 };
+use crate::rigid_world::RigidWorld;
 
 /// Substep (s) whose [`CouplingParams::for_substep`] contact constants every soft scene uses
 /// when its own substep is this short or shorter: the penalty stiffness and damping are then
@@ -44,7 +39,7 @@ use crate::adapters::mpm_rigid::{
 pub const COUPLING_REFERENCE_SUBSTEP: f32 = 1e-3;
 
 /// Why a soft scene failed.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum SoftSceneError {
     /// The MPM solver or the coupling refused an input.
     #[error("soft solver: {0}")]
@@ -54,7 +49,10 @@ pub enum SoftSceneError {
     Adapter(#[from] MpmAdapterError),
     /// The rigid world refused an input.
     #[error("rigid world: {0}")]
-    Physics(String),
+    Physics(#[from] ms2_physics::PhysicsError),
+    /// An input is out of its domain (the message names it).
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
 }
 
 /// Resolution, rates and material of a soft scene (see the [module docs](self)).
@@ -90,7 +88,7 @@ impl Default for SoftConfig {
     }
 }
 
-/// An MPM solver coupled to bodies of a rigid [`World`] (see the [module docs](self)).
+/// An MPM solver coupled to bodies of a [`RigidWorld`] (see the [module docs](self)).
 pub struct SoftWorld {
     solver: MpmSolver,
     coupling: Coupling,
@@ -113,7 +111,7 @@ impl SoftWorld {
     /// must divide the world's time step into a whole number of substeps.
     pub fn new(
         solver: MpmSolver,
-        world: &World,
+        world: &dyn RigidWorld,
         bodies: Vec<BodyId>,
     ) -> Result<Self, SoftSceneError> {
         let dt = solver.config().substep_dt;
@@ -151,14 +149,14 @@ impl SoftWorld {
     }
 
     /// One rigid step of `world` followed by the coupled soft substeps.
-    pub fn step(&mut self, world: &mut World) -> Result<(), SoftSceneError> {
+    pub fn step(&mut self, world: &mut dyn RigidWorld) -> Result<(), SoftSceneError> {
         world.step();
         self.after_rigid_step(world)
     }
 
     /// The coupled soft substeps that follow a rigid step of `world` (which the caller took):
     /// sync the bodies, run the substeps, hand the reaction wrenches to the world.
-    pub fn after_rigid_step(&mut self, world: &mut World) -> Result<(), SoftSceneError> {
+    pub fn after_rigid_step(&mut self, world: &mut dyn RigidWorld) -> Result<(), SoftSceneError> {
         self.coupling.advance(
             &mut self.solver,
             &mut MpmRigidWorld::new(world, &self.bodies),

@@ -9,18 +9,19 @@
 
 use glam::{Mat3, Vec2, Vec3};
 use ms2_mpm::{MpmSolver, MpmState};
-use ms2_physics::{ArticulationId, BodyId, World};
+use ms2_physics::{ArticulationId, BodyId};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
-use super::excavate::BucketPose;
-use super::{SoftConfig, SoftSceneError, SoftWorld};
+use super::excavate_scene::BucketPose;
 use crate::adapters::mpm_rigid::pose_to_glam;
-use crate::adapters::ParticleVisual;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
-use crate::geometry::Pose3;
+use crate::geometry::{vectorize_pose, Pose3};
 use crate::obs::{Array, ArrayData, DictBuilder, ObsValue};
-use crate::task::TaskScene;
+use crate::particles::ParticleVisual;
+use crate::rigid_world::RigidWorld;
+use crate::soft::{SoftConfig, SoftWorld};
+use crate::task::{SoftComponent, TaskScene};
 
 /// MPM substep frequency (Hz) of the soft-body tasks unless `EnvConfig::mpm_freq` says
 /// otherwise: 1 kHz, two substeps per 500 Hz physics step (ManiSkill2 uses 2 kHz).
@@ -39,11 +40,6 @@ pub const CLAY_COLOR: [f32; 3] = [0.45, 0.2, 0.08];
 
 /// Name of the clay's segmentation object (channel-1 id) in visual observations.
 pub const CLAY_SEGMENTATION_NAME: &str = "clay";
-
-/// A soft-scene error as an env error.
-pub fn soft_err(e: SoftSceneError) -> EnvError {
-    EnvError::Physics(format!("soft body: {e}"))
-}
 
 /// Pose of the bucket frame in the hand frame (`ms2_assets::PANDA_BUCKET_IN_HAND`).
 pub fn hand_from_bucket() -> Isometry3<f32> {
@@ -65,6 +61,7 @@ pub struct BucketArm {
     soft: Option<SoftWorld>,
     hand: Option<(ArticulationId, usize, BodyId)>,
     mpm_freq_hz: f64,
+    particle_spacing_m: f32,
 }
 
 impl Default for BucketArm {
@@ -74,25 +71,22 @@ impl Default for BucketArm {
             soft: None,
             hand: None,
             mpm_freq_hz: DEFAULT_MPM_FREQ_HZ,
+            particle_spacing_m: SoftConfig::default().particle_spacing,
         }
     }
 }
 
 impl BucketArm {
-    /// An arm whose clay takes `cfg.mpm_freq` substeps per second (default
-    /// [`DEFAULT_MPM_FREQ_HZ`]); an error names a frequency that is not a whole multiple of
-    /// `cfg.sim_freq`.
-    pub fn from_config(cfg: &EnvConfig) -> Result<Self, EnvError> {
+    /// An arm whose clay is sampled with `particle_spacing_m` (m) and takes `cfg.mpm_freq`
+    /// substeps per second (default [`DEFAULT_MPM_FREQ_HZ`]); an error names a frequency that
+    /// is not a whole multiple of `cfg.sim_freq`.
+    pub fn from_config(cfg: &EnvConfig, particle_spacing_m: f32) -> Result<Self, EnvError> {
         cfg.mpm_substep_dt(DEFAULT_MPM_FREQ_HZ)?;
         Ok(Self {
             mpm_freq_hz: cfg.mpm_freq.unwrap_or(DEFAULT_MPM_FREQ_HZ),
+            particle_spacing_m,
             ..Self::default()
         })
-    }
-
-    /// MPM substep frequency of the clay (Hz).
-    pub fn mpm_freq(&self) -> f64 {
-        self.mpm_freq_hz
     }
 
     /// `base` with this arm's MPM substep length.
@@ -111,13 +105,9 @@ impl BucketArm {
 
     /// Finds the hand of `scene`'s robot; returns its rigid body.
     pub fn locate_hand(&mut self, scene: &TaskScene) -> Result<BodyId, EnvError> {
-        let (world, art) = (&scene.world, scene.agent.articulation);
-        let link = world
-            .link_index(art, "panda_hand")
-            .map_err(|e| EnvError::Physics(e.to_string()))?;
-        let body = world
-            .link_body(art, link)
-            .map_err(|e| EnvError::Physics(e.to_string()))?;
+        let (world, art) = (scene.world.as_ref(), scene.agent.articulation());
+        let link = world.link_index(art, "panda_hand")?;
+        let body = world.link_body(art, link)?;
         self.hand = Some((art, link, body));
         Ok(body)
     }
@@ -126,17 +116,17 @@ impl BucketArm {
     pub fn couple(
         &mut self,
         solver: MpmSolver,
-        world: &World,
+        world: &dyn RigidWorld,
         others: &[BodyId],
     ) -> Result<(), EnvError> {
         let Some((_, _, hand)) = self.hand else {
-            return Err(EnvError::Physics(
+            return Err(EnvError::InvalidConfig(
                 "soft body: the robot's hand was not located".to_owned(),
             ));
         };
         let mut bodies = vec![hand];
         bodies.extend_from_slice(others);
-        self.soft = Some(SoftWorld::new(solver, world, bodies).map_err(soft_err)?);
+        self.soft = Some(SoftWorld::new(solver, world, bodies)?);
         Ok(())
     }
 
@@ -146,7 +136,7 @@ impl BucketArm {
     }
 
     /// World pose of the bucket frame (identity before the hand is located).
-    pub fn bucket_pose(&self, world: &World) -> Pose3 {
+    pub fn bucket_pose(&self, world: &dyn RigidWorld) -> Pose3 {
         let Some((art, link, _)) = self.hand else {
             return Pose3::identity();
         };
@@ -157,52 +147,13 @@ impl BucketArm {
     }
 
     /// The bucket's plate centre (m) and pitch (rad; positive raises the opening).
-    pub fn bucket_command_pose(&self, world: &World) -> BucketPose {
+    pub fn bucket_command_pose(&self, world: &dyn RigidWorld) -> BucketPose {
         let (p, q) = pose_to_glam(&self.bucket_pose(world));
         let x = q * Vec3::X;
         BucketPose {
             position: p,
             pitch: x.z.atan2(Vec2::new(x.x, x.y).length()),
         }
-    }
-
-    /// The soft substeps that follow a physics step.
-    pub fn after_physics_step(&mut self, world: &mut World) -> Result<(), EnvError> {
-        match &mut self.soft {
-            Some(soft) => soft.after_rigid_step(world).map_err(soft_err),
-            None => Ok(()),
-        }
-    }
-
-    /// `{"x": [N, 3]}` particle positions (m, world).
-    pub fn particles_obs(&self) -> Option<ObsValue> {
-        let x = self.soft.as_ref()?.solver().positions();
-        let mut particles = DictBuilder::new();
-        particles.push(
-            "x",
-            ObsValue::Array(Array {
-                shape: vec![x.len(), 3],
-                data: ArrayData::F32(x.iter().flat_map(|p| p.to_array()).collect()),
-            }),
-        );
-        Some(particles.build())
-    }
-
-    /// The clay as the cameras draw it: spheres of [`CLAY_RENDER_RADIUS_PER_SPACING`] ×
-    /// `particle_spacing_m` in [`CLAY_COLOR`], segmented as [`CLAY_SEGMENTATION_NAME`];
-    /// particles enclosed by neighbours on all sides are not drawn.
-    pub fn clay_visual(particle_spacing_m: f32) -> ParticleVisual {
-        ParticleVisual {
-            name: CLAY_SEGMENTATION_NAME.to_owned(),
-            radius_m: CLAY_RENDER_RADIUS_PER_SPACING * particle_spacing_m,
-            rgb: CLAY_COLOR,
-            packing_spacing_m: Some(particle_spacing_m),
-        }
-    }
-
-    /// Particle positions (m, world); empty before the first episode.
-    pub fn particle_positions(&self) -> &[Vec3] {
-        self.soft.as_ref().map_or(&[], |s| s.solver().positions())
     }
 
     /// Number of particles (0 before the first episode).
@@ -224,6 +175,26 @@ impl BucketArm {
         }
     }
 
+    /// The `extra` entries every bucket task observes: `tcp_pose` (7) and `bucket_pose` (7).
+    pub fn push_pose_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
+        let world = scene.world.as_ref();
+        extra.push_vector("tcp_pose", &vectorize_pose(&scene.agent.tcp_pose(world)));
+        extra.push_vector("bucket_pose", &vectorize_pose(&self.bucket_pose(world)));
+    }
+
+    /// The task state `header` followed by the particle state.
+    pub fn task_state(&self, header: &[f32]) -> Vec<f32> {
+        let mut out = Vec::with_capacity(self.task_state_len(header.len()));
+        out.extend_from_slice(header);
+        self.push_particle_state(&mut out);
+        out
+    }
+
+    /// Length of [`BucketArm::task_state`] with a header of `header_len` floats.
+    pub fn task_state_len(&self, header_len: usize) -> usize {
+        header_len + FLOATS_PER_PARTICLE * self.particle_count()
+    }
+
     /// Restores a particle state from [`Self::push_particle_state`] (same particle count;
     /// the runtime checked the length and finiteness). A position outside the soft domain is
     /// refused by the solver, which then keeps its state.
@@ -237,5 +208,49 @@ impl BucketArm {
             full.affine_velocities[i] = Mat3::from_cols_slice(&c[15..24]);
         }
         let _ = soft.set_state(&full);
+    }
+}
+
+/// The clay coupled to the arm is the bucket tasks' one soft component.
+impl SoftComponent for BucketArm {
+    fn mpm_freq(&self) -> f64 {
+        self.mpm_freq_hz
+    }
+
+    fn after_physics_step(&mut self, world: &mut dyn RigidWorld) -> Result<(), EnvError> {
+        match &mut self.soft {
+            Some(soft) => Ok(soft.after_rigid_step(world)?),
+            None => Ok(()),
+        }
+    }
+
+    fn particles_obs(&self) -> Option<ObsValue> {
+        let x = self.soft.as_ref()?.solver().positions();
+        let mut particles = DictBuilder::new();
+        particles.push(
+            "x",
+            ObsValue::Array(Array {
+                shape: vec![x.len(), 3],
+                data: ArrayData::F32(x.iter().flat_map(|p| p.to_array()).collect()),
+            }),
+        );
+        Some(particles.build())
+    }
+
+    /// The clay as the cameras draw it: spheres of [`CLAY_RENDER_RADIUS_PER_SPACING`] ×
+    /// the particle spacing in [`CLAY_COLOR`], segmented as [`CLAY_SEGMENTATION_NAME`];
+    /// particles enclosed by neighbours on all sides are not drawn.
+    fn particle_visuals(&self) -> Vec<ParticleVisual> {
+        let particle_spacing_m = self.particle_spacing_m;
+        vec![ParticleVisual {
+            name: CLAY_SEGMENTATION_NAME.to_owned(),
+            radius_m: CLAY_RENDER_RADIUS_PER_SPACING * particle_spacing_m,
+            rgb: CLAY_COLOR,
+            packing_spacing_m: Some(particle_spacing_m),
+        }]
+    }
+
+    fn particle_positions(&self, _set: usize) -> &[Vec3] {
+        self.soft.as_ref().map_or(&[], |s| s.solver().positions())
     }
 }

@@ -22,13 +22,16 @@
 use glam::{Vec2, Vec3};
 use ms2_mpm::sampling::{self, HeightMap};
 use ms2_mpm::{MpmSolver, MpmState, WallKind};
-use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig};
+#[cfg(feature = "rapier")]
+use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeSpec, World, WorldConfig};
+use ms2_physics::{Pose3, ShapeDesc};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::{SoftConfig, SoftSceneError, SoftWorld};
 use crate::adapters::mpm_rigid::pose_to_glam;
+use crate::rigid_world::RigidWorld;
+use crate::soft::{SoftConfig, SoftSceneError, SoftWorld};
 
 /// Control frequency (Hz), as ManiSkill2.
 pub const CONTROL_FREQ_HZ: u32 = 20;
@@ -315,7 +318,8 @@ pub struct ExcavateState {
     pub bed: ExcavateBed,
 }
 
-/// The Excavate scene (see the [module docs](self)).
+/// The Excavate scene (see the [module docs](self)), on the rapier engine.
+#[cfg(feature = "rapier")]
 pub struct ExcavateScene {
     world: World,
     soft: SoftWorld,
@@ -325,6 +329,7 @@ pub struct ExcavateScene {
     rigid_steps_per_control: usize,
 }
 
+#[cfg(feature = "rapier")]
 impl std::fmt::Debug for ExcavateScene {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("ExcavateScene")
@@ -334,6 +339,7 @@ impl std::fmt::Debug for ExcavateScene {
     }
 }
 
+#[cfg(feature = "rapier")]
 impl ExcavateScene {
     /// Builds an episode from `seed`: the bed's height map (5 × 5 samples, ±6 mm about a
     /// 3.5 cm thick bed), the bucket's start y (±1 cm) and the target amount.
@@ -352,8 +358,7 @@ impl ExcavateScene {
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5eed_b0c7);
         let start_y = 0.16 + rng.random_range(-0.01..0.01);
 
-        let mut world = World::new(WorldConfig::default())
-            .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
+        let mut world = World::new(WorldConfig::default())?;
         let command = BucketPose {
             position: Vec3::new(
                 bed.footprint[0].x - BUCKET_INNER_HALF[0] - 0.01,
@@ -362,13 +367,11 @@ impl ExcavateScene {
             ),
             pitch: 0.0,
         };
-        let bucket = world
-            .add_actor(
-                ActorDesc::new("bucket", ActorKind::Kinematic)
-                    .with_pose(command.to_pose())
-                    .with_shape(ShapeSpec::new(bucket_shape())),
-            )
-            .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
+        let bucket = world.add_actor(
+            ActorDesc::new("bucket", ActorKind::Kinematic)
+                .with_pose(command.to_pose())
+                .with_shape(ShapeSpec::new(bucket_shape())),
+        )?;
         let soft = SoftWorld::new(solver, &world, vec![bucket])?;
         let rigid_steps_per_control =
             (1.0 / (CONTROL_FREQ_HZ as f32 * world.timestep())).round() as usize;
@@ -386,7 +389,7 @@ impl ExcavateScene {
     /// control period, stepping the coupled rigid and soft simulation.
     pub fn step(&mut self, target: BucketPose) -> Result<(), SoftSceneError> {
         if !(target.position.is_finite() && target.pitch.is_finite()) {
-            return Err(SoftSceneError::Physics(format!(
+            return Err(SoftSceneError::InvalidInput(format!(
                 "bucket target {target:?} is not finite"
             )));
         }
@@ -394,9 +397,7 @@ impl ExcavateScene {
         let n = self.rigid_steps_per_control;
         for k in 1..=n {
             let pose = start.lerp(&target, k as f32 / n as f32).to_pose();
-            self.world
-                .set_kinematic_target(self.bucket, &pose)
-                .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
+            self.world.set_kinematic_target(self.bucket, &pose)?;
             self.soft.step(&mut self.world)?;
         }
         self.command = target;
@@ -429,7 +430,7 @@ impl ExcavateScene {
     }
 
     /// The rigid world.
-    pub fn world(&self) -> &World {
+    pub fn world(&self) -> &dyn RigidWorld {
         &self.world
     }
 
@@ -474,9 +475,7 @@ impl ExcavateScene {
 
     /// Restores a state from [`ExcavateScene::get_state`] of a scene built the same way.
     pub fn set_state(&mut self, state: &ExcavateState) -> Result<(), SoftSceneError> {
-        self.world
-            .set_state(&state.world)
-            .map_err(|e| SoftSceneError::Physics(e.to_string()))?;
+        self.world.set_state(&state.world)?;
         self.soft.set_state(&state.soft)?;
         self.command = state.bucket_command;
         self.bed = state.bed.clone();

@@ -14,9 +14,64 @@ use ms2_plan::{
 };
 use nalgebra::{Isometry3, Translation3, Vector3};
 
-use super::driver::{Gripper, JointTargetDriver};
-use super::scene::SensedState;
-use super::{SolveError, SolveTimings};
+use super::common::CUBE_HALF_SIZE;
+use super::lift_cube::GOAL_HEIGHT;
+use crate::demos::solutions::driver::{Gripper, JointTargetDriver};
+use crate::demos::solutions::scene::{self, SensedState};
+use crate::demos::solutions::{Solution, SolveError, SolveTimings};
+
+/// Height (m) LiftCube's cube is carried to above its success height (cube centre at
+/// `GOAL_HEIGHT + half size`), so that it stays above it while the robot settles.
+const LIFT_MARGIN: f64 = 0.03;
+/// Height (m) of the moved cube's bottom above the other cube's top when StackCube releases it.
+const STACK_GAP: f64 = 0.002;
+
+/// How far (m) PickCube's cube may be carried short of the goal when the upright hand cannot
+/// reach it (success needs 0.025 m; an upright hand keeps the episode convertible to
+/// `pd_ee_delta_pos`, whose hand orientation is fixed).
+const PICK_GOAL_TOLERANCE: f64 = 0.02;
+
+/// The solution of `PickCube-v0`.
+pub const PICK_CUBE: CubeTaskSolution = CubeTaskSolution {
+    env_id: "PickCube-v0",
+    cube: "obj",
+    obstacles: &[],
+    goal_world: |s| {
+        let g = scene::privileged_vector(&s.obs, "extra/goal_pos", 3)?;
+        Ok(Vector3::new(g[0], g[1], g[2]).cast())
+    },
+    goal_tolerance: PICK_GOAL_TOLERANCE,
+    finish: Finish::HoldStill,
+};
+
+/// The solution of `LiftCube-v0`.
+pub const LIFT_CUBE: CubeTaskSolution = CubeTaskSolution {
+    env_id: "LiftCube-v0",
+    cube: "obj",
+    obstacles: &[],
+    goal_world: |s| {
+        let cube = s.pose_world_from_base * s.cube("obj")?.pose_base_from_cube;
+        let mut goal = cube.translation.vector;
+        goal.z = f64::from(GOAL_HEIGHT + CUBE_HALF_SIZE) + LIFT_MARGIN;
+        Ok(goal)
+    },
+    goal_tolerance: 0.0,
+    finish: Finish::HoldStill,
+};
+
+/// The solution of `StackCube-v0`.
+pub const STACK_CUBE: CubeTaskSolution = CubeTaskSolution {
+    env_id: "StackCube-v0",
+    cube: "cubeA",
+    obstacles: &["cubeB"],
+    goal_world: |s| {
+        let b = s.cube("cubeB")?;
+        let on_top = s.pose_world_from_base * b.pose_base_from_cube;
+        Ok(on_top.translation.vector + Vector3::new(0.0, 0.0, 2.0 * b.half_size + STACK_GAP))
+    },
+    goal_tolerance: 0.0,
+    finish: Finish::PlaceAndRelease,
+};
 
 /// How a solution ends once the cube is at its goal.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -151,13 +206,8 @@ impl Carrying {
     }
 }
 
-impl CubeTaskSolution {
-    /// Runs the solution on `driver`'s freshly reset env. `seed` seeds the planners.
-    ///
-    /// # Errors
-    /// [`SolveError::OutOfSteps`] when the episode limit ends the motion, planning and env
-    /// errors otherwise.
-    pub fn run(
+impl Solution for CubeTaskSolution {
+    fn run(
         &self,
         driver: &mut JointTargetDriver<'_>,
         panda: &KinematicRobot,
@@ -193,7 +243,9 @@ impl CubeTaskSolution {
             }
         }
     }
+}
 
+impl CubeTaskSolution {
     /// Grasp: the top-down grasp at the cube's yaw symmetry closest to the hand's yaw (tilted
     /// if the upright one is out of reach); screw motion to the pre-grasp pose (RRT-Connect if
     /// that fails), screw down (the fingers may touch the cube), settle, close.

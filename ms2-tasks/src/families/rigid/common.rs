@@ -2,17 +2,16 @@
 //! and the shared base of PickCube and LiftCube ([`CubeGoalTask`]): one cube on the ground and a
 //! goal, with the task-specific parts as [`CubeGoal`] hooks.
 
-use std::any::Any;
-
-use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, VisualShape, World};
+use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, VisualShape};
 use nalgebra::Vector3;
 use rand::Rng;
 
-use crate::agent::{physics_err, ROBOT_STATIC_QVEL};
+use crate::agents::ROBOT_STATIC_QVEL;
 use crate::error::EnvError;
 use crate::geometry::{pose_xyz_yaw, Pose3};
 use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
+use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
 use crate::task::{Task, TaskScene};
 
@@ -26,7 +25,7 @@ pub const ACTOR_STATIC_ANG_SPEED: f32 = 1e-2;
 
 /// Adds a dynamic cube of half size `half` (m), density 1000 kg/m³, friction 1, colour `rgba`.
 pub fn add_cube(
-    world: &mut World,
+    world: &mut dyn RigidWorld,
     name: &str,
     half: f32,
     rgba: [f32; 4],
@@ -45,15 +44,19 @@ pub fn add_cube(
                     rgba,
                 }),
         )
-        .map_err(physics_err)
+        .map_err(EnvError::from)
 }
 
 /// Places `body` at `pose`, at rest.
-pub fn place_at_rest(world: &mut World, body: BodyId, pose: &Pose3) -> Result<(), EnvError> {
-    world.set_body_pose(body, pose).map_err(physics_err)?;
+pub fn place_at_rest(
+    world: &mut dyn RigidWorld,
+    body: BodyId,
+    pose: &Pose3,
+) -> Result<(), EnvError> {
+    world.set_body_pose(body, pose)?;
     world
         .set_body_velocity(body, &Vector3::zeros(), &Vector3::zeros())
-        .map_err(physics_err)
+        .map_err(EnvError::from)
 }
 
 /// A cube resting on the ground at `xy` (m) with a yaw uniform in [0, 2π) drawn from `rng`.
@@ -71,7 +74,7 @@ pub fn uniform_xy(rng: &mut EpisodeRng, low: [f32; 2], high: [f32; 2]) -> [f32; 
 }
 
 /// ManiSkill2's `check_actor_static`: linear speed ≤ 1e-3 m/s and angular speed ≤ 1e-2 rad/s.
-pub fn is_actor_static(world: &World, body: BodyId) -> bool {
+pub fn is_actor_static(world: &dyn RigidWorld, body: BodyId) -> bool {
     let lin = world
         .body_linear_velocity(body)
         .map(|v| v.norm())
@@ -84,7 +87,7 @@ pub fn is_actor_static(world: &World, body: BodyId) -> bool {
 }
 
 /// Pose of `body` (identity if the id is stale, which the runtime prevents).
-pub fn body_pose(world: &World, body: BodyId) -> Pose3 {
+pub fn body_pose(world: &dyn RigidWorld, body: BodyId) -> Pose3 {
     world.body_pose(body).unwrap_or_else(|_| Pose3::identity())
 }
 
@@ -105,7 +108,7 @@ pub struct CubeOnGround {
 
 impl CubeOnGround {
     /// Adds the cube.
-    pub fn build(&mut self, world: &mut World) -> Result<(), EnvError> {
+    pub fn build(&mut self, world: &mut dyn RigidWorld) -> Result<(), EnvError> {
         self.cube = Some(add_cube(
             world,
             "cube",
@@ -116,7 +119,11 @@ impl CubeOnGround {
     }
 
     /// Places the cube: xy uniform in [-0.1, 0.1]², yaw uniform.
-    pub fn initialize(&self, world: &mut World, rng: &mut EpisodeRng) -> Result<(), EnvError> {
+    pub fn initialize(
+        &self,
+        world: &mut dyn RigidWorld,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
         let xy = uniform_xy(rng, [-0.1, -0.1], [0.1, 0.1]);
         let pose = cube_pose_on_ground(xy, CUBE_HALF_SIZE, rng);
         place_at_rest(world, self.body(), &pose)
@@ -128,7 +135,7 @@ impl CubeOnGround {
     }
 
     /// Cube centre (m, world).
-    pub fn position(&self, world: &World) -> Vector3<f32> {
+    pub fn position(&self, world: &dyn RigidWorld) -> Vector3<f32> {
         body_pose(world, self.body()).translation.vector
     }
 }
@@ -136,7 +143,9 @@ impl CubeOnGround {
 /// Evaluation of a single-cube goal task: `is_obj_placed`, `is_robot_static`, success when both
 /// hold.
 fn placed_and_static(scene: &TaskScene, is_obj_placed: bool) -> Evaluation {
-    let is_robot_static = scene.agent.is_static(&scene.world, ROBOT_STATIC_QVEL);
+    let is_robot_static = scene
+        .agent
+        .is_static(scene.world.as_ref(), ROBOT_STATIC_QVEL);
     Evaluation {
         success: is_obj_placed && is_robot_static,
         terms: vec![
@@ -189,7 +198,11 @@ impl<G: CubeGoal> Task for CubeGoalTask<G> {
         G::MAX_DENSE_REWARD
     }
 
-    fn build_scene(&mut self, world: &mut World, _rng: &mut EpisodeRng) -> Result<(), EnvError> {
+    fn build_scene(
+        &mut self,
+        world: &mut dyn RigidWorld,
+        _rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
         self.scene.build(world)
     }
 
@@ -198,21 +211,22 @@ impl<G: CubeGoal> Task for CubeGoalTask<G> {
         scene: &mut TaskScene,
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
-        self.scene.initialize(&mut scene.world, rng)
+        self.scene.initialize(scene.world.as_mut(), rng)
     }
 
-    fn initialize_task(&mut self, scene: &TaskScene, rng: &mut EpisodeRng) {
-        self.goal_pos = G::sample_goal(self.scene.position(&scene.world), rng);
+    fn initialize_task(&mut self, scene: &TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
+        self.goal_pos = G::sample_goal(self.scene.position(scene.world.as_ref()), rng);
+        Ok(())
     }
 
     fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
-        let tcp = scene.agent.tcp_pose(&scene.world);
-        let cube = body_pose(&scene.world, self.scene.body());
+        let tcp = scene.agent.tcp_pose(scene.world.as_ref());
+        let cube = body_pose(scene.world.as_ref(), self.scene.body());
         G::extra_obs(&tcp, &cube, self.goal_pos, extra);
     }
 
     fn evaluate(&self, scene: &TaskScene) -> Evaluation {
-        let cube = self.scene.position(&scene.world);
+        let cube = self.scene.position(scene.world.as_ref());
         placed_and_static(scene, G::is_placed(cube, self.goal_pos))
     }
 
@@ -220,7 +234,7 @@ impl<G: CubeGoal> Task for CubeGoalTask<G> {
         if eval.success {
             return G::MAX_DENSE_REWARD;
         }
-        let world = &scene.world;
+        let world = scene.world.as_ref();
         let cube = self.scene.position(world);
         let tcp = scene.agent.tcp_pose(world).translation.vector;
         let mut reward = closeness((cube - tcp).norm(), 5.0);
@@ -243,9 +257,5 @@ impl<G: CubeGoal> Task for CubeGoalTask<G> {
 
     fn task_state_len(&self) -> usize {
         3
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
     }
 }

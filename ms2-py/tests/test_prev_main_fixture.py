@@ -1,0 +1,75 @@
+"""Trajectories written by the previous main (before the task-runtime reorganisation) replay bit
+for bit on this build: from their seeds, and (rigid tasks) from their recorded env states.
+
+The fixture and how it was made: ``fixtures/prev_main/README.md``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import pathlib
+
+import h5py
+import ms2
+import numpy as np
+import pytest
+
+FIXTURE = pathlib.Path(__file__).parent / "fixtures" / "prev_main"
+EXPECTED = np.load(FIXTURE / "expected_states.npz")
+EPISODES = [
+    (js.stem, ep["episode_id"])
+    for js in sorted(FIXTURE.glob("*.json"))
+    for ep in json.loads(js.read_text())["episodes"]
+]
+
+
+def _load(env_id: str, episode_id: int):
+    meta = json.loads((FIXTURE / f"{env_id}.json").read_text())
+    episode = next(e for e in meta["episodes"] if e["episode_id"] == episode_id)
+    with h5py.File(FIXTURE / f"{env_id}.h5") as f:
+        group = f[f"traj_{episode_id}"]
+        actions = group["actions"][:]
+        env_states = group["env_states"][:] if "env_states" in group else None
+    return meta["env_info"]["env_kwargs"], episode, actions, env_states
+
+
+def _digest(state: np.ndarray) -> np.ndarray:
+    raw = np.ascontiguousarray(state, dtype=np.float32).tobytes()
+    return np.frombuffer(hashlib.sha256(raw).digest(), dtype=np.uint8)
+
+
+@pytest.mark.parametrize(("env_id", "episode_id"), EPISODES)
+def test_replay_from_seed_is_bit_identical(env_id, episode_id):
+    kwargs, episode, actions, _ = _load(env_id, episode_id)
+    digests = EXPECTED[f"{env_id}/traj_{episode_id}/sha256"]
+    assert len(digests) == len(actions) + 1
+    env = ms2.Ms2Env(env_id, **kwargs)
+    env.reset(seed=episode["episode_seed"])
+    states = [env.unwrapped.get_state()]
+    for action in actions:
+        *_, info = env.step(action)
+        states.append(env.unwrapped.get_state())
+    env.close()
+    for t, (state, expected) in enumerate(zip(states, digests, strict=True)):
+        assert np.array_equal(_digest(state), expected), f"{env_id} diverges at state {t}"
+    final_key = f"{env_id}/traj_{episode_id}/final_state"
+    if final_key in EXPECTED.files:
+        np.testing.assert_array_equal(states[-1], EXPECTED[final_key])
+    assert info["success"] == episode["info"]["success"]
+
+
+@pytest.mark.parametrize(
+    ("env_id", "episode_id"), [e for e in EPISODES if _load(*e)[3] is not None]
+)
+def test_replay_with_env_states_is_bit_identical(env_id, episode_id):
+    kwargs, _, actions, env_states = _load(env_id, episode_id)
+    env = ms2.Ms2Env(env_id, **kwargs)
+    env.reset(seed=0)
+    for t, action in enumerate(actions):
+        env.unwrapped.set_state(env_states[t])
+        env.step(action)
+        np.testing.assert_array_equal(
+            env.unwrapped.get_state(), env_states[t + 1], err_msg=f"{env_id} step {t}"
+        )
+    env.close()

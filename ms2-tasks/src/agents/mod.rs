@@ -1,0 +1,122 @@
+//! Agents: robots with their controllers, behind one [`Agent`] trait, and the robot registry
+//! keyed by ManiSkill2's robot uids.
+//!
+//! A task names the robots it supports in its [`crate::spec::TaskSpec::robots`] (the uid a user
+//! passes as `robot=`, and the registered agent that uid builds for that task: ManiSkill2's
+//! `Excavate-v0` takes `robot="panda"` and builds the Panda carrying a bucket). The runtime
+//! builds the agent through the registry ([`robot_spec`]), into any [`RigidWorld`].
+//!
+//! | agent | what | control modes |
+//! |---|---|---|
+//! | `panda` | Franka Panda, two-finger gripper, ManiSkill2's base pose | every mode of [`ms2_control::RobotConfig::panda`] |
+//! | `panda_bucket` | the Panda with a bucket fixed to its hand (soft-body tasks) | the same |
+//!
+//! A new robot is one module here implementing [`Agent`] plus one [`RobotSpec`] in
+//! [`ROBOTS`]; see docs/architecture.md, "How to add a robot".
+
+pub mod panda;
+
+use std::any::Any;
+use std::fmt::Debug;
+
+use ms2_control::{CombinedController, ControlMode, ControlTiming};
+use ms2_physics::{ArticulationId, BodyId};
+
+use crate::error::EnvError;
+use crate::geometry::Pose3;
+use crate::rigid_world::RigidWorld;
+use crate::seeding::EpisodeRng;
+
+pub use panda::{PandaAgent, ARM_DOF, ARM_QPOS_NOISE_STD, GRASP_MIN_IMPULSE, ROBOT_STATIC_QVEL};
+
+/// A robot in a rigid world with the controller of one control mode.
+///
+/// Positions in metres, angles in radians, poses in the world frame.
+pub trait Agent: Any + Send + Debug {
+    /// The registered agent name, e.g. `"panda"` ([`RobotSpec::name`]).
+    fn name(&self) -> &'static str;
+    /// The robot's articulation in the world.
+    fn articulation(&self) -> ArticulationId;
+    /// The active control mode.
+    fn control_mode(&self) -> ControlMode;
+    /// The controller of the active control mode.
+    fn controller(&self) -> &CombinedController;
+    /// The controller, mutably (state restore).
+    fn controller_mut(&mut self) -> &mut CombinedController;
+    /// Pose of the robot base in the world.
+    fn base_pose(&self) -> Pose3;
+    /// Puts the robot at its episode-start configuration (drawn from `rng`), at rest, with
+    /// drive targets there, and resets the controller.
+    fn initialize(
+        &mut self,
+        world: &mut dyn RigidWorld,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError>;
+    /// Teleports the robot to `qpos` (dof order) at rest, drive targets at `qpos`; resets the
+    /// controller.
+    fn set_joint_state(&mut self, world: &mut dyn RigidWorld, qpos: &[f32])
+        -> Result<(), EnvError>;
+    /// Applies one env action (length and finiteness already checked) to the controller.
+    fn set_action(&mut self, world: &mut dyn RigidWorld, action: &[f32]) -> Result<(), EnvError>;
+    /// Lets the controller update drive targets before one physics substep.
+    fn before_substep(&mut self, world: &mut dyn RigidWorld);
+    /// Joint positions (rad / m) in dof order.
+    fn qpos(&self, world: &dyn RigidWorld) -> Vec<f32>;
+    /// Joint velocities (rad/s / m/s) in dof order.
+    fn qvel(&self, world: &dyn RigidWorld) -> Vec<f32>;
+    /// Pose of the tool centre point in the world.
+    fn tcp_pose(&self, world: &dyn RigidWorld) -> Pose3;
+    /// True when every arm joint speed is at most `max_speed` rad/s.
+    fn is_static(&self, world: &dyn RigidWorld, max_speed: f32) -> bool;
+    /// ManiSkill2's grasp check: the gripper holds `object` with contact impulses within
+    /// `max_angle_deg` degrees of its closing directions. Robots without a gripper: `false`.
+    fn is_grasping(&self, world: &dyn RigidWorld, object: BodyId, max_angle_deg: f32) -> bool;
+    /// Bodies of the gripper's fingers (empty without a gripper).
+    fn finger_bodies(&self) -> Vec<BodyId>;
+}
+
+impl dyn Agent {
+    /// The agent as its concrete type (e.g. [`PandaAgent`]), when it is one.
+    pub fn downcast_ref<A: Agent>(&self) -> Option<&A> {
+        (self as &dyn Any).downcast_ref::<A>()
+    }
+}
+
+/// Builds an agent of one control mode into a world.
+pub type BuildAgent = fn(
+    world: &mut dyn RigidWorld,
+    mode: ControlMode,
+    timing: ControlTiming,
+) -> Result<Box<dyn Agent>, EnvError>;
+
+/// A registered robot: its name, control modes and builder.
+#[derive(Debug, Clone, Copy)]
+pub struct RobotSpec {
+    /// Registered name (ManiSkill2's robot uid where it has one), e.g. `"panda"`.
+    pub name: &'static str,
+    /// What the robot is, in one line.
+    pub description: &'static str,
+    /// The control modes it supports, default first.
+    pub control_modes: fn() -> Vec<ControlMode>,
+    /// Builds it.
+    pub build: BuildAgent,
+}
+
+/// The registered robots.
+pub const ROBOTS: &[RobotSpec] = &[panda::PANDA, panda::PANDA_BUCKET];
+
+/// The registered robot `name`; an error lists the registered ones.
+///
+/// ```
+/// assert_eq!(ms2_tasks::agents::robot_spec("panda").unwrap().name, "panda");
+/// assert!(ms2_tasks::agents::robot_spec("ur5").is_err());
+/// ```
+pub fn robot_spec(name: &str) -> Result<&'static RobotSpec, EnvError> {
+    ROBOTS
+        .iter()
+        .find(|r| r.name == name)
+        .ok_or_else(|| EnvError::UnknownRobot {
+            got: name.to_owned(),
+            valid: ROBOTS.iter().map(|r| r.name.to_owned()).collect(),
+        })
+}

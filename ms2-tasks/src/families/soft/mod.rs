@@ -1,0 +1,73 @@
+//! Soft-body tasks on the MPM solver two-way coupled with the rigid world: `Excavate-v0` and
+//! `Fill-v0`, both with the Panda carrying a bucket (`panda_bucket`, ManiSkill2's
+//! `robot="panda"` with its bucket configuration).
+//!
+//! [`bucket_arm`] is the family's shared base and its one soft component (the clay coupled to
+//! the hand); [`excavate_scene`] the Excavate bed, goal and scoop (and a standalone kinematic
+//! scene); [`excavate`] and [`fill`] the tasks' hooks; [`scripted`] their oracle policies.
+
+pub mod bucket_arm;
+pub mod excavate;
+pub mod excavate_scene;
+pub mod fill;
+pub mod scripted;
+
+use crate::config::ObsMode;
+use crate::registry::{Registrar, TaskRegistration};
+use crate::spec::{RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE};
+
+/// Observation modes of the soft-body tasks (the rigid ones plus `particles`).
+const SOFT_OBS_MODES: &[ObsMode] = &[
+    ObsMode::StateDict,
+    ObsMode::State,
+    ObsMode::Rgbd,
+    ObsMode::PointCloud,
+    ObsMode::RgbdRobotSeg,
+    ObsMode::PointCloudRobotSeg,
+    ObsMode::Particles,
+];
+
+/// The bucket tasks' robot: `robot="panda"` builds the Panda carrying the bucket.
+const PANDA_WITH_BUCKET: &[RobotChoice] = &[RobotChoice {
+    uid: "panda",
+    agent: "panda_bucket",
+}];
+
+/// The spec shared by the bucket tasks.
+const fn bucket_spec(env_id: &'static str, summary: &'static str) -> TaskSpec {
+    TaskSpec {
+        env_id,
+        family: "soft",
+        summary,
+        max_episode_steps: fill::MAX_EPISODE_STEPS,
+        robots: PANDA_WITH_BUCKET,
+        control_modes: &[],
+        default_control_mode: DEFAULT_CONTROL_MODE,
+        obs_modes: SOFT_OBS_MODES,
+        non_privileged_extra_keys: &["tcp_pose"],
+        goal_marker: None,
+        soft_bodies: true,
+        assets: &[],
+    }
+}
+
+/// `Excavate-v0`'s spec.
+pub const EXCAVATE: TaskSpec = bucket_spec(
+    "Excavate-v0",
+    "scoop a target amount of clay with the bucket and lift it",
+);
+
+/// `Fill-v0`'s spec.
+pub const FILL: TaskSpec = bucket_spec("Fill-v0", "pour the clay in the bucket into a beaker");
+
+/// Registers the family.
+pub fn register(r: &mut Registrar) {
+    r.add(
+        TaskRegistration::new(EXCAVATE, |cfg| Ok(Box::new(excavate::Excavate::new(cfg)?)))
+            .scripted(scripted::ExcavatePolicy::boxed),
+    );
+    r.add(
+        TaskRegistration::new(FILL, |cfg| Ok(Box::new(fill::Fill::new(cfg)?)))
+            .scripted(scripted::FillPolicy::boxed),
+    );
+}
