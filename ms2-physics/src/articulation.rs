@@ -28,6 +28,12 @@ use crate::world::{BodyEntry, BodyId, BodyKind, ExcludedPairs, World};
 pub struct ArticulationId(pub(crate) u32);
 
 impl ArticulationId {
+    /// The id of index `index`, for another engine that implements a rigid-world port in
+    /// ms2-physics' vocabulary (its own ids, minted in its own creation order).
+    pub fn from_index(index: usize) -> Self {
+        Self(index as u32)
+    }
+
     /// The id as an index (creation order).
     pub fn index(self) -> usize {
         self.0 as usize

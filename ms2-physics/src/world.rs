@@ -25,6 +25,12 @@ use crate::state::SnapshotCache;
 pub struct BodyId(pub(crate) u32);
 
 impl BodyId {
+    /// The id of index `index`, for another engine that implements a rigid-world port in
+    /// ms2-physics' vocabulary (its own ids, minted in its own creation order).
+    pub fn from_index(index: usize) -> Self {
+        Self(index as u32)
+    }
+
     /// The id as an index (creation order, starting at 0).
     pub fn index(self) -> usize {
         self.0 as usize

@@ -437,7 +437,7 @@ impl RigidWorld for KinematicWorld {
             .bodies
             .get(link)
             .copied()
-            .ok_or_else(|| no_name("link", link))
+            .ok_or_else(|| no_name("link", &link.to_string()))
     }
 
     fn link_pose(&self, art: ArticulationId, link: usize) -> PortResult<Pose3> {
