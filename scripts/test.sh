@@ -5,6 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 started=$(date +%s)
+echo "[test] repository hygiene (no tracked build artefacts; the check's own test)"
+bash scripts/check_repo.sh
+bash scripts/test_check_repo.sh
 bash scripts/setup.sh
 # shellcheck disable=SC1091
 . .venv/bin/activate
