@@ -12,7 +12,7 @@ if [ "$(id -u)" != "0" ]; then SUDO="sudo"; fi
 
 # --- Toolchains ---------------------------------------------------------------------------------
 if ! command -v cargo >/dev/null 2>&1; then
-  echo "[setup] error: cargo not found. ms2 needs a Rust toolchain >= 1.86 (rustup: https://rustup.rs)" >&2
+  echo "[setup] error: cargo not found. ms2 needs a Rust toolchain >= 1.90 (rustup: https://rustup.rs)" >&2
   exit 1
 fi
 PY=${PYTHON:-python3}

@@ -5,10 +5,14 @@
 //! contact reports that ManiSkill2's grasp checks read).
 
 use nalgebra::{Point3, Vector3};
+#[cfg(feature = "rapier")]
 use rapier3d::geometry::ContactPair;
 
+use crate::ids::BodyId;
+#[cfg(feature = "rapier")]
 use crate::math::vec_to_na;
-use crate::world::{BodyId, World};
+#[cfg(feature = "rapier")]
+use crate::world::World;
 
 /// One contact point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,6 +65,7 @@ impl ContactReport {
     }
 }
 
+#[cfg(feature = "rapier")]
 impl World {
     fn report_of(&self, pair: &ContactPair) -> Option<ContactReport> {
         if !pair.has_any_active_contact() {
@@ -156,6 +161,7 @@ impl World {
     }
 }
 
+#[cfg(feature = "rapier")]
 fn merge_into(out: &mut Vec<ContactReport>, r: ContactReport) {
     for m in out.iter_mut() {
         if m.body_a == r.body_a && m.body_b == r.body_b {

@@ -7,7 +7,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::error::{PhysicsError, Result, UrdfError};
 use crate::math::Pose3;
-use crate::shape::{ShapeSpec, VisualShape};
+use crate::shape::{Material, ShapeSpec, VisualShape};
 
 /// Type of a joint.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -104,6 +104,7 @@ pub struct ArticulationDesc {
     pub joints: Vec<JointDesc>,
 }
 
+#[cfg_attr(not(feature = "rapier"), allow(dead_code))] // used by the rapier engine
 pub(crate) fn invalid(file: &str, element: String, reason: String) -> PhysicsError {
     PhysicsError::Urdf(UrdfError::Invalid {
         file: file.to_string(),
@@ -112,12 +113,14 @@ pub(crate) fn invalid(file: &str, element: String, reason: String) -> PhysicsErr
     })
 }
 
+#[cfg_attr(not(feature = "rapier"), allow(dead_code))] // used by the rapier engine
 /// The validated tree: link order (depth first) and each link's parent joint.
 pub(crate) struct Tree {
     pub(crate) order: Vec<usize>,
     pub(crate) parent_joint: Vec<Option<usize>>,
 }
 
+#[cfg_attr(not(feature = "rapier"), allow(dead_code))] // used by the rapier engine
 /// Checks names, references and tree shape; returns the depth-first order.
 pub(crate) fn validate_tree(desc: &ArticulationDesc, file: &str) -> Result<Tree> {
     let mut link_index = HashMap::new();
@@ -272,4 +275,110 @@ pub(crate) fn validate_tree(desc: &ArticulationDesc, file: &str) -> Result<Tree>
         order,
         parent_joint,
     })
+}
+
+/// How an articulation's links collide with each other.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SelfCollision {
+    /// Links never collide with each other.
+    Disabled,
+    /// Links collide, except links joined by a joint and link pairs already touching (within
+    /// 1 mm) at the configuration the articulation is built in.
+    NonAdjacent,
+}
+
+/// Options for adding an articulation to a world (engine-neutral: how an engine builds an
+/// [`ArticulationDesc`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ArticulationOptions {
+    /// Pose of the root link in the world. The root is fixed (mobile robots carry their base
+    /// motion as prismatic/revolute joints, as in ManiSkill2).
+    pub root_pose: Pose3,
+    /// Cancel gravity on the links (ManiSkill2's `balance_passive_force`): the links feel no
+    /// gravity, so the drives only see contact and inertial forces. Objects held by the robot
+    /// still weigh on it.
+    pub gravity_compensation: bool,
+    /// Self-collision filtering.
+    pub self_collision: SelfCollision,
+    /// Material of every link's collision shapes unless overridden in `link_materials`.
+    pub default_material: Material,
+    /// Per-link material overrides (link name, material).
+    pub link_materials: Vec<(String, Material)>,
+    /// Joint positions to build in (dof order); `None` for all zeros clamped into the limits.
+    pub initial_qpos: Option<Vec<f32>>,
+}
+
+impl Default for ArticulationOptions {
+    fn default() -> Self {
+        ArticulationOptions {
+            root_pose: Pose3::identity(),
+            gravity_compensation: true,
+            self_collision: SelfCollision::NonAdjacent,
+            default_material: Material::default(),
+            link_materials: Vec::new(),
+            initial_qpos: None,
+        }
+    }
+}
+
+/// PD drive of one degree of freedom: force = stiffness·(q* − q) + damping·(q̇* − q̇), clamped
+/// to ±force_limit, solved implicitly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriveParams {
+    /// Stiffness (N·m/rad or N/m).
+    pub stiffness: f32,
+    /// Damping (N·m·s/rad or N·s/m).
+    pub damping: f32,
+    /// Maximal force magnitude (N·m or N).
+    pub force_limit: f32,
+}
+
+impl DriveParams {
+    /// ManiSkill2's Panda arm drive: stiffness 1e3, damping 1e2, force limit 100.
+    pub const MANISKILL2_ARM: DriveParams = DriveParams {
+        stiffness: 1e3,
+        damping: 1e2,
+        force_limit: 100.0,
+    };
+
+    #[cfg_attr(not(feature = "rapier"), allow(dead_code))]
+    pub(crate) fn validate(&self) -> Result<()> {
+        let ok = |v: f32| !v.is_nan() && v >= 0.0;
+        if ok(self.stiffness) && ok(self.damping) && ok(self.force_limit) {
+            Ok(())
+        } else {
+            Err(PhysicsError::InvalidParameter {
+                name: "drive",
+                value: format!("{self:?}"),
+                expected: "stiffness, damping and force limit >= 0 (force limit may be infinite)",
+            })
+        }
+    }
+}
+
+/// Read-only facts about one joint of a built articulation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointInfo {
+    /// Joint name.
+    pub name: String,
+    /// Joint type.
+    pub joint_type: JointType,
+    /// Index of the parent link (in the articulation's link order, `World::link_names`).
+    pub parent_link: usize,
+    /// Index of the child link.
+    pub child_link: usize,
+    /// Position limits (rad or m); `[-inf, inf]` for continuous joints, `[0, 0]` for fixed.
+    pub limits: [f32; 2],
+    /// Unit axis in the joint frame.
+    pub axis: Vector3<f32>,
+    /// Pose of the joint frame in the parent link frame.
+    pub pose_parent_from_joint: Pose3,
+    /// Effort limit from the description (as data).
+    pub effort_limit: f32,
+    /// Velocity limit from the description (as data).
+    pub velocity_limit: f32,
+    /// Mimic relation (as data).
+    pub mimic: Option<Mimic>,
+    /// Index of the degree of freedom (qpos index), `None` for fixed joints.
+    pub dof: Option<usize>,
 }

@@ -65,7 +65,7 @@ pub enum UrdfError {
         mesh: PathBuf,
     },
     /// A mesh file exists but could not be loaded (unknown format, parse error, no triangles).
-    #[error("URDF {file}: <link name=\"{link}\"> <{element}> mesh {mesh:?}: {reason}")]
+    #[error("URDF {file}: <link name=\"{link}\"> <{element}> mesh {mesh:?}: {source}")]
     MeshLoad {
         /// Path of the URDF file.
         file: String,
@@ -76,7 +76,7 @@ pub enum UrdfError {
         /// The resolved mesh path.
         mesh: PathBuf,
         /// Why loading failed.
-        reason: String,
+        source: crate::mesh::MeshError,
     },
     /// An element is well-formed but its content is invalid (e.g. an unknown parent link, a
     /// negative mass, a zero joint axis, a kinematic loop).
@@ -153,6 +153,7 @@ pub enum PhysicsError {
 /// Result type of ms2-physics.
 pub type Result<T> = std::result::Result<T, PhysicsError>;
 
+#[cfg_attr(not(feature = "rapier"), allow(dead_code))] // used by the rapier engine
 /// Checks that every value is finite; `what` names the values for the error.
 pub(crate) fn check_finite(what: impl FnOnce() -> String, values: &[f32]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
@@ -165,6 +166,7 @@ pub(crate) fn check_finite(what: impl FnOnce() -> String, values: &[f32]) -> Res
     }
 }
 
+#[cfg_attr(not(feature = "rapier"), allow(dead_code))] // used by the rapier engine
 /// Checks that every component of `pose` (translation x, y, z, then quaternion i, j, k, w) is
 /// finite; `what` names the pose for the error.
 pub(crate) fn check_pose_finite(what: impl FnOnce() -> String, pose: &Pose3) -> Result<()> {
@@ -173,6 +175,7 @@ pub(crate) fn check_pose_finite(what: impl FnOnce() -> String, pose: &Pose3) -> 
     check_finite(what, &[t.x, t.y, t.z, r.i, r.j, r.k, r.w])
 }
 
+#[cfg_attr(not(feature = "rapier"), allow(dead_code))] // used by the rapier engine
 /// Checks that parameter `name` is finite and `>= 0`; `expected` describes the valid range (with
 /// its unit) for the error.
 pub(crate) fn check_non_negative(
@@ -191,6 +194,7 @@ pub(crate) fn check_non_negative(
     }
 }
 
+#[cfg_attr(not(feature = "rapier"), allow(dead_code))] // used by the rapier engine
 /// Checks a slice length; `what` names the slice for the error.
 pub(crate) fn check_len(what: impl FnOnce() -> String, expected: usize, got: usize) -> Result<()> {
     if expected == got {

@@ -15,7 +15,20 @@
 //!
 //! The public API uses nalgebra (`f32`); rapier's glam types stay inside.
 //!
+//! ## Features
+//!
+//! - **`rapier`** (default): the [`World`] above, over rapier3d, with [`add_panda`].
+//!
+//! Without `rapier` (`default-features = false`) the crate is the engine-neutral vocabulary
+//! another rigid engine builds on, with the same paths: ids ([`BodyId`], [`ArticulationId`],
+//! minted with `from_index`), actor and shape descriptions ([`ActorDesc`], [`ShapeSpec`],
+//! [`VisualShape`], ...), articulation descriptions and URDF parsing ([`ArticulationDesc`],
+//! [`parse_urdf_file`], [`JointInfo`], [`DriveParams`], ...), contact reports
+//! ([`ContactReport`]), [`WorldConfig`] and the errors ([`PhysicsError`], [`UrdfError`]).
+//!
 //! ```
+//! # #[cfg(feature = "rapier")]
+//! # fn main() {
 //! use ms2_physics::{ActorDesc, ActorKind, ShapeDesc, ShapeSpec, World, WorldConfig, Pose3};
 //! let mut world = World::new(WorldConfig::default()).unwrap();
 //! let cube = world
@@ -28,33 +41,48 @@
 //! world.step_n(500); // one second
 //! let z = world.body_pose(cube).unwrap().translation.z;
 //! assert!((z - 0.02).abs() < 2e-3, "the cube rests on the ground: z = {z}");
+//! # }
+//! # #[cfg(not(feature = "rapier"))]
+//! # fn main() {}
 //! ```
 
+mod actor;
+#[cfg(feature = "rapier")]
 pub mod articulation;
+#[cfg(feature = "rapier")]
 mod bodies;
 pub mod config;
 pub mod contact;
 pub mod description;
 pub mod error;
+mod ids;
+#[cfg(feature = "rapier")]
 mod joints;
 pub mod math;
 pub mod mesh;
 pub mod panda;
 pub mod shape;
+#[cfg(feature = "rapier")]
 pub mod state;
 pub mod urdf;
+#[cfg(feature = "rapier")]
 pub mod world;
 
-pub use articulation::{
-    ArticulationDesc, ArticulationId, ArticulationOptions, DriveParams, Inertial, JointDesc,
-    JointInfo, JointType, LinkDesc, Mimic, SelfCollision,
-};
+pub use actor::{ActorDesc, ActorKind};
 pub use config::{GroundConfig, SolverConfig, WorldConfig};
 pub use contact::{ContactPoint, ContactReport};
+pub use description::{
+    ArticulationDesc, ArticulationOptions, DriveParams, Inertial, JointDesc, JointInfo, JointType,
+    LinkDesc, Mimic, SelfCollision,
+};
 pub use error::{PhysicsError, Result, UrdfError};
+pub use ids::{ArticulationId, BodyId, BodyKind};
 pub use math::Pose3;
-pub use mesh::MeshCollision;
-pub use panda::{add_panda, add_panda_from_urdf, PandaOptions, PANDA_FINGER_FRICTION};
+pub use mesh::{MeshCollision, MeshError};
+#[cfg(feature = "rapier")]
+pub use panda::{add_panda, add_panda_from_urdf};
+pub use panda::{PandaOptions, PANDA_FINGER_FRICTION};
 pub use shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
 pub use urdf::{parse_urdf_file, parse_urdf_str, UrdfLoadOptions};
-pub use world::{ActorDesc, ActorKind, BodyId, BodyKind, World};
+#[cfg(feature = "rapier")]
+pub use world::World;

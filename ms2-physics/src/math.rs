@@ -1,11 +1,12 @@
-//! Conversions between ms2's public maths types (nalgebra, `f32`) and rapier's (glam).
+//! ms2's public maths types (nalgebra, `f32`), and conversions to parry's and rapier's (glam).
 //!
 //! The public API of this crate uses [`nalgebra`]: poses are [`Isometry3<f32>`], points and
-//! vectors are [`Vector3<f32>`]. rapier 0.36 and parry 0.31 use glam types; everything is
-//! converted at the boundary, component by component, so conversions are exact.
+//! vectors are [`Vector3<f32>`]. parry 0.31 (and rapier 0.36, which uses parry's maths types)
+//! use glam types; everything is converted at the boundary, component by component, so
+//! conversions are exact.
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
-use rapier3d::math::{Pose, Rotation, Vector};
+use parry3d::math::{Pose, Rotation, Vector};
 
 /// A rigid transform in metres, `f32` (ms2's public pose type).
 pub type Pose3 = Isometry3<f32>;
@@ -34,7 +35,7 @@ pub fn rot_from_na(q: &UnitQuaternion<f32>) -> Rotation {
     Rotation::from_xyzw(q.i, q.j, q.k, q.w)
 }
 
-/// Converts a rapier pose to a nalgebra isometry.
+/// Converts a parry (or rapier) pose to a nalgebra isometry.
 #[inline]
 pub fn pose_to_na(p: &Pose) -> Pose3 {
     Isometry3::from_parts(
@@ -43,7 +44,7 @@ pub fn pose_to_na(p: &Pose) -> Pose3 {
     )
 }
 
-/// Converts a nalgebra isometry to a rapier pose.
+/// Converts a nalgebra isometry to a parry (or rapier) pose.
 #[inline]
 pub fn pose_from_na(p: &Pose3) -> Pose {
     Pose::from_parts(vec_from_na(&p.translation.vector), rot_from_na(&p.rotation))

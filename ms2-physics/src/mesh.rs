@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use nalgebra::{Point3, Vector3};
-use rapier3d::prelude::SharedShape;
+use parry3d::shape::SharedShape;
 
 use crate::math::{pose_to_na, vec_from_na, vec_to_na};
 use crate::shape::ShapeDesc;
@@ -27,23 +27,55 @@ pub struct TriangleMesh {
     pub indices: Vec<[u32; 3]>,
 }
 
-/// Reads every mesh of an OBJ / STL / DAE file into one triangle mesh, scaled per axis.
+/// Why a mesh file could not become a triangle mesh or a collision shape.
 ///
-/// Errors are plain strings; the URDF loader wraps them with the file, link and element.
-pub fn load_mesh_file(path: &Path, scale: Vector3<f32>) -> Result<TriangleMesh, String> {
+/// The errors name neither the file nor who asked for it: callers wrap them (the URDF loader in
+/// [`UrdfError::MeshLoad`](crate::UrdfError::MeshLoad), with the file, link and element).
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    /// The file extension is not one of the supported formats.
+    #[error("unsupported mesh format \"{extension}\": expected .obj, .stl or .dae")]
+    UnsupportedFormat {
+        /// The extension found (lower case, empty when the file has none).
+        extension: String,
+    },
+    /// The file could not be read or parsed.
+    #[error("cannot parse mesh: {source}")]
+    Parse {
+        /// What `mesh-loader` reported.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file parsed but holds no triangle.
+    #[error("the file holds no triangles")]
+    NoTriangles,
+    /// A vertex has a NaN or infinite coordinate (after scaling).
+    #[error("vertex {vertex:?} is not finite")]
+    NonFiniteVertex {
+        /// The vertex (m).
+        vertex: Point3<f32>,
+    },
+    /// The convex decomposition (V-HACD) did not produce usable convex parts.
+    #[error("convex decomposition failed: {reason}")]
+    Decomposition {
+        /// What went wrong.
+        reason: &'static str,
+    },
+}
+
+/// Reads every mesh of an OBJ / STL / DAE file into one triangle mesh, scaled per axis.
+pub fn load_mesh_file(path: &Path, scale: Vector3<f32>) -> Result<TriangleMesh, MeshError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
     if !matches!(ext.as_str(), "obj" | "stl" | "dae") {
-        return Err(format!(
-            "unsupported mesh format \"{ext}\": expected .obj, .stl or .dae"
-        ));
+        return Err(MeshError::UnsupportedFormat { extension: ext });
     }
     let scene = mesh_loader::Loader::default()
         .load(path)
-        .map_err(|e| format!("cannot parse mesh: {e}"))?;
+        .map_err(|source| MeshError::Parse { source })?;
     let mut out = TriangleMesh {
         vertices: Vec::new(),
         indices: Vec::new(),
@@ -62,20 +94,23 @@ pub fn load_mesh_file(path: &Path, scale: Vector3<f32>) -> Result<TriangleMesh, 
         );
     }
     if out.vertices.is_empty() || out.indices.is_empty() {
-        return Err("the file holds no triangles".into());
+        return Err(MeshError::NoTriangles);
     }
     if let Some(p) = out
         .vertices
         .iter()
         .find(|p| !p.coords.iter().all(|v| v.is_finite()))
     {
-        return Err(format!("vertex {p:?} is not finite"));
+        return Err(MeshError::NonFiniteVertex { vertex: *p });
     }
     Ok(out)
 }
 
 /// Turns a triangle mesh into a convex collision shape description.
-pub fn mesh_collision_shape(mesh: &TriangleMesh, mode: MeshCollision) -> Result<ShapeDesc, String> {
+pub fn mesh_collision_shape(
+    mesh: &TriangleMesh,
+    mode: MeshCollision,
+) -> Result<ShapeDesc, MeshError> {
     match mode {
         MeshCollision::ConvexHull => Ok(ShapeDesc::ConvexHull {
             points: mesh.vertices.clone(),
@@ -87,14 +122,16 @@ pub fn mesh_collision_shape(mesh: &TriangleMesh, mode: MeshCollision) -> Result<
                 .map(|p| vec_from_na(&p.coords))
                 .collect();
             let shape = SharedShape::convex_decomposition(&verts, &mesh.indices);
-            let compound = shape
-                .as_compound()
-                .ok_or_else(|| "convex decomposition did not produce a compound".to_string())?;
+            let compound = shape.as_compound().ok_or(MeshError::Decomposition {
+                reason: "the result is not a compound",
+            })?;
             let mut parts = Vec::new();
             for (pose, part) in compound.shapes() {
                 let poly = part
                     .as_convex_polyhedron()
-                    .ok_or_else(|| "convex decomposition produced a non-convex part".to_string())?;
+                    .ok_or(MeshError::Decomposition {
+                        reason: "a part is not a convex polyhedron",
+                    })?;
                 parts.push((
                     pose_to_na(pose),
                     ShapeDesc::ConvexHull {
@@ -107,7 +144,9 @@ pub fn mesh_collision_shape(mesh: &TriangleMesh, mode: MeshCollision) -> Result<
                 ));
             }
             if parts.is_empty() {
-                return Err("convex decomposition produced no part".into());
+                return Err(MeshError::Decomposition {
+                    reason: "no convex part",
+                });
             }
             Ok(ShapeDesc::Compound { parts })
         }

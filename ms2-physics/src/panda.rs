@@ -1,11 +1,16 @@
 //! The Franka Panda of `ms2-assets`, set up as ManiSkill2 sets it up.
 
-use crate::articulation::{ArticulationId, ArticulationOptions, DriveParams, SelfCollision};
-use crate::error::Result;
+use crate::description::DriveParams;
 use crate::math::Pose3;
 use crate::shape::Material;
-use crate::urdf::{parse_urdf_str, UrdfLoadOptions};
-use crate::world::World;
+#[cfg(feature = "rapier")]
+use crate::{
+    description::{ArticulationOptions, SelfCollision},
+    error::Result,
+    ids::ArticulationId,
+    urdf::{parse_urdf_str, UrdfLoadOptions},
+    world::World,
+};
 
 /// Friction coefficient of the finger pads (ManiSkill2 uses 2.0 so grasps hold).
 pub const PANDA_FINGER_FRICTION: f32 = 2.0;
@@ -43,6 +48,7 @@ impl Default for PandaOptions {
 
 /// Adds the Panda (9 degrees of freedom: `panda_joint1..7`, `panda_finger_joint1/2`) with
 /// gravity-compensated links, PD drives and finger friction; drive targets start at `qpos`.
+#[cfg(feature = "rapier")]
 pub fn add_panda(world: &mut World, options: &PandaOptions) -> Result<ArticulationId> {
     add_panda_from_urdf(
         world,
@@ -55,6 +61,7 @@ pub fn add_panda(world: &mut World, options: &PandaOptions) -> Result<Articulati
 /// [`add_panda`] from another description of the same robot: `urdf` must have the Panda's
 /// joints and finger links (e.g. `ms2_assets::PANDA_BUCKET_URDF`, the Panda with a tool fixed
 /// to its hand); `source` names it in errors.
+#[cfg(feature = "rapier")]
 pub fn add_panda_from_urdf(
     world: &mut World,
     options: &PandaOptions,

@@ -4,10 +4,15 @@
 //! body they belong to, through a local pose (`pose_body_from_shape`).
 
 use nalgebra::{Point3, Vector3};
+#[cfg(feature = "rapier")]
 use rapier3d::prelude::{ColliderBuilder, SharedShape};
 
-use crate::error::{check_non_negative, PhysicsError, Result};
-use crate::math::{pose_from_na, vec_from_na, Pose3};
+#[cfg(feature = "rapier")]
+use crate::error::check_non_negative;
+use crate::error::{PhysicsError, Result};
+use crate::math::Pose3;
+#[cfg(feature = "rapier")]
+use crate::math::{pose_from_na, vec_from_na};
 
 /// A collision (or visual) geometry in its own frame.
 ///
@@ -71,6 +76,7 @@ impl ShapeDesc {
         matches!(self, ShapeDesc::TriMesh { .. })
     }
 
+    #[cfg(feature = "rapier")]
     /// Builds rapier's shape. Cylinders and capsules are rotated from rapier's y axis to z.
     pub(crate) fn to_shared_shape(&self) -> Result<SharedShape> {
         let positive = |name: &str, v: f32| -> Result<()> {
@@ -163,12 +169,14 @@ impl ShapeDesc {
 }
 
 /// The rotation taking rapier's cylinder axis (y) onto ms2's (z).
+#[cfg(feature = "rapier")]
 fn y_to_z_rotation() -> rapier3d::math::Pose {
     rapier3d::math::Pose::from_rotation(rapier3d::math::Rotation::from_rotation_x(
         std::f32::consts::FRAC_PI_2,
     ))
 }
 
+#[cfg(feature = "rapier")]
 fn convex_hull(points: &[Point3<f32>]) -> Result<SharedShape> {
     if let Some(p) = points
         .iter()
@@ -303,6 +311,7 @@ impl ShapeSpec {
         self
     }
 
+    #[cfg(feature = "rapier")]
     /// Builds the rapier collider (without parent).
     pub(crate) fn to_collider(&self) -> Result<ColliderBuilder> {
         self.material.validate()?;
@@ -357,7 +366,7 @@ pub struct VisualShape {
     pub rgba: [f32; 4],
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "rapier"))]
 mod tests {
     use super::*;
 

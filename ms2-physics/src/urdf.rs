@@ -8,14 +8,18 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::articulation::{
-    ArticulationDesc, ArticulationId, ArticulationOptions, Inertial, JointDesc, JointType,
-    LinkDesc, Mimic,
-};
-use crate::error::{Result, UrdfError};
+#[cfg(feature = "rapier")]
+use crate::description::ArticulationOptions;
+use crate::description::{ArticulationDesc, Inertial, JointDesc, JointType, LinkDesc, Mimic};
+#[cfg(feature = "rapier")]
+use crate::error::Result;
+use crate::error::UrdfError;
+#[cfg(feature = "rapier")]
+use crate::ids::ArticulationId;
 use crate::math::{pose_f64_to_f32, pose_from_xyz_rpy};
-use crate::mesh::{load_mesh_file, mesh_collision_shape, MeshCollision};
+use crate::mesh::{load_mesh_file, mesh_collision_shape, MeshCollision, MeshError};
 use crate::shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
+#[cfg(feature = "rapier")]
 use crate::world::World;
 
 /// Options of URDF parsing.
@@ -295,12 +299,12 @@ fn geometry(
                 });
             }
             let s = scale.as_ref().map(|s| s.0).unwrap_or([1.0; 3]);
-            let mesh_err = |reason: String| UrdfError::MeshLoad {
+            let mesh_err = |source: MeshError| UrdfError::MeshLoad {
                 file: file.into(),
                 link: link.into(),
                 element,
                 mesh: path.clone(),
-                reason,
+                source,
             };
             let mesh = load_mesh_file(&path, Vector3::from(s).cast::<f32>()).map_err(mesh_err)?;
             match mesh_collision {
@@ -314,6 +318,7 @@ fn geometry(
     })
 }
 
+#[cfg(feature = "rapier")]
 impl World {
     /// Loads a URDF file and adds it as an articulation (mesh collision as convex hulls).
     pub fn load_urdf(

@@ -11,107 +11,14 @@ use rapier3d::prelude::{
     SolverFlags, SpringCoefficients,
 };
 
-use crate::articulation::{Articulation, ArticulationId};
+pub use crate::actor::{ActorDesc, ActorKind};
+use crate::articulation::Articulation;
 use crate::config::WorldConfig;
 use crate::error::{check_finite, check_non_negative, check_pose_finite, PhysicsError, Result};
-use crate::math::{pose_from_na, vec_from_na, Pose3};
+pub use crate::ids::{BodyId, BodyKind};
+use crate::math::{pose_from_na, vec_from_na};
 use crate::shape::{ShapeSpec, VisualShape};
 use crate::state::SnapshotCache;
-
-/// Identifies a rigid body of a [`World`]: an actor or an articulation link body.
-///
-/// Ids are indices in creation order and stay valid for the life of the world.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct BodyId(pub(crate) u32);
-
-impl BodyId {
-    /// The id of index `index`, for another engine that implements a rigid-world port in
-    /// ms2-physics' vocabulary (its own ids, minted in its own creation order).
-    pub fn from_index(index: usize) -> Self {
-        Self(index as u32)
-    }
-
-    /// The id as an index (creation order, starting at 0).
-    pub fn index(self) -> usize {
-        self.0 as usize
-    }
-}
-
-/// How an actor moves.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ActorKind {
-    /// Never moves (walls, tables, the ground).
-    Static,
-    /// Moved by forces and contacts.
-    Dynamic,
-    /// Moved only by the user, through [`World::set_kinematic_target`]; pushes dynamic bodies.
-    Kinematic,
-}
-
-/// What kind of body a [`BodyId`] names.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BodyKind {
-    /// A static actor (including the ground).
-    Static,
-    /// A dynamic actor.
-    Dynamic,
-    /// A kinematic actor.
-    Kinematic,
-    /// A link body of an articulation.
-    Link(ArticulationId),
-}
-
-/// Description of an actor: a single rigid body with its shapes.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ActorDesc {
-    /// Name (for errors, contacts and renderers; need not be unique).
-    pub name: String,
-    /// How the actor moves.
-    pub kind: ActorKind,
-    /// Initial pose of the actor frame in the world.
-    pub pose: Pose3,
-    /// Collision shapes in the actor frame.
-    pub shapes: Vec<ShapeSpec>,
-    /// Visual shapes in the actor frame (empty: renderers draw the collision shapes).
-    pub visuals: Vec<VisualShape>,
-    /// Linear velocity damping (1/s).
-    pub linear_damping: f32,
-    /// Angular velocity damping (1/s).
-    pub angular_damping: f32,
-}
-
-impl ActorDesc {
-    /// An actor with no shapes at the origin.
-    pub fn new(name: impl Into<String>, kind: ActorKind) -> Self {
-        ActorDesc {
-            name: name.into(),
-            kind,
-            pose: Pose3::identity(),
-            shapes: Vec::new(),
-            visuals: Vec::new(),
-            linear_damping: 0.0,
-            angular_damping: 0.0,
-        }
-    }
-
-    /// Sets the initial pose.
-    pub fn with_pose(mut self, pose: Pose3) -> Self {
-        self.pose = pose;
-        self
-    }
-
-    /// Adds a collision shape.
-    pub fn with_shape(mut self, shape: ShapeSpec) -> Self {
-        self.shapes.push(shape);
-        self
-    }
-
-    /// Adds a visual shape.
-    pub fn with_visual(mut self, visual: VisualShape) -> Self {
-        self.visuals.push(visual);
-        self
-    }
-}
 
 /// One entry of the body table.
 #[derive(Clone, Debug)]

@@ -1,5 +1,6 @@
 //! The rest of the API, each behaviour simulated: shapes, kinematic actors, forces, velocity
 //! drives, sleeping, link velocities, mesh files.
+#![cfg(feature = "rapier")] // These tests drive the rapier `World`.
 
 mod common;
 

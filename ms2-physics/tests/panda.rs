@@ -1,4 +1,5 @@
 //! The Panda under its PD drives: holding the rest pose, step responses, and a grasp.
+#![cfg(feature = "rapier")] // These tests drive the rapier `World`.
 
 mod common;
 

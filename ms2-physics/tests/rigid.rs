@@ -1,4 +1,5 @@
 //! Actors: falling, resting, stacking, contact impulses.
+#![cfg(feature = "rapier")] // These tests drive the rapier `World`.
 
 use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig};
 

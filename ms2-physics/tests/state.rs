@@ -1,4 +1,5 @@
 //! Flat state: exact continuation after `set_state(get_state())`, cold writes, errors.
+#![cfg(feature = "rapier")] // These tests drive the rapier `World`.
 
 use ms2_physics::{
     add_panda, ActorDesc, ActorKind, ArticulationId, BodyId, PandaOptions, Pose3, ShapeDesc,

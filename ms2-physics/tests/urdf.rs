@@ -1,4 +1,5 @@
 //! URDF loading: the Panda, and one clear error per kind of bad input.
+#![cfg(feature = "rapier")] // These tests drive the rapier `World`.
 
 use std::path::Path;
 
