@@ -78,7 +78,7 @@ impl PandaAgent {
             let view = PhysicsArticulation::new(world, art);
             robot
                 .build_controller(mode, &view, timing)
-                .map_err(|e| EnvError::Controller(e.to_string()))?
+                .map_err(|e| EnvError::Controller(e.into()))?
         };
         let finger = |world: &World, link: &str, joint: &str| -> Result<Finger, EnvError> {
             let link = world.link_index(art, link).map_err(physics_err)?;
@@ -143,7 +143,7 @@ impl PandaAgent {
         let mut view = PhysicsArticulation::new(world, self.articulation);
         self.controller
             .set_action(&mut view, &self.action_f64)
-            .map_err(|e| EnvError::Controller(e.to_string()))
+            .map_err(|e| EnvError::Controller(e.into()))
     }
 
     /// Lets the controller update drive targets before one physics substep.

@@ -42,7 +42,7 @@ impl<T: Task> TaskEnv<T> {
     /// Builds the runtime for `cfg` (control mode resolved here) around `task`.
     pub(crate) fn new(cfg: &EnvConfig, substeps: u32, mut task: T) -> Result<Self, EnvError> {
         let robot = RobotConfig::panda(ms2_assets::PANDA_URDF)
-            .map_err(|e| EnvError::Controller(e.to_string()))?;
+            .map_err(|e| EnvError::Controller(e.into()))?;
         let control_modes: Vec<String> = robot
             .supported_modes
             .iter()
@@ -312,7 +312,7 @@ impl<T: Task> EnvBackend for TaskEnv<T> {
             .agent
             .controller
             .set_state(&restored)
-            .map_err(EnvError::Controller)?;
+            .map_err(|e| EnvError::Controller(e.into()))?;
         self.task.set_task_state(task_state);
         Ok(())
     }
