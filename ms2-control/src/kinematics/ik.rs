@@ -4,10 +4,10 @@
 //! seed joint vector, linearising the chain at each iterate with the base-frame geometric Jacobian
 //! and the pose error `[p* − p; log(R* Rᵀ)]`. The target is an [`IkTarget`]: a full pose, a
 //! position only, or a partial target whose six dimensions are weighted (0 = free) along base or
-//! target axes ([`TaskWeights`](super::TaskWeights)); only the constrained rows of the Jacobian and error enter the
-//! step. They return [`IkSolution`] only when the tip is within the tolerances of the target on
-//! the constrained dimensions; otherwise
-//! [`IkError::NotConverged`] carries the best joint vector found and its residual, so a caller can
+//! target axes ([`TaskWeights`](super::TaskWeights)); only the constrained rows of the Jacobian
+//! and error enter the step. They return [`IkSolution`] only when the tip is within the
+//! tolerances of the target on the constrained dimensions; otherwise [`IkError::NotConverged`]
+//! carries the best joint vector found and its residual, so a caller can
 //! decide what to do with an unreachable target instead of receiving a silently wrong answer.
 
 use clarabel::algebra::CscMatrix;
@@ -481,8 +481,8 @@ impl DlsIk {
     }
 
     /// Joint vector (chain order) that brings the chain tip onto `target`: a full pose, a position
-    /// only, or a partial target (see [`IkTarget`], [`TaskWeights`](super::TaskWeights)); `seed` and `free` as in
-    /// [`DlsIk::solve`].
+    /// only, or a partial target (see [`IkTarget`], [`TaskWeights`](super::TaskWeights)); `seed`
+    /// and `free` as in [`DlsIk::solve`].
     ///
     /// ```
     /// use ms2_control::nalgebra::Vector3;
