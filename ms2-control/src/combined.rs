@@ -9,6 +9,7 @@ use crate::articulation::Articulation;
 use crate::controllers::{
     BuildContext, BuildError, ControlTiming, IkReport, PartController, PartControllerConfig,
 };
+use crate::error::StateError;
 use crate::kinematics::KinematicModel;
 
 /// One named slice of a flat action, e.g. `arm` = `[0..7]`.
@@ -48,6 +49,26 @@ pub enum ConversionError {
         /// The value.
         value: f64,
     },
+    /// A part controller cannot convert joint targets into its action (the default of
+    /// [`PartController::action_for_joint_targets`] for user controllers).
+    #[error("controller `{controller}` does not support converting joint targets into actions")]
+    Unsupported {
+        /// Controller name.
+        controller: String,
+    },
+}
+
+/// One part's controller state with its observation key (see [`CombinedController::state_entries`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartState {
+    /// Part name (`arm`, `gripper`, `base`, ...).
+    pub part: String,
+    /// Observation key of the values: [`crate::controllers::STATE_KEY_TARGET_QPOS`] (joint
+    /// targets, rad or m), [`crate::controllers::STATE_KEY_TARGET_POSE`] (target pose
+    /// `[x, y, z, qw, qx, qy, qz]` in the robot base frame, m) or a user controller's own key.
+    pub key: String,
+    /// The state values ([`PartController::state`]).
+    pub values: Vec<f64>,
 }
 
 /// A robot's controller for one control mode: part controllers behind one flat action.
@@ -55,6 +76,9 @@ pub enum ConversionError {
 /// Usage per episode: [`CombinedController::reset`] after the robot is placed, then per control
 /// step [`CombinedController::set_action`], and [`CombinedController::before_substep`] before each
 /// physics substep.
+///
+/// Built from part configurations ([`CombinedController::build`]) or, to mix in user
+/// controllers, with [`CombinedController::builder`].
 #[derive(Debug)]
 pub struct CombinedController {
     mode: String,
@@ -76,25 +100,98 @@ impl CombinedController {
         articulation: &dyn Articulation,
         timing: ControlTiming,
     ) -> Result<Self, BuildError> {
+        let mut builder = Self::builder(mode, model, articulation, timing);
+        for (part, config) in parts {
+            builder.add_config(part, config)?;
+        }
+        builder.build()
+    }
+
+    /// A builder for a controller whose parts are built-in configurations and/or user
+    /// [`PartController`]s, for `articulation`'s joint layout.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use ms2_control::controllers::{JointPositionConfig, PartControllerConfig};
+    /// use ms2_control::{CombinedController, ControlTiming, DriveGains, PerfectTrackingArticulation, RobotConfig};
+    /// let panda = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
+    /// let robot = PerfectTrackingArticulation::for_model(&panda.model, ms2_assets::PANDA_REST_QPOS.to_vec());
+    /// let joints = |names: &[&str]| names.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    /// let absolute = |name: &str, joint_names| PartControllerConfig::JointPosition(JointPositionConfig {
+    ///     name: name.into(), joint_names, lower: None, upper: None, use_delta: false,
+    ///     use_target: false, normalize_action: false, interpolate: false, mimic: false,
+    ///     velocity_bounds: None, gains: DriveGains::MANISKILL2_DEFAULT,
+    /// });
+    /// let mut b = CombinedController::builder("my_mode", &panda.model, &robot, ControlTiming::MANISKILL2);
+    /// b.add_config("arm", &absolute("arm", joints(&ms2_assets::PANDA_ARM_JOINTS))).unwrap();
+    /// b.add_config("fingers", &absolute("fingers", joints(&ms2_assets::PANDA_GRIPPER_JOINTS))).unwrap();
+    /// // b.add_part("tool", Box::new(my_controller)) adds a user PartController the same way.
+    /// let ctrl = b.build().unwrap();
+    /// assert_eq!(ctrl.layout(), "arm [0..7], fingers [7..9]");
+    /// ```
+    pub fn builder(
+        mode: &str,
+        model: &Arc<KinematicModel>,
+        articulation: &dyn Articulation,
+        timing: ControlTiming,
+    ) -> CombinedControllerBuilder {
         let names = articulation.joint_names();
-        let joint_index: HashMap<String, usize> = names
+        let joint_index = names
             .iter()
             .cloned()
             .enumerate()
             .map(|(i, n)| (n, i))
             .collect();
-        let ctx = BuildContext {
-            model,
-            joint_index: &joint_index,
+        CombinedControllerBuilder {
+            mode: mode.to_string(),
+            model: Arc::clone(model),
             timing,
-        };
+            names,
+            joint_index,
+            parts: Vec::new(),
+        }
+    }
+
+    /// Combines already built part controllers `(part name, controller)`, in action order, for an
+    /// articulation whose joints are `joint_names` (dof order). Every joint must be driven by
+    /// exactly one part.
+    pub fn from_parts(
+        mode: &str,
+        joint_names: &[String],
+        parts: Vec<(String, Box<dyn PartController>)>,
+    ) -> Result<Self, BuildError> {
+        let names = joint_names;
         let mut built = Vec::with_capacity(parts.len());
         let mut slices = Vec::with_capacity(parts.len());
         let (mut low, mut high) = (Vec::new(), Vec::new());
         let mut driven = vec![false; names.len()];
-        for (part, config) in parts {
-            let controller = config.build(&ctx)?;
+        for (part, controller) in parts {
+            if slices.iter().any(|s: &ActionSlice| s.name == part) {
+                return Err(BuildError::BadConfig {
+                    controller: controller.name().to_string(),
+                    message: format!("part name `{part}` is used twice"),
+                });
+            }
+            let dim = controller.bounds().dim();
+            if controller.bounds().high.len() != dim {
+                return Err(BuildError::BadConfig {
+                    controller: controller.name().to_string(),
+                    message: format!(
+                        "action bounds have {dim} lower and {} upper values",
+                        controller.bounds().high.len()
+                    ),
+                });
+            }
             for &i in controller.joint_indices() {
+                if i >= names.len() {
+                    return Err(BuildError::BadConfig {
+                        controller: controller.name().to_string(),
+                        message: format!(
+                            "joint index {i} is out of range; the articulation has {} joints",
+                            names.len()
+                        ),
+                    });
+                }
                 if driven[i] {
                     return Err(BuildError::BadConfig {
                         controller: controller.name().to_string(),
@@ -110,7 +207,7 @@ impl CombinedController {
                 name: part.clone(),
                 range: start..low.len(),
             });
-            built.push((part.clone(), controller));
+            built.push((part, controller));
         }
         let uncontrolled: Vec<String> = names
             .iter()
@@ -284,7 +381,7 @@ impl CombinedController {
                 .iter()
                 .map(|&i| desired_qpos[i])
                 .collect();
-            let c = part.action_for_joint_targets(articulation, &targets);
+            let c = part.action_for_joint_targets(articulation, &targets)?;
             if c.saturated {
                 saturated_parts.push(name.clone());
             }
@@ -297,6 +394,7 @@ impl CombinedController {
     }
 
     /// Controller state of target-accumulating parts, per part name (empty parts omitted).
+    /// [`CombinedController::state_entries`] adds each part's observation key.
     pub fn state(&self) -> Vec<(String, Vec<f64>)> {
         self.parts
             .iter()
@@ -305,21 +403,117 @@ impl CombinedController {
             .collect()
     }
 
-    /// Restores a state from [`CombinedController::state`].
-    pub fn set_state(&mut self, state: &[(String, Vec<f64>)]) -> Result<(), String> {
+    /// Controller state of target-accumulating parts with their observation keys, in part
+    /// order (parts with an empty state omitted): e.g. `arm` → `target_pose` for
+    /// `pd_ee_target_delta_pose`, `arm` → `target_qpos` for `pd_joint_target_delta_pos`.
+    ///
+    /// ```
+    /// use ms2_control::{ControlMode, ControlTiming, PerfectTrackingArticulation, RobotConfig};
+    /// let panda = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
+    /// let robot = PerfectTrackingArticulation::for_model(&panda.model, ms2_assets::PANDA_REST_QPOS.to_vec());
+    /// let ctrl = panda.build_controller(ControlMode::PdEeTargetDeltaPose, &robot, ControlTiming::MANISKILL2).unwrap();
+    /// let state = ctrl.state_entries();
+    /// assert_eq!((state[0].part.as_str(), state[0].key.as_str(), state[0].values.len()), ("arm", "target_pose", 7));
+    /// assert_eq!(ctrl.state_key("arm"), Some("target_pose"));
+    /// ```
+    pub fn state_entries(&self) -> Vec<PartState> {
+        self.parts
+            .iter()
+            .map(|(n, p)| PartState {
+                part: n.clone(),
+                key: p.state_key().to_string(),
+                values: p.state(),
+            })
+            .filter(|s| !s.values.is_empty())
+            .collect()
+    }
+
+    /// Observation key of the state of part `part` ([`PartController::state_key`]), whether or
+    /// not its state is empty; `None` for an unknown part.
+    pub fn state_key(&self, part: &str) -> Option<&str> {
+        self.part(part).map(|p| p.state_key())
+    }
+
+    /// Restores a state from [`CombinedController::state`] (part name, values).
+    pub fn set_state(&mut self, state: &[(String, Vec<f64>)]) -> Result<(), StateError> {
         for (name, values) in state {
-            let part = self
-                .parts
-                .iter_mut()
-                .find(|(n, _)| n == name)
-                .ok_or_else(|| format!("mode `{}` has no part `{name}`", self.mode))?;
+            let Some(part) = self.parts.iter_mut().find(|(n, _)| n == name) else {
+                return Err(StateError::UnknownPart {
+                    mode: self.mode.clone(),
+                    part: name.clone(),
+                    parts: self.slices.iter().map(|s| s.name.clone()).collect(),
+                });
+            };
             part.1.set_state(values)?;
         }
         Ok(())
     }
 
+    /// The part controller called `name`, mutably (e.g. to reconfigure a user controller).
+    pub fn part_mut(&mut self, name: &str) -> Option<&mut (dyn PartController + 'static)> {
+        self.parts
+            .iter_mut()
+            .find(|(n, _)| n == name)
+            .map(|(_, c)| c.as_mut())
+    }
+
     /// IK outcome of the last action, from the first part that uses IK.
     pub fn last_ik_report(&self) -> Option<IkReport> {
         self.parts.iter().find_map(|(_, p)| p.last_ik_report())
+    }
+}
+
+/// Builds a [`CombinedController`] from built-in part configurations and user
+/// [`PartController`]s; see [`CombinedController::builder`].
+///
+/// Parts are concatenated into the flat action in the order they are added.
+#[derive(Debug)]
+pub struct CombinedControllerBuilder {
+    mode: String,
+    model: Arc<KinematicModel>,
+    timing: ControlTiming,
+    names: Vec<String>,
+    joint_index: HashMap<String, usize>,
+    parts: Vec<(String, Box<dyn PartController>)>,
+}
+
+impl CombinedControllerBuilder {
+    /// What built-in controllers are built with: the kinematic model, the articulation's joint
+    /// name → dof index map and the timing. User controllers can resolve joint names with
+    /// [`BuildContext::indices`].
+    pub fn context(&self) -> BuildContext<'_> {
+        BuildContext {
+            model: &self.model,
+            joint_index: &self.joint_index,
+            timing: self.timing,
+        }
+    }
+
+    /// Articulation dof index of the joint called `name`.
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joint_index.get(name).copied()
+    }
+
+    /// Builds a built-in controller from `config` and appends it as part `part`.
+    pub fn add_config(
+        &mut self,
+        part: &str,
+        config: &PartControllerConfig,
+    ) -> Result<&mut Self, BuildError> {
+        let controller = config.build(&self.context())?;
+        self.parts.push((part.to_string(), controller));
+        Ok(self)
+    }
+
+    /// Appends a user (or pre-built) controller as part `part`.
+    pub fn add_part(&mut self, part: &str, controller: Box<dyn PartController>) -> &mut Self {
+        self.parts.push((part.to_string(), controller));
+        self
+    }
+
+    /// The combined controller; errors when a joint is driven by two parts or by none, a part
+    /// name repeats, or a joint index is out of range.
+    pub fn build(self) -> Result<CombinedController, BuildError> {
+        CombinedController::from_parts(&self.mode, &self.names, self.parts)
     }
 }

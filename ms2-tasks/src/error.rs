@@ -124,9 +124,9 @@ pub enum EnvError {
         /// The missing feature.
         feature: &'static str,
     },
-    /// The controller failed (message from the control crate).
+    /// The controller failed (the control crate's error is the source).
     #[error("controller error: {0}")]
-    Controller(String),
+    Controller(#[from] ms2_control::ControlError),
     /// Rendering failed (message from the render crate), or the scene holds something that
     /// cannot be drawn.
     #[error("render error: {0}")]

@@ -269,18 +269,17 @@ impl EnvBackend for TaskEnv {
         let mut agent_obs = DictBuilder::new();
         agent_obs.push_vector("qpos", &agent.qpos(world));
         agent_obs.push_vector("qvel", &agent.qvel(world));
-        // Target-accumulating modes also report their targets, as ManiSkill2 does.
-        let ctrl_state = agent.controller().state();
+        // Target-accumulating modes also report their targets under the key each controller
+        // names (`target_qpos`, `target_pose`), as ManiSkill2 does.
+        let ctrl_state = agent.controller().state_entries();
         if !ctrl_state.is_empty() {
             let mut ctrl = DictBuilder::new();
-            for (part, values) in ctrl_state {
-                let key = if agent.control_mode().name().starts_with("pd_ee") && part == "arm" {
-                    "target_pose"
-                } else {
-                    "target_qpos"
-                };
-                let values: Vec<f32> = values.iter().map(|&v| v as f32).collect();
-                ctrl.push(&part, DictBuilder::new().vector(key, &values).build());
+            for entry in ctrl_state {
+                let values: Vec<f32> = entry.values.iter().map(|&v| v as f32).collect();
+                ctrl.push(
+                    &entry.part,
+                    DictBuilder::new().vector(&entry.key, &values).build(),
+                );
             }
             agent_obs.push("controller", ctrl.build());
         }
@@ -343,7 +342,7 @@ impl EnvBackend for TaskEnv {
             .agent
             .controller_mut()
             .set_state(&restored)
-            .map_err(EnvError::Controller)?;
+            .map_err(|e| EnvError::Controller(e.into()))?;
         self.task.set_task_state(task_state);
         Ok(())
     }

@@ -6,6 +6,7 @@ use super::{
 };
 use crate::action::ActionBounds;
 use crate::articulation::{Articulation, DriveGains};
+use crate::combined::ConversionError;
 
 /// Configuration of a [`BaseVelocityController`].
 ///
@@ -99,26 +100,17 @@ impl PartController for BaseVelocityController {
         v[1] = s * x[0] + c * x[1];
         self.joints.set_velocity_targets(articulation, v);
     }
-    fn position_targets(&self) -> Option<Vec<f64>> {
-        None
-    }
     /// The ego-centric velocity that covers `q̄ − q` in one control period.
     fn action_for_joint_targets(
         &self,
         articulation: &dyn Articulation,
         joint_targets: &[f64],
-    ) -> PartConversion {
+    ) -> Result<PartConversion, ConversionError> {
         let world = self.joints.velocities_to_reach(articulation, joint_targets);
         let (s, c) = self.yaw(articulation).sin_cos();
         let mut ego = world.clone();
         ego[0] = c * world[0] + s * world[1];
         ego[1] = -s * world[0] + c * world[1];
-        PartConversion::from_physical(self.joints.bounds(), &ego)
-    }
-    fn state(&self) -> Vec<f64> {
-        self.joints.state()
-    }
-    fn set_state(&mut self, state: &[f64]) -> Result<(), String> {
-        self.joints.set_state(state)
+        Ok(PartConversion::from_physical(self.joints.bounds(), &ego))
     }
 }

@@ -8,9 +8,12 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use super::position_targets::PositionTargets;
 use super::{
     action_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+    STATE_KEY_TARGET_POSE,
 };
 use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
+use crate::combined::ConversionError;
+use crate::error::StateError;
 use crate::kinematics::{
     DlsIk, IkError, IkOptions, IkSolution, KinematicChain, KinematicModel, QpIk, QpIkOptions,
 };
@@ -379,7 +382,7 @@ impl PartController for EePoseController {
         &self,
         articulation: &dyn Articulation,
         joint_targets: &[f64],
-    ) -> PartConversion {
+    ) -> Result<PartConversion, ConversionError> {
         let current = gather(&articulation.qpos(), &self.chain_to_articulation);
         let mut desired = current.clone();
         for (k, &c) in self.driven_in_chain.iter().enumerate() {
@@ -417,7 +420,7 @@ impl PartController for EePoseController {
             }
             action.extend(r.iter());
         }
-        PartConversion { action, saturated }
+        Ok(PartConversion { action, saturated })
     }
 
     fn state(&self) -> Vec<f64> {
@@ -430,22 +433,33 @@ impl PartController for EePoseController {
         }
     }
 
-    fn set_state(&mut self, state: &[f64]) -> Result<(), String> {
+    /// [`STATE_KEY_TARGET_POSE`]: the accumulated target pose, `[x, y, z, qw, qx, qy, qz]`.
+    fn state_key(&self) -> &str {
+        STATE_KEY_TARGET_POSE
+    }
+
+    fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
         let expected = self.state().len();
         if state.len() != expected {
-            return Err(format!(
-                "{}: state has {} values, expected {expected} (p xyz, q wxyz)",
-                self.config.name,
-                state.len()
-            ));
+            return Err(StateError::WrongLength {
+                controller: self.config.name.clone(),
+                expected,
+                got: state.len(),
+                layout: if self.config.use_target {
+                    "target pose: p xyz in m, q wxyz, base frame".into()
+                } else {
+                    "stateless controller".into()
+                },
+            });
         }
         if self.config.use_target {
             let q = nalgebra::Quaternion::new(state[3], state[4], state[5], state[6]);
             if q.norm() <= 0.0 || q.norm().is_nan() || state.iter().any(|v| !v.is_finite()) {
-                return Err(format!(
-                    "{}: target pose state {state:?} is not a valid pose",
-                    self.config.name
-                ));
+                return Err(StateError::Invalid {
+                    controller: self.config.name.clone(),
+                    values: state.to_vec(),
+                    what: "pose (finite p xyz in m, non-zero quaternion wxyz)".into(),
+                });
             }
             self.target_pose = Isometry3::from_parts(
                 Translation3::new(state[0], state[1], state[2]),

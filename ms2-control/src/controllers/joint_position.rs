@@ -4,9 +4,12 @@
 use super::position_targets::PositionTargets;
 use super::{
     action_bounds, gather, per_joint, BuildContext, BuildError, PartController, PartConversion,
+    STATE_KEY_TARGET_QPOS,
 };
 use crate::action::ActionBounds;
 use crate::articulation::{Articulation, DriveGains};
+use crate::combined::ConversionError;
+use crate::error::StateError;
 
 /// Configuration of a [`JointPositionController`].
 #[derive(Debug, Clone, PartialEq)]
@@ -176,7 +179,7 @@ impl PartController for JointPositionController {
         &self,
         articulation: &dyn Articulation,
         joint_targets: &[f64],
-    ) -> PartConversion {
+    ) -> Result<PartConversion, ConversionError> {
         let q = gather(&articulation.qpos(), &self.joint_indices);
         let mut physical: Vec<f64> = (0..self.position_dim)
             .map(|j| match (self.config.use_delta, self.config.use_target) {
@@ -188,7 +191,7 @@ impl PartController for JointPositionController {
         if self.config.velocity_bounds.is_some() {
             physical.extend(std::iter::repeat_n(0.0, self.joint_indices.len()));
         }
-        PartConversion::from_physical(&self.bounds, &physical)
+        Ok(PartConversion::from_physical(&self.bounds, &physical))
     }
 
     fn state(&self) -> Vec<f64> {
@@ -199,14 +202,31 @@ impl PartController for JointPositionController {
         }
     }
 
-    fn set_state(&mut self, state: &[f64]) -> Result<(), String> {
+    /// [`STATE_KEY_TARGET_QPOS`]: the accumulated joint targets (rad or m).
+    fn state_key(&self) -> &str {
+        STATE_KEY_TARGET_QPOS
+    }
+
+    fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
         let expected = self.state().len();
         if state.len() != expected {
-            return Err(format!(
-                "{}: state has {} values, expected {expected}",
-                self.config.name,
-                state.len()
-            ));
+            return Err(StateError::WrongLength {
+                controller: self.config.name.clone(),
+                expected,
+                got: state.len(),
+                layout: if self.config.use_target {
+                    "target joint positions, rad or m".into()
+                } else {
+                    "stateless controller".into()
+                },
+            });
+        }
+        if let Some(index) = state.iter().position(|v| !v.is_finite()) {
+            return Err(StateError::Invalid {
+                controller: self.config.name.clone(),
+                values: state.to_vec(),
+                what: format!("joint target vector (value {index} is not finite)"),
+            });
         }
         if self.config.use_target {
             self.targets.target = state.to_vec();

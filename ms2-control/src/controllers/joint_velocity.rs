@@ -5,6 +5,7 @@ use super::{
 };
 use crate::action::ActionBounds;
 use crate::articulation::{Articulation, DriveGains};
+use crate::combined::ConversionError;
 
 /// Configuration of a [`JointVelocityController`].
 #[derive(Debug, Clone, PartialEq)]
@@ -107,30 +108,13 @@ impl PartController for JointVelocityController {
         let velocities = self.bounds.to_physical_all(action);
         self.set_velocity_targets(articulation, velocities);
     }
-    fn position_targets(&self) -> Option<Vec<f64>> {
-        None
-    }
     /// The constant velocity that covers `q̄ − q` in one control period.
     fn action_for_joint_targets(
         &self,
         articulation: &dyn Articulation,
         joint_targets: &[f64],
-    ) -> PartConversion {
+    ) -> Result<PartConversion, ConversionError> {
         let velocities = self.velocities_to_reach(articulation, joint_targets);
-        PartConversion::from_physical(&self.bounds, &velocities)
-    }
-    fn state(&self) -> Vec<f64> {
-        Vec::new()
-    }
-    fn set_state(&mut self, state: &[f64]) -> Result<(), String> {
-        if state.is_empty() {
-            Ok(())
-        } else {
-            Err(format!(
-                "{}: stateless controller got {} state values",
-                self.config.name,
-                state.len()
-            ))
-        }
+        Ok(PartConversion::from_physical(&self.bounds, &velocities))
     }
 }

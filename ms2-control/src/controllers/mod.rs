@@ -3,6 +3,11 @@
 //! A part controller owns a set of joints, turns its slice of the action into PD drive targets,
 //! and can compute the action that reproduces given joint targets (demonstration conversion).
 //! [`crate::CombinedController`] concatenates parts into one flat action.
+//!
+//! Every built-in controller implements the [`PartController`] trait, and so can a user's own
+//! controller: implement the trait and add it with
+//! [`crate::CombinedControllerBuilder::add_part`] next to built-ins added from a
+//! [`PartControllerConfig`].
 
 mod base_velocity;
 mod ee_pose;
@@ -20,7 +25,17 @@ pub use joint_velocity::{JointVelocityConfig, JointVelocityController};
 
 use crate::action::{ActionBounds, ActionScaling};
 use crate::articulation::{Articulation, DriveGains};
+use crate::combined::ConversionError;
+use crate::error::StateError;
 use crate::kinematics::{KinematicModel, KinematicsError};
+
+/// Observation key of the state of controllers that accumulate joint position targets
+/// (`pd_joint_target_delta_pos`): the target joint positions (rad or m).
+pub const STATE_KEY_TARGET_QPOS: &str = "target_qpos";
+
+/// Observation key of the state of controllers that accumulate an end-effector target pose
+/// (`pd_ee_target_delta_pos(e)`): `[x, y, z, qw, qx, qy, qz]` (m, unit quaternion), base frame.
+pub const STATE_KEY_TARGET_POSE: &str = "target_pose";
 
 /// Control and simulation rates: how many physics substeps one action lasts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -136,7 +151,7 @@ pub struct PartConversion {
 impl PartConversion {
     /// The user-facing action for physical action entries `0..physical.len()` of `bounds`,
     /// clipped into the action space; `saturated` if any entry was clipped.
-    pub(crate) fn from_physical(bounds: &ActionBounds, physical: &[f64]) -> Self {
+    pub fn from_physical(bounds: &ActionBounds, physical: &[f64]) -> Self {
         let mut saturated = false;
         let action = physical
             .iter()
@@ -151,53 +166,123 @@ impl PartConversion {
     }
 }
 
-/// A controller of one robot part.
+/// A controller of one robot part: the extension point for user controllers.
 ///
 /// Life cycle per episode: [`PartController::reset`], then per control step
 /// [`PartController::set_action`] followed by one [`PartController::before_substep`] per physics
-/// substep. Actions reach `set_action` already checked for length and finiteness.
+/// substep. Actions reach `set_action` already checked for length and finiteness (by
+/// [`crate::CombinedController::set_action`]); entries outside [`PartController::bounds`] are the
+/// controller's to clip ([`ActionBounds::to_physical`] does).
+///
+/// Required: identity ([`name`](PartController::name), [`joint_indices`](PartController::joint_indices)),
+/// action space ([`bounds`](PartController::bounds)), PD gains, `reset` and `set_action`. The
+/// rest has defaults for a stateless controller that does not support demonstration conversion.
+/// Joint indices address the articulation's dof order; resolve them from joint names with
+/// [`BuildContext::indices`] (see [`crate::CombinedControllerBuilder::context`]).
+///
+/// ```
+/// use ms2_control::controllers::{PartController, STATE_KEY_TARGET_QPOS};
+/// use ms2_control::{ActionBounds, ActionScaling, Articulation, DriveGains};
+///
+/// /// Holds one joint at an absolute angle given in degrees.
+/// #[derive(Debug)]
+/// struct Degrees { joint: [usize; 1], bounds: ActionBounds }
+///
+/// impl PartController for Degrees {
+///     fn name(&self) -> &str { "wrist_degrees" }
+///     fn joint_indices(&self) -> &[usize] { &self.joint }
+///     fn bounds(&self) -> &ActionBounds { &self.bounds }
+///     fn drive_gains(&self) -> Vec<DriveGains> { vec![DriveGains::MANISKILL2_DEFAULT] }
+///     fn reset(&mut self, robot: &mut dyn Articulation) {
+///         let q = robot.qpos()[self.joint[0]];
+///         robot.set_drive_position_targets(&self.joint, &[q]);
+///     }
+///     fn set_action(&mut self, robot: &mut dyn Articulation, action: &[f64]) {
+///         let deg = self.bounds.to_physical(0, action[0]);
+///         robot.set_drive_position_targets(&self.joint, &[deg.to_radians()]);
+///     }
+/// }
+/// let c = Degrees {
+///     joint: [0],
+///     bounds: ActionBounds { low: vec![-90.0], high: vec![90.0], scaling: ActionScaling::Physical },
+/// };
+/// assert!(c.state().is_empty());
+/// assert_eq!(c.state_key(), "state");
+/// # let _ = STATE_KEY_TARGET_QPOS;
+/// ```
 pub trait PartController: std::fmt::Debug + Send + Sync {
-    /// ManiSkill2 name of the controller, e.g. `arm_pd_ee_delta_pose`.
+    /// Name of the controller, e.g. `arm_pd_ee_delta_pose` (used in error messages).
     fn name(&self) -> &str;
 
-    /// Articulation indices of the driven joints.
+    /// Articulation indices (dof order) of the driven joints.
     fn joint_indices(&self) -> &[usize];
 
-    /// Physical bounds and scaling of this part's action.
+    /// Physical bounds and scaling of this part's action (its length is the part's action dim).
     fn bounds(&self) -> &ActionBounds;
 
-    /// Drive gains per driven joint (applied at reset).
+    /// Drive gains per driven joint (`joint_indices` order), applied by
+    /// [`crate::CombinedController::reset`] before [`PartController::reset`].
     fn drive_gains(&self) -> Vec<DriveGains>;
 
-    /// Resets the controller's internal targets to the articulation's current state.
+    /// Resets the controller's internal targets to the articulation's current state (typically:
+    /// position targets := current `qpos`, velocity targets := 0).
     fn reset(&mut self, articulation: &mut dyn Articulation);
 
-    /// Interprets `action` (this part's slice) and sets drive targets.
+    /// Interprets `action` (this part's slice of the flat action, user-facing units) and sets
+    /// drive targets.
     fn set_action(&mut self, articulation: &mut dyn Articulation, action: &[f64]);
 
-    /// Called before each physics substep of the control step.
+    /// Called before each physics substep of the control step (default: nothing).
     fn before_substep(&mut self, _articulation: &mut dyn Articulation) {}
 
-    /// Current drive position targets of the driven joints (`joint_indices` order), if this part
-    /// drives positions.
-    fn position_targets(&self) -> Option<Vec<f64>>;
+    /// Current drive position targets of the driven joints (`joint_indices` order, rad or m), if
+    /// this part drives positions (default: `None`).
+    fn position_targets(&self) -> Option<Vec<f64>> {
+        None
+    }
 
     /// The action that would make this part's drive targets equal `joint_targets` (positions,
-    /// `joint_indices` order), given the articulation's current state; closed-loop conversion.
+    /// `joint_indices` order, rad or m), given the articulation's current state; closed-loop
+    /// demonstration conversion. Default: [`ConversionError::Unsupported`].
     fn action_for_joint_targets(
         &self,
-        articulation: &dyn Articulation,
-        joint_targets: &[f64],
-    ) -> PartConversion;
+        _articulation: &dyn Articulation,
+        _joint_targets: &[f64],
+    ) -> Result<PartConversion, ConversionError> {
+        Err(ConversionError::Unsupported {
+            controller: self.name().to_string(),
+        })
+    }
 
     /// Internal state that target-accumulating controllers carry between steps (flat); empty
-    /// for stateless controllers.
-    fn state(&self) -> Vec<f64>;
+    /// for stateless controllers (the default).
+    fn state(&self) -> Vec<f64> {
+        Vec::new()
+    }
 
-    /// Restores a state returned by [`PartController::state`]; errors on a length mismatch.
-    fn set_state(&mut self, state: &[f64]) -> Result<(), String>;
+    /// Observation key of [`PartController::state`]: [`STATE_KEY_TARGET_QPOS`] for joint-target
+    /// controllers, [`STATE_KEY_TARGET_POSE`] for end-effector target-pose controllers; default
+    /// `"state"`.
+    fn state_key(&self) -> &str {
+        "state"
+    }
 
-    /// Outcome of the last IK solve, for controllers that use IK.
+    /// Restores a state returned by [`PartController::state`]. The default accepts only the
+    /// empty state of a stateless controller.
+    fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
+        if state.is_empty() {
+            Ok(())
+        } else {
+            Err(StateError::WrongLength {
+                controller: self.name().to_string(),
+                expected: 0,
+                got: state.len(),
+                layout: "stateless controller".into(),
+            })
+        }
+    }
+
+    /// Outcome of the last IK solve, for controllers that use IK (default: `None`).
     fn last_ik_report(&self) -> Option<IkReport> {
         None
     }

@@ -1,9 +1,13 @@
 //! Inverse kinematics: damped least squares (faer) and a box-constrained QP (clarabel).
 //!
-//! Both solvers iterate from a seed joint vector, linearising the chain at each iterate with the
-//! base-frame geometric Jacobian and the pose error `[p* − p; log(R* Rᵀ)]`. They return
-//! [`IkSolution`] only when the tip is within the tolerances of the target; otherwise
-//! [`IkError::NotConverged`] carries the best joint vector found and its residual, so a caller can
+//! Both solvers work on any [`KinematicChain`] (any URDF, any number of joints) and iterate from a
+//! seed joint vector, linearising the chain at each iterate with the base-frame geometric Jacobian
+//! and the pose error `[p* − p; log(R* Rᵀ)]`. The target is an [`IkTarget`]: a full pose, a
+//! position only, or a partial target whose six dimensions are weighted (0 = free) along base or
+//! target axes ([`TaskWeights`](super::TaskWeights)); only the constrained rows of the Jacobian
+//! and error enter the step. They return [`IkSolution`] only when the tip is within the
+//! tolerances of the target on the constrained dimensions; otherwise [`IkError::NotConverged`]
+//! carries the best joint vector found and its residual, so a caller can
 //! decide what to do with an unreachable target instead of receiving a silently wrong answer.
 
 use clarabel::algebra::CscMatrix;
@@ -12,12 +16,12 @@ use clarabel::solver::{
 };
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
-use nalgebra::{Isometry3, Matrix6xX, Vector6};
+use nalgebra::{DMatrix, DVector, Isometry3, Matrix6xX};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::chain::KinematicChain;
-use super::pose_error::pose_error;
+use super::target::{IkTarget, Task};
 use super::KinematicsError;
 
 /// Settings shared by both IK solvers.
@@ -63,9 +67,11 @@ pub struct IkSolution {
     pub q: Vec<f64>,
     /// Iterations used in the attempt that produced `q`.
     pub iterations: usize,
-    /// Remaining tip position error (m).
+    /// Remaining tip position error (m) over the constrained translation dimensions (the full
+    /// distance for pose and position targets).
     pub position_error_m: f64,
-    /// Remaining tip orientation error (rad).
+    /// Remaining tip orientation error (rad) over the constrained rotation dimensions (the full
+    /// angle for pose targets, 0 for position targets).
     pub rotation_error_rad: f64,
 }
 
@@ -106,9 +112,23 @@ pub enum IkError {
         /// Whether a joint position or step bound held the best iterate.
         limits_active: bool,
     },
-    /// The QP solver reported a failure.
-    #[error("linear or QP solver failed: {0}")]
-    SolverFailed(String),
+    /// The target's task weights are not usable.
+    #[error(
+        "IK task weights {weights:?} are invalid: each must be finite and >= 0, and at least one > 0"
+    )]
+    BadWeights {
+        /// The weights given (`[x, y, z, rx, ry, rz]`).
+        weights: [f64; 6],
+    },
+    /// The linear (Cholesky) or QP solver failed; the solver's error is the source.
+    #[error("{solver} failed: {source}")]
+    SolverFailed {
+        /// Which solver step failed, e.g. `Cholesky of J·Jᵀ + λ²I` or `clarabel QP`.
+        solver: &'static str,
+        /// The solver's error.
+        #[source]
+        source: crate::ErrorSource,
+    },
 }
 
 impl IkError {
@@ -127,12 +147,13 @@ struct StepBounds {
     upper: Vec<f64>,
 }
 
-/// A rule computing one IK step from the Jacobian (free columns only) and the error.
+/// A rule computing one IK step from the task Jacobian (constrained rows, free columns) and the
+/// weighted task error.
 trait StepRule {
     fn step(
         &mut self,
-        jac: &Matrix6xX<f64>,
-        err: &Vector6<f64>,
+        jac: &DMatrix<f64>,
+        err: &DVector<f64>,
         bounds: &StepBounds,
         damping: f64,
     ) -> Result<Vec<f64>, IkError>;
@@ -152,14 +173,17 @@ fn check_per_joint_len<T>(chain: &KinematicChain, values: Option<&[T]>) -> Resul
 
 fn check_inputs(
     chain: &KinematicChain,
-    target: &Isometry3<f64>,
+    target: &IkTarget,
     seed: &[f64],
     free: Option<&[bool]>,
 ) -> Result<(), IkError> {
-    let finite = target.translation.vector.iter().all(|v| v.is_finite())
-        && target.rotation.coords.iter().all(|v| v.is_finite());
-    if !finite {
-        return Err(IkError::NonFiniteTarget(*target));
+    if !target.is_finite() {
+        return Err(IkError::NonFiniteTarget(target.pose));
+    }
+    if !target.weights.is_valid() {
+        return Err(IkError::BadWeights {
+            weights: target.weights.weights,
+        });
     }
     chain.forward_kinematics(seed)?;
     check_per_joint_len(chain, free)
@@ -172,7 +196,7 @@ fn check_inputs(
 #[allow(clippy::too_many_arguments)]
 fn attempt(
     chain: &KinematicChain,
-    target: &Isometry3<f64>,
+    task: &Task,
     start: &[f64],
     free: &[usize],
     lower_abs: &[f64],
@@ -189,26 +213,27 @@ fn attempt(
     let n = chain.dof();
     let mut q = start.to_vec();
     let mut jac_full = Matrix6xX::zeros(n);
-    let mut jac = Matrix6xX::zeros(free.len());
+    let mut jac_free = Matrix6xX::zeros(free.len());
+    let mut jac = DMatrix::zeros(task.dim(), free.len());
     let mut candidate_jac = Matrix6xX::zeros(n);
     let pose = chain.pose_and_jacobian_into(&q, &mut jac_full);
-    let mut e = pose_error(&pose, target);
-    let score = |e: &super::PoseError| e.position_norm() + e.rotation_angle();
+    let mut e = task.residual(&pose);
+    let score = |e: &super::target::Residual| e.score;
     let mut damping = opts.damping;
     let mut iterations = 0;
     let at_bound = |q: &[f64]| {
         free.iter()
             .any(|&j| (q[j] - lower_abs[j]).abs() < 1e-7 || (upper_abs[j] - q[j]).abs() < 1e-7)
     };
-    let converged = |e: &super::PoseError| {
-        e.position_norm() <= opts.position_tolerance_m
-            && e.rotation_angle() <= opts.rotation_tolerance_rad
+    let converged = |e: &super::target::Residual| {
+        e.position_m <= opts.position_tolerance_m && e.rotation_rad <= opts.rotation_tolerance_rad
     };
     while !converged(&e) && iterations < opts.max_iterations {
         iterations += 1;
         for (k, &j) in free.iter().enumerate() {
-            jac.set_column(k, &jac_full.column(j));
+            jac_free.set_column(k, &jac_full.column(j));
         }
+        task.jacobian_into(&jac_free, &mut jac);
         let bounds = StepBounds {
             lower: free
                 .iter()
@@ -219,7 +244,7 @@ fn attempt(
                 .map(|&j| (upper_abs[j] - q[j]).min(opts.max_step).max(0.0))
                 .collect(),
         };
-        let mut dq = rule.step(&jac, &e.as_vector(), &bounds, damping)?;
+        let mut dq = rule.step(&jac, &e.weighted, &bounds, damping)?;
         // Uniform scaling keeps the step direction when it is too long.
         let longest = dq.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         if longest > opts.max_step {
@@ -232,7 +257,7 @@ fn attempt(
         }
         let moved = candidate.iter().zip(&q).any(|(a, b)| (a - b).abs() > 1e-15);
         let candidate_pose = chain.pose_and_jacobian_into(&candidate, &mut candidate_jac);
-        let candidate_e = pose_error(&candidate_pose, target);
+        let candidate_e = task.residual(&candidate_pose);
         if moved && score(&candidate_e) < score(&e) {
             // Accepted steps that no longer reduce the error (an unreachable target's closest
             // point) end the attempt early.
@@ -261,8 +286,8 @@ fn attempt(
     let solution = IkSolution {
         q,
         iterations,
-        position_error_m: e.position_norm(),
-        rotation_error_rad: e.rotation_angle(),
+        position_error_m: e.position_m,
+        rotation_error_rad: e.rotation_rad,
     };
     Ok((solution, done, active))
 }
@@ -270,7 +295,7 @@ fn attempt(
 #[allow(clippy::too_many_arguments)]
 fn solve_with(
     chain: &KinematicChain,
-    target: &Isometry3<f64>,
+    target: &IkTarget,
     seed: &[f64],
     free: Option<&[bool]>,
     opts: &IkOptions,
@@ -279,6 +304,7 @@ fn solve_with(
 ) -> Result<IkSolution, IkError> {
     check_per_joint_len(chain, step_limit)?;
     check_inputs(chain, target, seed, free)?;
+    let task = Task::new(target);
     let n = chain.dof();
     let free_idx: Vec<usize> = (0..n).filter(|&j| free.is_none_or(|m| m[j])).collect();
     let limits = chain.limits();
@@ -313,7 +339,7 @@ fn solve_with(
         .map(|(j, &v)| v.clamp(lower_abs[j], upper_abs[j]))
         .collect();
     let (mut best, converged, mut limits_active) = attempt(
-        chain, target, &start, &free_idx, &lower_abs, &upper_abs, opts, rule,
+        chain, &task, &start, &free_idx, &lower_abs, &upper_abs, opts, rule,
     )?;
     if converged {
         return Ok(best);
@@ -336,7 +362,7 @@ fn solve_with(
             })
             .collect();
         let (sol, conv, active) = attempt(
-            chain, target, &start, &free_idx, &lower_abs, &upper_abs, opts, rule,
+            chain, &task, &start, &free_idx, &lower_abs, &upper_abs, opts, rule,
         )?;
         if conv {
             return Ok(sol);
@@ -385,30 +411,31 @@ impl StepRule for DlsRule {
     /// are removed from the Jacobian and the step is recomputed for the others.
     fn step(
         &mut self,
-        jac: &Matrix6xX<f64>,
-        err: &Vector6<f64>,
+        jac: &DMatrix<f64>,
+        err: &DVector<f64>,
         bounds: &StepBounds,
         damping: f64,
     ) -> Result<Vec<f64>, IkError> {
-        let n = jac.ncols();
+        let (m, n) = jac.shape();
         let mut active = vec![true; n];
         let mut dq = vec![0.0; n];
         for _ in 0..n {
-            let mut jjt = nalgebra::Matrix6::<f64>::zeros();
+            let mut jjt = DMatrix::<f64>::zeros(m, m);
             for k in (0..n).filter(|&k| active[k]) {
                 let c = jac.column(k);
                 jjt += c * c.transpose();
             }
             let lambda2 = damping * damping;
-            let a = Mat::<f64>::from_fn(6, 6, |i, j| {
+            let a = Mat::<f64>::from_fn(m, m, |i, j| {
                 jjt[(i, j)] + if i == j { lambda2 } else { 0.0 }
             });
-            let mut rhs = Mat::<f64>::from_fn(6, 1, |i, _| err[i]);
-            let llt = a.llt(Side::Lower).map_err(|e| {
-                IkError::SolverFailed(format!("Cholesky of J·Jᵀ + λ²I failed: {e:?}"))
+            let mut rhs = Mat::<f64>::from_fn(m, 1, |i, _| err[i]);
+            let llt = a.llt(Side::Lower).map_err(|e| IkError::SolverFailed {
+                solver: "Cholesky of J·Jᵀ + λ²I",
+                source: crate::ErrorSource::new(e),
             })?;
             llt.solve_in_place(rhs.as_mut());
-            let y = Vector6::from_fn(|i, _| rhs[(i, 0)]);
+            let y = DVector::from_fn(m, |i, _| rhs[(i, 0)]);
             let mut blocked = false;
             for k in 0..n {
                 dq[k] = if active[k] {
@@ -437,14 +464,43 @@ impl DlsIk {
         Self { options }
     }
 
-    /// Joint vector (chain order) that puts the chain tip at `target` (`pose_base_from_tip`).
+    /// Joint vector (chain order) that puts the chain tip at the pose `target`
+    /// (`pose_base_from_tip`, chain base frame), all six dimensions constrained.
     ///
     /// `seed` is the starting joint vector (chain order); `free` optionally marks which joints may
-    /// move (the others stay at their seed value).
+    /// move (the others stay at their seed value). Same as
+    /// [`DlsIk::solve_target`] with [`IkTarget::pose`].
     pub fn solve(
         &self,
         chain: &KinematicChain,
         target: &Isometry3<f64>,
+        seed: &[f64],
+        free: Option<&[bool]>,
+    ) -> Result<IkSolution, IkError> {
+        self.solve_target(chain, &IkTarget::pose(*target), seed, free)
+    }
+
+    /// Joint vector (chain order) that brings the chain tip onto `target`: a full pose, a position
+    /// only, or a partial target (see [`IkTarget`], [`TaskWeights`](super::TaskWeights)); `seed`
+    /// and `free` as in [`DlsIk::solve`].
+    ///
+    /// ```
+    /// use ms2_control::nalgebra::Vector3;
+    /// use ms2_control::{DlsIk, IkOptions, IkTarget, KinematicModel};
+    /// let model = KinematicModel::from_urdf_str(ms2_assets::PANDA_URDF).unwrap();
+    /// let chain = model.chain_to("panda_hand_tcp").unwrap();
+    /// let rest = [0.0, 0.39, 0.0, -1.96, 0.0, 2.36, 0.79];
+    /// let goal = Vector3::new(0.4, 0.2, 0.3); // m, base frame; any orientation
+    /// let sol = DlsIk::new(IkOptions::default())
+    ///     .solve_target(&chain, &IkTarget::position(goal), &rest, None)
+    ///     .unwrap();
+    /// let reached = chain.forward_kinematics(&sol.q).unwrap();
+    /// assert!((reached.translation.vector - goal).norm() < 1e-4);
+    /// ```
+    pub fn solve_target(
+        &self,
+        chain: &KinematicChain,
+        target: &IkTarget,
         seed: &[f64],
         free: Option<&[bool]>,
     ) -> Result<IkSolution, IkError> {
@@ -494,8 +550,8 @@ struct QpRule;
 impl StepRule for QpRule {
     fn step(
         &mut self,
-        jac: &Matrix6xX<f64>,
-        err: &Vector6<f64>,
+        jac: &DMatrix<f64>,
+        err: &DVector<f64>,
         bounds: &StepBounds,
         damping: f64,
     ) -> Result<Vec<f64>, IkError> {
@@ -541,13 +597,27 @@ impl StepRule for QpRule {
             .verbose(false)
             .presolve_enable(false)
             .build()
-            .map_err(|e| IkError::SolverFailed(e.to_string()))?;
-        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings)
-            .map_err(|e| IkError::SolverFailed(e.to_string()))?;
+            .map_err(|e| IkError::SolverFailed {
+                solver: "clarabel settings",
+                source: crate::ErrorSource::new(e),
+            })?;
+        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).map_err(|e| {
+            IkError::SolverFailed {
+                solver: "clarabel QP setup",
+                source: crate::ErrorSource::new(e),
+            }
+        })?;
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => {}
-            other => return Err(IkError::SolverFailed(format!("clarabel status {other:?}"))),
+            other => {
+                return Err(IkError::SolverFailed {
+                    solver: "clarabel QP",
+                    source: crate::ErrorSource::message(format!(
+                        "solver status {other:?}, expected Solved"
+                    )),
+                })
+            }
         }
         // The interior-point solution can sit a hair outside the box: project it back.
         Ok(solver
@@ -566,12 +636,25 @@ impl QpIk {
         Self { options }
     }
 
-    /// Joint vector (chain order) that puts the chain tip at `target` (`pose_base_from_tip`),
-    /// respecting joint limits and the displacement bound; see [`DlsIk::solve`] for `seed`/`free`.
+    /// Joint vector (chain order) that puts the chain tip at the pose `target`
+    /// (`pose_base_from_tip`), respecting joint limits and the displacement bound; see
+    /// [`DlsIk::solve`] for `seed`/`free`.
     pub fn solve(
         &self,
         chain: &KinematicChain,
         target: &Isometry3<f64>,
+        seed: &[f64],
+        free: Option<&[bool]>,
+    ) -> Result<IkSolution, IkError> {
+        self.solve_target(chain, &IkTarget::pose(*target), seed, free)
+    }
+
+    /// As [`QpIk::solve`] for a full, position-only or partial [`IkTarget`] (see
+    /// [`DlsIk::solve_target`]).
+    pub fn solve_target(
+        &self,
+        chain: &KinematicChain,
+        target: &IkTarget,
         seed: &[f64],
         free: Option<&[bool]>,
     ) -> Result<IkSolution, IkError> {

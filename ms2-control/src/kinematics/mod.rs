@@ -9,6 +9,7 @@ mod chain;
 mod ik;
 mod model;
 mod pose_error;
+mod target;
 
 pub use chain::KinematicChain;
 pub use ik::{DlsIk, IkError, IkOptions, IkSolution, QpIk, QpIkOptions};
@@ -16,13 +17,14 @@ pub use model::{
     pose_from_xyz_rpy, Joint, JointDescription, JointKind, JointLimits, KinematicModel, LinkId,
 };
 pub use pose_error::{pose_error, PoseError};
+pub use target::{IkTarget, TaskFrame, TaskWeights};
 
 /// Errors of model construction and kinematic queries.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum KinematicsError {
-    /// The URDF text could not be parsed.
+    /// The URDF text could not be parsed; the parser's error is the source.
     #[error("cannot parse URDF: {0}")]
-    Urdf(String),
+    Urdf(#[source] crate::ErrorSource),
     /// A URDF joint type other than revolute, continuous, prismatic or fixed.
     #[error(
         "joint `{joint}` has type {joint_type}; supported: revolute, continuous, prismatic, fixed"

@@ -228,8 +228,8 @@ impl KinematicModel {
     /// assert_eq!(model.dof(), 9); // 7 arm joints + 2 fingers
     /// ```
     pub fn from_urdf_str(urdf: &str) -> Result<Self, KinematicsError> {
-        let robot =
-            urdf_rs::read_from_string(urdf).map_err(|e| KinematicsError::Urdf(e.to_string()))?;
+        let robot = urdf_rs::read_from_string(urdf)
+            .map_err(|e| KinematicsError::Urdf(crate::ErrorSource::new(e)))?;
         let mut joints = Vec::with_capacity(robot.joints.len());
         for j in &robot.joints {
             let kind = match j.joint_type {

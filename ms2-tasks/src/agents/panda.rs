@@ -44,9 +44,9 @@ pub const PANDA_BUCKET: RobotSpec = RobotSpec {
 
 /// The Panda's controller configuration (parsed once per process).
 pub fn panda_robot_config() -> Result<&'static RobotConfig, EnvError> {
-    static CONFIG: OnceLock<Result<RobotConfig, String>> = OnceLock::new();
+    static CONFIG: OnceLock<Result<RobotConfig, ms2_control::ControlError>> = OnceLock::new();
     CONFIG
-        .get_or_init(|| RobotConfig::panda(ms2_assets::PANDA_URDF).map_err(|e| e.to_string()))
+        .get_or_init(|| RobotConfig::panda(ms2_assets::PANDA_URDF).map_err(Into::into))
         .as_ref()
         .map_err(|e| EnvError::Controller(e.clone()))
 }
@@ -122,7 +122,7 @@ impl PandaAgent {
             let view = PhysicsArticulation::new(world, art);
             robot
                 .build_controller(mode, &view, timing)
-                .map_err(|e| EnvError::Controller(e.to_string()))?
+                .map_err(|e| EnvError::Controller(e.into()))?
         };
         let finger =
             |world: &dyn RigidWorld, link: &str, joint: &str| -> Result<Finger, EnvError> {
@@ -275,7 +275,7 @@ impl Agent for PandaAgent {
         let mut view = PhysicsArticulation::new(world, self.articulation);
         self.controller
             .set_action(&mut view, &self.action_f64)
-            .map_err(|e| EnvError::Controller(e.to_string()))
+            .map_err(|e| EnvError::Controller(e.into()))
     }
 
     /// Lets the controller update drive targets before one physics substep.

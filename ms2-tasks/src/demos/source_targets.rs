@@ -59,14 +59,14 @@ impl SourceJointTargets {
             .ok_or_else(|| unsupported(source, cfg, "the env has no robot"))?;
         let articulation = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation());
         let robot = RobotConfig::panda(ms2_assets::PANDA_URDF)
-            .map_err(|e| DemoError::Env(EnvError::Controller(e.to_string())))?;
+            .map_err(|e| DemoError::Env(EnvError::Controller(e.into())))?;
         let timing = ControlTiming {
             control_freq_hz: cfg.control_freq,
             sim_freq_hz: cfg.sim_freq,
         };
         let controller = robot
             .build_controller(mode, &articulation, timing)
-            .map_err(|e| DemoError::Env(EnvError::Controller(e.to_string())))?;
+            .map_err(|e| DemoError::Env(EnvError::Controller(e.into())))?;
         let action_f64 = vec![0.0; controller.action_dim()];
         let mut this = Self {
             controller,
@@ -158,7 +158,7 @@ impl SourceJointTargets {
         }
         self.controller
             .set_action(&mut self.articulation, &self.action_f64)
-            .map_err(|e| DemoError::Env(EnvError::Controller(e.to_string())))?;
+            .map_err(|e| DemoError::Env(EnvError::Controller(e.into())))?;
         let targets = self.controller.position_targets();
         targets
             .iter()
