@@ -81,7 +81,9 @@ impl KinematicWorld {
     }
 
     fn body_mut(&mut self, body: BodyId) -> PortResult<&mut Body> {
-        self.bodies.get_mut(body.index()).ok_or_else(|| no_body(body))
+        self.bodies
+            .get_mut(body.index())
+            .ok_or_else(|| no_body(body))
     }
 
     fn art(&self, art: ArticulationId) -> PortResult<&Articulation> {
@@ -109,11 +111,9 @@ impl KinematicWorld {
                         Translation3::identity(),
                         UnitQuaternion::from_scaled_axis(joint.axis * q),
                     ),
-                    JointType::Prismatic => Pose3::translation(
-                        joint.axis.x * q,
-                        joint.axis.y * q,
-                        joint.axis.z * q,
-                    ),
+                    JointType::Prismatic => {
+                        Pose3::translation(joint.axis.x * q, joint.axis.y * q, joint.axis.z * q)
+                    }
                     JointType::Fixed => Pose3::identity(),
                 };
                 poses[link] = poses[joint.parent_link] * joint.pose_parent_from_joint * motion;
@@ -401,7 +401,12 @@ impl RigidWorld for KinematicWorld {
     }
 
     fn joint_infos(&self, art: ArticulationId) -> PortResult<Vec<&JointInfo>> {
-        Ok(self.art(art)?.joints.iter().filter(|j| j.dof.is_some()).collect())
+        Ok(self
+            .art(art)?
+            .joints
+            .iter()
+            .filter(|j| j.dof.is_some())
+            .collect())
     }
 
     fn joint_names(&self, art: ArticulationId) -> PortResult<Vec<&str>> {
@@ -421,7 +426,12 @@ impl RigidWorld for KinematicWorld {
     }
 
     fn link_names(&self, art: ArticulationId) -> PortResult<Vec<&str>> {
-        Ok(self.art(art)?.link_names.iter().map(String::as_str).collect())
+        Ok(self
+            .art(art)?
+            .link_names
+            .iter()
+            .map(String::as_str)
+            .collect())
     }
 
     fn link_index(&self, art: ArticulationId, link: &str) -> PortResult<usize> {

@@ -5,7 +5,6 @@
 //! `scripts/test_add_family.sh` does that and reaches it from `gym.make` and `ms2 run`).
 
 use ms2_tasks::config::ObsMode;
-use ms2_tasks::Env;
 use ms2_tasks::error::EnvError;
 use ms2_tasks::geometry::{vectorize_pose, Pose3};
 use ms2_tasks::info::{Evaluation, InfoValue};
@@ -17,6 +16,7 @@ use ms2_tasks::scripted::{tcp_oracle, ScriptedPolicy};
 use ms2_tasks::seeding::EpisodeRng;
 use ms2_tasks::spec::{RobotChoice, TaskSpec};
 use ms2_tasks::task::{Task, TaskScene};
+use ms2_tasks::Env;
 use nalgebra::Vector3;
 use rand::Rng;
 
@@ -55,7 +55,11 @@ pub struct ReachGoal {
 
 impl ReachGoal {
     fn distance(&self, scene: &TaskScene) -> f32 {
-        let tcp = scene.agent.tcp_pose(scene.world.as_ref()).translation.vector;
+        let tcp = scene
+            .agent
+            .tcp_pose(scene.world.as_ref())
+            .translation
+            .vector;
         (tcp - self.goal).norm()
     }
 }
