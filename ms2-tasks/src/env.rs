@@ -85,6 +85,12 @@ impl Env {
         let spec = registration.spec;
         let obs_mode = ObsMode::parse(&cfg.obs_mode)?;
         if !spec.supports_obs_mode(obs_mode) {
+            if obs_mode.visual().is_some() {
+                return Err(EnvError::NotRenderable {
+                    env_id: cfg.env_id.clone(),
+                    reason: "it has no 3D scene; use obs_mode state or state_dict".to_owned(),
+                });
+            }
             return Err(EnvError::UnknownObsMode {
                 got: cfg.obs_mode.clone(),
                 valid: supported_obs_modes(&spec),
