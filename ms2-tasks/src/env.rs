@@ -36,6 +36,7 @@ pub struct StepOutput {
 /// One environment: a task's simulation plus seeding, rewards, observations and episode limits.
 ///
 /// ```
+/// # #[cfg(feature = "rapier")] {
 /// use ms2_tasks::{make_env, EnvConfig};
 /// let mut env = make_env(&EnvConfig::new("Dummy-v0")).unwrap();
 /// let (obs, _info) = env.reset(Some(0), false).unwrap();
@@ -43,6 +44,7 @@ pub struct StepOutput {
 /// let out = env.step(&action).unwrap();
 /// assert_eq!(env.elapsed_steps(), 1);
 /// assert!(obs.get("agent/qpos").is_some() && !out.truncated);
+/// # }
 /// ```
 pub struct Env {
     cfg: EnvConfig,

@@ -37,12 +37,14 @@ pub enum EnvCommand<'a> {
 /// fusion, robot masks) in parallel. The images equal those of stepping each env alone.
 ///
 /// ```
+/// # #[cfg(feature = "rapier")] {
 /// use ms2_tasks::{EnvConfig, VecEnv};
 /// let mut venv = VecEnv::new(&EnvConfig::new("Dummy-v0"), 2).unwrap();
 /// venv.reset(&[Some(0), Some(1)]).unwrap();
 /// let dim = venv.envs()[0].action_space().size();
 /// let outs = venv.step(&vec![0.0; 2 * dim]).unwrap();
 /// assert_eq!(outs.len(), 2);
+/// # }
 /// ```
 #[derive(Debug)]
 pub struct VecEnv {
