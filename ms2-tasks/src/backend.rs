@@ -12,7 +12,8 @@ use crate::seeding::EpisodeRng;
 use crate::spaces::BoxSpace;
 use crate::task::TaskScene;
 
-/// A simulation the [`crate::Env`] runtime drives.
+/// A simulation the [`crate::Env`] runtime drives. The render hooks exist with the `render`
+/// feature only.
 pub(crate) trait EnvBackend: Send {
     /// Control modes supported by the robot.
     fn control_modes(&self) -> Vec<String>;
@@ -49,11 +50,13 @@ pub(crate) trait EnvBackend: Send {
     /// Restores a state (length and finiteness already checked).
     fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError>;
     /// Renders the observation cameras (robot tasks only).
+    #[cfg(feature = "render")]
     fn capture_cameras(&self) -> Result<crate::sensors::CameraFrame, EnvError> {
         Err(self.not_renderable())
     }
     /// The observation sensors (built on first use) and the world they see, for batched
     /// rendering across envs (robot tasks only).
+    #[cfg(feature = "render")]
     fn sensors_mut(
         &mut self,
     ) -> Result<
@@ -67,18 +70,22 @@ pub(crate) trait EnvBackend: Send {
     }
     /// Renders the human view with a goal marker at the `extra` entry `goal_key` (robot tasks
     /// only).
+    #[cfg(feature = "render")]
     fn render_human(&self, _goal_key: Option<&str>) -> Result<ms2_render::CameraOutput, EnvError> {
         Err(self.not_renderable())
     }
     /// Channel-1 segmentation ids by object name (robot tasks only).
+    #[cfg(feature = "render")]
     fn segmentation_ids(&self) -> Result<Vec<(String, u32)>, EnvError> {
         Err(self.not_renderable())
     }
     /// Triangles drawn per observation camera (0 before the first render).
+    #[cfg(feature = "render")]
     fn triangles_per_camera(&self) -> usize {
         0
     }
     /// The error of the render calls of a backend without a scene.
+    #[cfg(feature = "render")]
     fn not_renderable(&self) -> EnvError {
         EnvError::NotRenderable {
             env_id: "Dummy-v0".to_owned(),

@@ -36,6 +36,7 @@ pub struct StepOutput {
 /// One environment: a task's simulation plus seeding, rewards, observations and episode limits.
 ///
 /// ```
+/// # #[cfg(feature = "rapier")] {
 /// use ms2_tasks::{make_env, EnvConfig};
 /// let mut env = make_env(&EnvConfig::new("Dummy-v0")).unwrap();
 /// let (obs, _info) = env.reset(Some(0), false).unwrap();
@@ -43,6 +44,7 @@ pub struct StepOutput {
 /// let out = env.step(&action).unwrap();
 /// assert_eq!(env.elapsed_steps(), 1);
 /// assert!(obs.get("agent/qpos").is_some() && !out.truncated);
+/// # }
 /// ```
 pub struct Env {
     cfg: EnvConfig,
@@ -97,10 +99,7 @@ impl Env {
             });
         }
         if obs_mode.visual().is_some() && !cfg!(feature = "render") {
-            return Err(EnvError::FeatureDisabled {
-                what: format!("obs_mode {:?}", cfg.obs_mode),
-                feature: "render",
-            });
+            return Err(render_disabled(format!("obs_mode {:?}", cfg.obs_mode)));
         }
         let reward_mode =
             RewardMode::parse(cfg.reward_mode.as_deref().unwrap_or("normalized_dense"))?;
@@ -110,6 +109,9 @@ impl Env {
                     got: rm.clone(),
                     valid: RENDER_MODES.iter().map(|s| s.to_string()).collect(),
                 });
+            }
+            if !cfg!(feature = "render") {
+                return Err(render_disabled(format!("render_mode {rm:?}")));
             }
         }
         if cfg.max_episode_steps == Some(0) {
@@ -228,18 +230,21 @@ impl Env {
     }
 
     /// The visual layout of the obs mode and whether it adds a robot mask; `None` in state modes.
+    #[cfg(feature = "render")]
     pub(crate) fn visual_layout(&self) -> Option<(crate::sensors::VisualLayout, bool)> {
         self.obs_mode.visual()
     }
 
     /// Synchronises the render scene with the world and returns the observation cameras at
     /// their current poses (for batched rendering; see [`crate::sensors::capture_batch`]).
+    #[cfg(feature = "render")]
     pub(crate) fn prepare_cameras(&mut self) -> Result<Vec<ms2_render::Camera>, EnvError> {
         let (sensors, world) = self.backend.sensors_mut()?;
         sensors.prepare(world)
     }
 
     /// The env's sensors (built on first use).
+    #[cfg(feature = "render")]
     pub(crate) fn sensors(&mut self) -> Result<&crate::sensors::Sensors, EnvError> {
         Ok(self.backend.sensors_mut()?.0)
     }
@@ -305,9 +310,13 @@ impl Env {
         info
     }
 
-    /// The current observation in the env's obs mode, rendering the cameras in visual modes.
+    /// The current observation in the env's obs mode, rendering the cameras in visual modes
+    /// (feature `render`; without it an env in a visual mode cannot be made).
     pub fn try_observe(&self) -> Result<ObsValue, EnvError> {
         match self.obs_mode.visual() {
+            #[cfg(not(feature = "render"))]
+            Some(_) => Err(render_disabled(format!("obs_mode {:?}", self.cfg.obs_mode))),
+            #[cfg(feature = "render")]
             Some((layout, robot_seg)) => {
                 let frame = self.backend.capture_cameras()?;
                 Ok(crate::sensors::visual_obs::assemble(
@@ -457,31 +466,57 @@ impl Env {
     }
 
     /// The human view for `render_mode = "rgb_array"`: uint8 [512, 512, 3] from the render
-    /// camera, goal markers shown (they never appear in observation images).
+    /// camera, goal markers shown (they never appear in observation images). Without the
+    /// `render` feature: [`EnvError::FeatureDisabled`].
     pub fn render(&self) -> Result<Array, EnvError> {
-        let out = self.backend.render_human(self.spec.goal_marker)?;
-        Ok(Array {
-            shape: vec![out.height() as usize, out.width() as usize, 3],
-            data: ArrayData::U8(out.rgb),
-        })
+        #[cfg(feature = "render")]
+        {
+            let out = self.backend.render_human(self.spec.goal_marker)?;
+            Ok(Array {
+                shape: vec![out.height() as usize, out.width() as usize, 3],
+                data: ArrayData::U8(out.rgb),
+            })
+        }
+        #[cfg(not(feature = "render"))]
+        Err(render_disabled("render()".to_owned()))
     }
 
     /// The objects of the segmentation images' channel 1 (actor/link ids) as `(name, id)`
     /// pairs, in id order: the ground, each actor (e.g. `"cube"`), each robot link (e.g.
     /// `"panda_hand"`) and each particle set (the soft-body tasks' `"clay"`). Builds the
-    /// env's sensors if no render happened yet; an error for envs without a 3D scene.
+    /// env's sensors if no render happened yet; an error for envs without a 3D scene, and
+    /// [`EnvError::FeatureDisabled`] without the `render` feature.
     pub fn segmentation_ids(&self) -> Result<Vec<(String, u32)>, EnvError> {
-        self.backend.segmentation_ids()
+        #[cfg(feature = "render")]
+        {
+            self.backend.segmentation_ids()
+        }
+        #[cfg(not(feature = "render"))]
+        Err(render_disabled("segmentation_ids()".to_owned()))
     }
 
-    /// Triangles drawn per observation camera in the last render (0 before any render).
+    /// Triangles drawn per observation camera in the last render (0 before any render, and
+    /// always 0 without the `render` feature).
     pub fn triangles_per_camera(&self) -> usize {
-        self.backend.triangles_per_camera()
+        #[cfg(feature = "render")]
+        {
+            self.backend.triangles_per_camera()
+        }
+        #[cfg(not(feature = "render"))]
+        0
     }
 
     /// Largest dense reward of the task.
     pub fn max_dense_reward(&self) -> f64 {
         self.backend.max_dense_reward()
+    }
+}
+
+/// The error of a request that needs the `render` feature when this build lacks it.
+fn render_disabled(what: String) -> EnvError {
+    EnvError::FeatureDisabled {
+        what,
+        feature: "render",
     }
 }
 
@@ -503,5 +538,24 @@ mod tests {
     #[test]
     fn env_is_send() {
         assert_send::<Env>();
+    }
+
+    #[cfg(not(feature = "rapier"))]
+    #[test]
+    fn without_an_engine_make_env_is_refused() {
+        assert_eq!(
+            make_env(&EnvConfig::new("PickCube-v0")).unwrap_err(),
+            EnvError::NoRigidEngine
+        );
+    }
+
+    #[cfg(not(feature = "render"))]
+    #[test]
+    fn without_render_the_refusal_names_the_feature() {
+        let err = render_disabled("obs_mode \"rgbd\"".to_owned());
+        assert_eq!(
+            err.to_string(),
+            "obs_mode \"rgbd\" needs ms2-tasks' `render` feature, which this build lacks"
+        );
     }
 }

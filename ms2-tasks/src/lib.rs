@@ -3,12 +3,25 @@
 //! Gymnasium-style environments of the ManiSkill2 benchmark: [`Env`] (reset / step / state),
 //! [`VecEnv`] (parallel envs on rayon), seeding as in ManiSkill2, reward modes (`sparse`,
 //! `dense`, `normalized_dense`), observation modes (`state_dict`, `state`, and the visual `rgbd`, `pointcloud`,
-//! `*_robot_seg` rendered with ms2-render, see [`sensors`]), and scripted oracle
+//! `*_robot_seg` rendered with ms2-render (feature `render`), see [`sensors`]), and scripted oracle
 //! policies ([`make_scripted_policy`]).
 //!
 //! Ids: see [`env_ids`]. `Dummy-v0` is a documented physics-free test env.
 //!
+//! ## Cargo features (all on by default)
+//!
+//! | feature | brings |
+//! |---|---|
+//! | `rapier` | the default rigid engine ([`rigid_world::rapier`], ms2-physics' `World`): [`make_env`] / [`Env::new`] / [`VecEnv`] work; without it they return [`EnvError::NoRigidEngine`] and [`Env::with_engine`] takes an engine of one's own |
+//! | `render` | ms2-render (wgpu): the visual obs modes, [`Env::render`], [`Env::segmentation_ids`], `sensors::Sensors`, batched capture, `adapters::render_scene`; without it these give [`EnvError::FeatureDisabled`] (camera configs stay available as data) |
+//! | `soft` | ms2-mpm: the `soft` family (`Excavate-v0`, `Fill-v0`), the `particles` obs mode, `soft`, `adapters::mpm_rigid` |
+//! | `demos` | ms2-plan: `demos` (motion-planning solutions, recording, replay, conversion) |
+//!
+//! `--no-default-features --features rapier` is the state-only runtime of the rigid tasks
+//! (`PickCube-v0`, `LiftCube-v0`, `StackCube-v0`, `Dummy-v0`; obs modes `state`, `state_dict`).
+//!
 //! ```
+//! # #[cfg(feature = "rapier")] {
 //! use ms2_tasks::{make_env, make_scripted_policy, EnvConfig};
 //! let mut env = make_env(&EnvConfig::new("Dummy-v0")).unwrap();
 //! let mut policy = make_scripted_policy(&env).unwrap();
@@ -20,6 +33,7 @@
 //!     if out.terminated { solved = true; break; }
 //! }
 //! assert!(solved);
+//! # }
 //! ```
 
 #![warn(missing_docs)]

@@ -1,11 +1,14 @@
 //! [`TaskEnv`]: the shared runtime of the robot tasks (world + robot + controller + step loop),
 //! driving a [`Task`]'s hooks.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
+#[cfg(feature = "render")]
+use std::sync::Mutex;
 
 use ms2_control::{ControlMode, ControlTiming};
 use ms2_physics::WorldConfig;
 
+#[cfg(feature = "render")]
 use crate::adapters::RenderContext;
 use crate::agents::{robot_spec, RobotSpec};
 use crate::backend::EnvBackend;
@@ -15,9 +18,12 @@ use crate::geometry::vectorize_pose;
 use crate::info::Evaluation;
 use crate::obs::{DictBuilder, ObsValue};
 use crate::rigid_world::RigidEngine;
+#[cfg(feature = "render")]
 use crate::rigid_world::RigidWorld;
 use crate::seeding::{episode_rng, EpisodeRng};
-use crate::sensors::{CameraConfig, CameraFrame, Sensors};
+use crate::sensors::CameraConfig;
+#[cfg(feature = "render")]
+use crate::sensors::{CameraFrame, Sensors};
 use crate::spaces::BoxSpace;
 use crate::spec::TaskSpec;
 use crate::task::{Task, TaskScene};
@@ -36,8 +42,11 @@ pub(crate) struct TaskEnv {
     substeps: u32,
     control_modes: Vec<String>,
     action_space: BoxSpace,
+    /// The observation cameras (checked when the env is made, in every build).
+    #[cfg(feature = "render")]
     camera_cfgs: Vec<CameraConfig>,
     /// Cameras and render scene, built on the first render (state-only envs never render).
+    #[cfg(feature = "render")]
     sensors: Mutex<Option<Sensors>>,
 }
 
@@ -118,12 +127,15 @@ impl TaskEnv {
             substeps,
             control_modes,
             action_space,
+            #[cfg(feature = "render")]
             camera_cfgs,
+            #[cfg(feature = "render")]
             sensors: Mutex::new(None),
         })
     }
 
     /// Runs `f` on the env's sensors (built on first use) and world.
+    #[cfg(feature = "render")]
     fn with_sensors<R>(
         &self,
         f: impl FnOnce(&mut Sensors, &dyn RigidWorld) -> Result<R, EnvError>,
@@ -142,6 +154,7 @@ impl TaskEnv {
 
     /// The env's cameras and render scene (with the task's particle sets), drawing through the
     /// process-wide render context.
+    #[cfg(feature = "render")]
     fn new_sensors(&self) -> Result<Sensors, EnvError> {
         let mut sensors = Sensors::new(
             RenderContext::shared()?,
@@ -173,6 +186,7 @@ impl TaskEnv {
 }
 
 /// Copies the task's current particle positions into the sensors' particle sets.
+#[cfg(feature = "render")]
 fn sync_particles(task: &dyn Task, sensors: &mut Sensors) -> Result<(), EnvError> {
     let Some(soft) = task.soft() else {
         return Ok(());
@@ -184,6 +198,7 @@ fn sync_particles(task: &dyn Task, sensors: &mut Sensors) -> Result<(), EnvError
 }
 
 /// The error of a sensor lock poisoned by a panic during an earlier render.
+#[cfg(feature = "render")]
 fn poisoned<T>(_: std::sync::PoisonError<T>) -> EnvError {
     EnvError::Render("sensor lock poisoned by an earlier panic".to_owned())
 }
@@ -233,7 +248,10 @@ impl EnvBackend for TaskEnv {
             rng,
         )?;
         // The new world has new bodies: the render scene is rebuilt on the next render.
-        *self.sensors.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
+        #[cfg(feature = "render")]
+        {
+            *self.sensors.get_mut().unwrap_or_else(|e| e.into_inner()) = None;
+        }
         Ok(())
     }
 
@@ -347,10 +365,12 @@ impl EnvBackend for TaskEnv {
         Ok(())
     }
 
+    #[cfg(feature = "render")]
     fn capture_cameras(&self) -> Result<CameraFrame, EnvError> {
         self.with_sensors(|sensors, world| sensors.capture(world))
     }
 
+    #[cfg(feature = "render")]
     fn sensors_mut(&mut self) -> Result<(&mut Sensors, &dyn RigidWorld), EnvError> {
         if self.sensors.get_mut().map_err(poisoned)?.is_none() {
             let built = self.new_sensors()?;
@@ -366,6 +386,7 @@ impl EnvBackend for TaskEnv {
         Ok((sensors, self.scene.world.as_ref()))
     }
 
+    #[cfg(feature = "render")]
     fn render_human(&self, goal_key: Option<&str>) -> Result<ms2_render::CameraOutput, EnvError> {
         let state = goal_key.map(|_| self.observe_state_dict());
         let goal = goal_key
@@ -375,6 +396,7 @@ impl EnvBackend for TaskEnv {
         self.with_sensors(|sensors, world| sensors.render_human(world, goal))
     }
 
+    #[cfg(feature = "render")]
     fn segmentation_ids(&self) -> Result<Vec<(String, u32)>, EnvError> {
         self.with_sensors(|sensors, _| {
             Ok(sensors
@@ -386,6 +408,7 @@ impl EnvBackend for TaskEnv {
         })
     }
 
+    #[cfg(feature = "render")]
     fn triangles_per_camera(&self) -> usize {
         self.sensors
             .lock()

@@ -8,7 +8,9 @@ use crate::env::{Env, StepOutput};
 use crate::error::EnvError;
 use crate::info::Info;
 use crate::obs::ObsValue;
+#[cfg(feature = "render")]
 use crate::sensors::batch::{submit_batch, BatchItem, PendingBatch};
+#[cfg(feature = "render")]
 use crate::sensors::{visual_obs, CameraFrame, VisualLayout};
 
 /// What one env does during [`VecEnv::run`].
@@ -28,25 +30,28 @@ pub enum EnvCommand<'a> {
 /// `num_envs` copies of one env config, reset and stepped in parallel (no autoreset: the Python
 /// layer implements gymnasium's).
 ///
-/// In visual obs modes a vector step has three phases: physics (and the poses of every env's
-/// render scene and cameras) in parallel; batched rendering of every camera (one GPU
-/// submission and one readback per half of the envs, pipelined with the other half's physics:
-/// [`submit_batch`]); then observation assembly (point-cloud fusion, robot masks) in
-/// parallel. The images equal those of stepping each env alone.
+/// In visual obs modes (feature `render`) a vector step has three phases: physics (and the
+/// poses of every env's render scene and cameras) in parallel; batched rendering of every
+/// camera (one GPU submission and one readback per half of the envs, pipelined with the other
+/// half's physics: `sensors::batch::submit_batch`); then observation assembly (point-cloud
+/// fusion, robot masks) in parallel. The images equal those of stepping each env alone.
 ///
 /// ```
+/// # #[cfg(feature = "rapier")] {
 /// use ms2_tasks::{EnvConfig, VecEnv};
 /// let mut venv = VecEnv::new(&EnvConfig::new("Dummy-v0"), 2).unwrap();
 /// venv.reset(&[Some(0), Some(1)]).unwrap();
 /// let dim = venv.envs()[0].action_space().size();
 /// let outs = venv.step(&vec![0.0; 2 * dim]).unwrap();
 /// assert_eq!(outs.len(), 2);
+/// # }
 /// ```
 #[derive(Debug)]
 pub struct VecEnv {
     envs: Vec<Env>,
     action_dim: usize,
     /// Whether visual steps render in two pipelined halves (see [`VecEnv::run`]).
+    #[cfg_attr(not(feature = "render"), allow(dead_code))]
     pipelined: bool,
 }
 
@@ -87,7 +92,8 @@ impl VecEnv {
 
     /// Turns the two-half render pipeline of visual steps on (the default) or off (all envs'
     /// physics, then one batch of all cameras). The outputs are the same either way; this is
-    /// for measuring the overlap.
+    /// for measuring the overlap. Without the `render` feature there are no visual steps and
+    /// this changes nothing.
     pub fn set_pipelined_rendering(&mut self, pipelined: bool) {
         self.pipelined = pipelined;
     }
@@ -152,10 +158,23 @@ impl VecEnv {
                 commands.len()
             )));
         }
-        let Some((layout, robot_seg)) = self.envs[0].visual_layout() else {
-            let stepped = simulate(&mut self.envs, commands, false)?;
-            return Ok(stepped.into_iter().map(|s| s.map(|(out, _)| out)).collect());
-        };
+        #[cfg(feature = "render")]
+        if let Some((layout, robot_seg)) = self.envs[0].visual_layout() {
+            return self.run_visual(commands, layout, robot_seg);
+        }
+        let stepped = simulate(&mut self.envs, commands, |_| Ok(()))?;
+        Ok(stepped.into_iter().map(|s| s.map(|(out, _)| out)).collect())
+    }
+
+    /// [`VecEnv::run`] in a visual obs mode: physics, batched rendering and assembly in two
+    /// pipelined halves.
+    #[cfg(feature = "render")]
+    fn run_visual(
+        &mut self,
+        commands: &[EnvCommand<'_>],
+        layout: VisualLayout,
+        robot_seg: bool,
+    ) -> Result<Vec<Option<StepOutput>>, EnvError> {
         let n = self.envs.len();
         let split = if n >= 2 && self.pipelined {
             n.div_ceil(2)
@@ -164,9 +183,9 @@ impl VecEnv {
         };
         let (first_envs, second_envs) = self.envs.split_at_mut(split);
         let (first_commands, second_commands) = commands.split_at(split);
-        let first = simulate(first_envs, first_commands, true)?;
+        let first = simulate(first_envs, first_commands, Env::prepare_cameras)?;
         let first_batch = submit(first_envs, &first)?;
-        let second = simulate(second_envs, second_commands, true)?;
+        let second = simulate(second_envs, second_commands, Env::prepare_cameras)?;
         let second_batch = submit(second_envs, &second)?;
         let keys = self.envs[0].spec().non_privileged_extra_keys;
         let mut outs = assemble(first, first_batch.wait()?, keys, layout, robot_seg);
@@ -183,15 +202,16 @@ impl VecEnv {
 
 /// An env's step output before its images, and its cameras posed for rendering (`None` for
 /// [`EnvCommand::Keep`]).
+#[cfg(feature = "render")]
 type Simulated = Option<(StepOutput, Vec<ms2_render::Camera>)>;
 
-/// Runs the commands' physics in parallel; with `visual`, also poses each env's render scene
-/// and cameras.
-fn simulate(
+/// Runs the commands' physics in parallel, then `prepare` on each env that ran a command (in
+/// visual modes: pose its render scene and cameras); `None` for [`EnvCommand::Keep`].
+fn simulate<C: Send>(
     envs: &mut [Env],
     commands: &[EnvCommand<'_>],
-    visual: bool,
-) -> Result<Vec<Simulated>, EnvError> {
+    prepare: impl Fn(&mut Env) -> Result<C, EnvError> + Sync,
+) -> Result<Vec<Option<(StepOutput, C)>>, EnvError> {
     envs.par_iter_mut()
         .zip(commands.par_iter())
         .map(|(env, command)| {
@@ -209,16 +229,14 @@ fn simulate(
                     }
                 }
             };
-            let cameras = match visual {
-                true => env.prepare_cameras()?,
-                false => Vec::new(),
-            };
-            Ok(Some((out, cameras)))
+            let prepared = prepare(env)?;
+            Ok(Some((out, prepared)))
         })
         .collect()
 }
 
 /// Submits every camera of the simulated envs in one batch.
+#[cfg(feature = "render")]
 fn submit(envs: &mut [Env], simulated: &[Simulated]) -> Result<PendingBatch, EnvError> {
     let items: Vec<BatchItem<'_>> = envs
         .iter_mut()
@@ -232,6 +250,7 @@ fn submit(envs: &mut [Env], simulated: &[Simulated]) -> Result<PendingBatch, Env
 }
 
 /// The visual observations (image copies, fused point clouds, masks), in parallel.
+#[cfg(feature = "render")]
 fn assemble(
     simulated: Vec<Simulated>,
     frames: Vec<CameraFrame>,

@@ -1,12 +1,13 @@
 //! Demonstration replay and closed-loop conversion (`ms2_tasks::demos`), on PickCube /
 //! StackCube episodes recorded from the scripted oracle in the source control mode, and on short
-//! soft-body (Fill-v0) episodes, which keep only their initial state.
+//! soft-body (Fill-v0) episodes, which keep only their initial state (feature `soft`).
 
-use ms2_tasks::demos::{
-    replay_episode, scripted_episode, DemoEpisode, DemoError, EpisodeRecorder, ReplayOptions,
-    StateRecording,
-};
-use ms2_tasks::{make_env, make_scripted_policy, EnvConfig, EnvError};
+use ms2_tasks::demos::{replay_episode, scripted_episode, DemoEpisode, DemoError, ReplayOptions};
+#[cfg(feature = "soft")]
+use ms2_tasks::demos::{EpisodeRecorder, StateRecording};
+#[cfg(feature = "soft")]
+use ms2_tasks::make_scripted_policy;
+use ms2_tasks::{make_env, EnvConfig, EnvError};
 
 fn cfg(env_id: &str, control_mode: &str) -> EnvConfig {
     EnvConfig {
@@ -252,6 +253,7 @@ fn failed_conversions_of_successful_sources_are_retried() {
     assert!((5 + 10..=20 + 10).contains(&retried.episode.actions.len()));
 }
 
+#[cfg(feature = "soft")]
 /// The first `steps` steps of the scripted Fill-v0 policy in `control_mode` for `seed`, recorded
 /// as a soft-body episode, with every state it went through (taken separately).
 fn soft_episode(control_mode: &str, seed: u64, steps: usize) -> (DemoEpisode, Vec<Vec<f32>>) {
@@ -272,6 +274,7 @@ fn soft_episode(control_mode: &str, seed: u64, steps: usize) -> (DemoEpisode, Ve
 
 /// The state `episode` (a soft-body one) ends in: its initial state restored after the reset,
 /// then its actions stepped.
+#[cfg(feature = "soft")]
 fn final_state(episode: &DemoEpisode) -> Vec<f32> {
     let mut env = make_env(&cfg(&episode.env_id, &episode.control_mode)).unwrap();
     env.reset(Some(episode.episode_seed), false).unwrap();
@@ -282,6 +285,7 @@ fn final_state(episode: &DemoEpisode) -> Vec<f32> {
     env.get_state()
 }
 
+#[cfg(feature = "soft")]
 #[test]
 fn soft_episodes_keep_only_the_initial_state_and_replay_bit_for_bit() {
     let (episode, states) = soft_episode("pd_joint_delta_pos", 3, 5);
@@ -325,6 +329,7 @@ fn soft_episodes_keep_only_the_initial_state_and_replay_bit_for_bit() {
     assert!(mixed.validate().is_err());
 }
 
+#[cfg(feature = "soft")]
 #[test]
 fn soft_conversion_resimulates_the_source_like_recorded_states_would() {
     let (episode, states) = soft_episode("pd_joint_delta_pos", 1, 4);

@@ -1,10 +1,16 @@
 //! Camera configurations: ManiSkill2's `base_camera`, `hand_camera` and human render camera.
+//! Plain data in every build; [`CameraConfig::camera_at`] (a posed `ms2_render::Camera`) needs
+//! the `render` feature.
 
-use ms2_physics::{ArticulationId, Pose3};
+#[cfg(feature = "render")]
+use ms2_physics::ArticulationId;
+use ms2_physics::Pose3;
+#[cfg(feature = "render")]
 use ms2_render::Camera;
 use nalgebra::{Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 use crate::error::EnvError;
+#[cfg(feature = "render")]
 use crate::rigid_world::RigidWorld;
 
 /// Where a camera is: fixed in the world, or riding on a link of the robot.
@@ -164,7 +170,8 @@ impl CameraConfig {
     }
 
     /// The render camera at the current pose of its mount (`robot` = the robot carrying
-    /// link-mounted cameras).
+    /// link-mounted cameras). Feature `render`.
+    #[cfg(feature = "render")]
     pub fn camera_at(
         &self,
         world: &dyn RigidWorld,

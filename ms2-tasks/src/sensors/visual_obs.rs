@@ -11,11 +11,15 @@
 //!   adds `pointcloud["robot_seg"]` bool [N,1].
 //! - `Segmentation` channels: 0 = visual-shape id, 1 = actor/link id (see
 //!   [`crate::adapters::render_scene`]), 2 and 3 = 0 (as in ManiSkill2).
+//! - [`VisualLayout`] is plain data (every build); [`CameraFrame`] and [`assemble`] need the
+//!   `render` feature.
 //! - `extra` keeps only what a real robot would know: the task spec's
 //!   `non_privileged_extra_keys` ([`crate::spec::TaskSpec`]).
 
+#[cfg(feature = "render")]
 use ms2_render::CameraOutput;
 
+#[cfg(feature = "render")]
 use crate::obs::{non_privileged_state, Array, ArrayData, ObsValue};
 
 /// A visual observation layout.
@@ -27,7 +31,8 @@ pub enum VisualLayout {
     PointCloud,
 }
 
-/// One frame of an env's observation cameras.
+/// One frame of an env's observation cameras (feature `render`).
+#[cfg(feature = "render")]
 #[derive(Debug, Clone)]
 pub struct CameraFrame {
     /// Camera uids, in config order.
@@ -38,10 +43,12 @@ pub struct CameraFrame {
     pub robot_ids: Vec<u32>,
 }
 
+#[cfg(feature = "render")]
 fn array(shape: Vec<usize>, data: ArrayData) -> ObsValue {
     ObsValue::Array(Array { shape, data })
 }
 
+#[cfg(feature = "render")]
 fn matrix_rows<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f32, R, C>) -> ObsValue {
     let data = (0..R)
         .flat_map(|r| (0..C).map(move |c| m[(r, c)]))
@@ -52,6 +59,8 @@ fn matrix_rows<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f32, R, C>)
 /// The full visual observation: `state_dict`'s non-privileged part (`extra` filtered to
 /// `non_privileged_extra_keys`) plus the camera data in `layout`, with a robot mask when
 /// `robot_seg`. Takes the frame by value: its images move into the observation without copies.
+/// Feature `render`.
+#[cfg(feature = "render")]
 pub fn assemble(
     state_dict: ObsValue,
     non_privileged_extra_keys: &[&str],
