@@ -72,7 +72,7 @@ fn controller_setup(
 fn ee_action(i: usize) -> [f64; 7] {
     let dp = Vector3::new(0.01, 0.005, -0.01);
     let dr = Vector3::new(0.0, 0.0, 0.02);
-    let (p, r) = if (i / 10) % 2 == 0 {
+    let (p, r) = if (i / 10).is_multiple_of(2) {
         (dp, dr)
     } else {
         (-(UnitQuaternion::from_scaled_axis(dr).inverse() * dp), -dr)

@@ -20,7 +20,7 @@ pub const BENCH_SPACING: f32 = 0.005;
 /// 64³ grid of 1 cm cells with slip walls, gravity −9.81 m/s² on z, substeps of 0.5 ms.
 /// `particles` must be a positive multiple of 1024.
 pub fn clay_block(particles: usize) -> Result<MpmSolver, MpmError> {
-    if particles == 0 || particles % 1024 != 0 || particles / 1024 > 96 {
+    if particles == 0 || !particles.is_multiple_of(1024) || particles / 1024 > 96 {
         return Err(MpmError::InvalidConfig {
             field: "particles",
             value: particles.to_string(),

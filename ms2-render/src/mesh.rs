@@ -51,7 +51,7 @@ impl MeshData {
                 )));
             }
         }
-        if self.indices.len() % 3 != 0 {
+        if !self.indices.len().is_multiple_of(3) {
             return Err(RenderError::InvalidMesh(format!(
                 "index count {} is not a multiple of 3",
                 self.indices.len()

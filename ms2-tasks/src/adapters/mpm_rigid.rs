@@ -1,12 +1,12 @@
-//! [`ms2_mpm::RigidBackend`] for the ms2-physics [`World`]: two-way coupling of MPM soft
-//! bodies with rapier actors and articulation links.
+//! [`ms2_mpm::RigidBackend`] for any [`RigidWorld`] (e.g. ms2-physics' rapier `World`): two-way
+//! coupling of MPM soft bodies with rigid actors and articulation links.
 //!
 //! [`MpmRigidWorld`] is a newtype over `&mut dyn RigidWorld` plus the list of bodies that may touch
 //! soft material ([`CoupledBodies`]). Coupled body `i` of the MPM side is `bodies[i]`.
 //! Shapes are converted once at setup ([`CoupledBodies::new`] refuses shapes the coupling
 //! cannot represent); poses, velocities and centres of mass are read from the world each rigid
-//! step; the coupling's wrench is applied with [`World::apply_force`] / [`World::apply_torque`]
-//! and acts during the next [`World::step`] only (static and kinematic bodies are moved by
+//! step; the coupling's wrench is applied with [`RigidWorld::apply_force`] / [`RigidWorld::apply_torque`]
+//! and acts during the next [`RigidWorld::step`] only (static and kinematic bodies are moved by
 //! the task, so they feel no wrench).
 //!
 //! Frames: both sides use the world frame with +z up, metres, seconds. ms2-physics capsules
@@ -15,7 +15,7 @@
 //!
 //! ```
 //! use ms2_mpm::{Coupling, CouplingParams, RigidBackend};
-//! use ms2_physics::{ActorDesc, ActorKind, ShapeDesc, ShapeSpec, WorldConfig};
+//! use ms2_physics::{ActorDesc, ActorKind, ShapeDesc, ShapeSpec, World, WorldConfig};
 //! use ms2_tasks::adapters::mpm_rigid::{CoupledBodies, MpmRigidWorld};
 //! use nalgebra::Vector3;
 //! let mut world = World::new(WorldConfig::default()).unwrap();
