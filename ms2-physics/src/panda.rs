@@ -1,11 +1,10 @@
 //! The Franka Panda of `ms2-assets`, set up as ManiSkill2 sets it up.
 
-use crate::description::DriveParams;
+use crate::description::{ArticulationOptions, DriveParams, SelfCollision};
 use crate::math::Pose3;
 use crate::shape::Material;
 #[cfg(feature = "rapier")]
 use crate::{
-    description::{ArticulationOptions, SelfCollision},
     error::Result,
     ids::ArticulationId,
     urdf::{parse_urdf_str, UrdfLoadOptions},
@@ -46,6 +45,25 @@ impl Default for PandaOptions {
     }
 }
 
+impl PandaOptions {
+    /// The articulation options of the Panda: root at `base_pose`, gravity-compensated links,
+    /// non-adjacent self-collision, `finger_material` on the two fingers and `link_material`
+    /// elsewhere, built in at `qpos`.
+    pub fn articulation_options(&self) -> ArticulationOptions {
+        ArticulationOptions {
+            root_pose: self.base_pose,
+            gravity_compensation: true,
+            self_collision: SelfCollision::NonAdjacent,
+            default_material: self.link_material,
+            link_materials: vec![
+                ("panda_leftfinger".into(), self.finger_material),
+                ("panda_rightfinger".into(), self.finger_material),
+            ],
+            initial_qpos: Some(self.qpos.to_vec()),
+        }
+    }
+}
+
 /// Adds the Panda (9 degrees of freedom: `panda_joint1..7`, `panda_finger_joint1/2`) with
 /// gravity-compensated links, PD drives and finger friction; drive targets start at `qpos`.
 #[cfg(feature = "rapier")]
@@ -74,18 +92,7 @@ pub fn add_panda_from_urdf(
         source,
         &UrdfLoadOptions::default(),
     )?;
-    let art_options = ArticulationOptions {
-        root_pose: options.base_pose,
-        gravity_compensation: true,
-        self_collision: SelfCollision::NonAdjacent,
-        default_material: options.link_material,
-        link_materials: vec![
-            ("panda_leftfinger".into(), options.finger_material),
-            ("panda_rightfinger".into(), options.finger_material),
-        ],
-        initial_qpos: Some(options.qpos.to_vec()),
-    };
-    let art = world.add_articulation_from(&desc, &art_options, source)?;
+    let art = world.add_articulation_from(&desc, &options.articulation_options(), source)?;
     for i in 0..7 {
         world.set_drive(art, i, options.arm_drive)?;
     }

@@ -4,10 +4,7 @@
 use std::sync::OnceLock;
 
 use ms2_control::{CombinedController, ControlMode, ControlTiming, RobotConfig};
-use ms2_physics::{
-    parse_urdf_str, ArticulationId, ArticulationOptions, BodyId, PandaOptions, SelfCollision,
-    UrdfLoadOptions,
-};
+use ms2_physics::{parse_urdf_str, ArticulationId, BodyId, PandaOptions, UrdfLoadOptions};
 use nalgebra::Vector3;
 use rand_distr::{Distribution, Normal};
 
@@ -189,18 +186,7 @@ fn add_panda(
         "robot URDF of the task",
         &UrdfLoadOptions::default(),
     )?;
-    let art_options = ArticulationOptions {
-        root_pose: options.base_pose,
-        gravity_compensation: true,
-        self_collision: SelfCollision::NonAdjacent,
-        default_material: options.link_material,
-        link_materials: vec![
-            ("panda_leftfinger".into(), options.finger_material),
-            ("panda_rightfinger".into(), options.finger_material),
-        ],
-        initial_qpos: Some(options.qpos.to_vec()),
-    };
-    let art = world.add_articulation(&desc, &art_options)?;
+    let art = world.add_articulation(&desc, &options.articulation_options())?;
     for i in 0..ARM_DOF {
         world.set_drive(art, i, options.arm_drive)?;
     }
