@@ -16,16 +16,8 @@ use crate::config::ObsMode;
 use crate::registry::{Registrar, TaskRegistration};
 use crate::spec::{RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE};
 
-/// Observation modes of the soft-body tasks (the rigid ones plus `particles`).
-const SOFT_OBS_MODES: &[ObsMode] = &[
-    ObsMode::StateDict,
-    ObsMode::State,
-    ObsMode::Rgbd,
-    ObsMode::PointCloud,
-    ObsMode::RgbdRobotSeg,
-    ObsMode::PointCloudRobotSeg,
-    ObsMode::Particles,
-];
+/// Observation modes of the soft-body tasks: every mode, `particles` included.
+const SOFT_OBS_MODES: &[ObsMode] = &ObsMode::ALL;
 
 /// The bucket tasks' robot: `robot="panda"` builds the Panda carrying the bucket.
 const PANDA_WITH_BUCKET: &[RobotChoice] = &[RobotChoice {
