@@ -20,16 +20,18 @@ echo "[test] ms2-physics without its rapier engine (--no-default-features: the e
 cargo clippy -p ms2-physics --no-default-features --all-targets -- -D warnings
 echo "[test] cargo test (workspace, release profile)"
 cargo test --release --workspace --exclude ms2-py
-echo "[test] ms2-tasks feature combinations (cargo check --all-targets each; state-only tests)"
-# Every feature combination of ms2-tasks must build (checks only, not builds), and the
+echo "[test] ms2-tasks feature combinations (clippy --all-targets each; state-only tests)"
+# Every feature combination of ms2-tasks must build (lints only, not builds), and the
 # state-only runtime (`rapier` alone: no wgpu, no MPM, no planner) must pass its tests.
 # Measured on the 2-core dev machine (load ~3, 2026-11-24), dependencies already compiled by the
 # steps above so that only ms2-tasks itself is compiled per combination: 27 s for the step
 # (checks 1-3 s each, the state-only release build and test run 16 s). In a cold target/ the
 # same step took ~40 min there (wgpu, MPM and a release rapier build under load ~8).
+# Clippy rather than check, so that each combination is linted too (17 s for the five here,
+# warm).
 for features in "" rapier rapier,render rapier,soft rapier,demos; do
-    echo "[test]   cargo check -p ms2-tasks --all-targets --no-default-features --features '$features'"
-    cargo check -q -p ms2-tasks --all-targets --no-default-features --features "$features"
+    echo "[test]   cargo clippy -p ms2-tasks --all-targets --no-default-features --features '$features'"
+    cargo clippy -q -p ms2-tasks --all-targets --no-default-features --features "$features" -- -D warnings
 done
 echo "[test]   cargo test --release -p ms2-tasks --no-default-features --features rapier"
 cargo test --release -p ms2-tasks --no-default-features --features rapier
