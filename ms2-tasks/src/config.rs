@@ -229,8 +229,10 @@ impl RewardMode {
     }
 }
 
-/// Render modes accepted in [`EnvConfig::render_mode`].
-pub const RENDER_MODES: [&str; 1] = ["rgb_array"];
+/// Render modes accepted in [`EnvConfig::render_mode`]. `human` is a viewer window, which the
+/// application opens (crate `ms2-viewer`; Python's `render_mode="human"`) over
+/// [`crate::Env::view_scene`]; [`crate::Env::render`] returns the `rgb_array` image in it.
+pub const RENDER_MODES: [&str; 2] = ["rgb_array", "human"];
 
 #[cfg(test)]
 mod tests {
