@@ -54,7 +54,11 @@ class Ms2Env(gym.Env):
             A robot the task does not support raises ``ValueError`` listing the valid ones.
         control_mode: e.g. ``"pd_ee_delta_pose"``; ``None`` = ``"pd_joint_delta_pos"``.
         reward_mode: ``"sparse"``, ``"dense"`` or ``"normalized_dense"`` (``None``).
-        render_mode: ``None`` or ``"rgb_array"``.
+        render_mode: ``None``, ``"rgb_array"`` (``render()`` returns an image) or ``"human"``
+            (``render()`` opens and updates a viewer window: mouse orbit / pan / zoom, ``space``
+            pause, ``n`` single step, ``c`` sensor views, ``m`` segmentation; see
+            docs/viewer.md). ``"human"`` needs a display: without one ``render()`` raises
+            ``RuntimeError`` naming ``DISPLAY`` / ``WAYLAND_DISPLAY``.
         sim_freq: physics frequency in Hz (500 by default).
         control_freq: env step frequency in Hz (20 by default); ``sim_freq`` must be a multiple.
         max_episode_steps: episode limit in env steps after which ``truncated`` is set;
@@ -72,7 +76,7 @@ class Ms2Env(gym.Env):
     Unknown ids or modes raise ``ValueError`` listing the valid ones.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 20}
 
     def __init__(
         self,
@@ -106,6 +110,7 @@ class Ms2Env(gym.Env):
         self.action_space = to_gym_space(self._native.action_space())
         self.metadata = {**self.metadata, "render_fps": self.control_freq}
         self._seeded = False
+        self._viewer: Any = None
 
     # --- gymnasium API -------------------------------------------------------------------------
 
@@ -138,17 +143,44 @@ class Ms2Env(gym.Env):
             )
         return self._native.step(action)
 
-    def render(self) -> np.ndarray | None:
-        """An RGB image (uint8 [H, W, 3]) of the scene when ``render_mode="rgb_array"``."""
+    def render(self) -> Any:
+        """``render_mode="rgb_array"``: an RGB image (uint8 [H, W, 3]) of the scene.
+        ``render_mode="human"``: shows the scene in the viewer window (opened on the first call)
+        and returns ``None`` (gymnasium's rule; :meth:`render_human` returns the viewer, as
+        ManiSkill2's does, and :attr:`viewer` holds it)."""
         if self.render_mode is None:
             gym.logger.warn(
                 "render() called without render_mode; make the env with render_mode='rgb_array'"
             )
             return None
+        if self.render_mode == "human":
+            self.render_human()
+            return None
         return self._native.render()
 
+    def render_human(self) -> Any:
+        """Opens the viewer window on the first call (``RuntimeError`` without a display),
+        handles its mouse and key events and draws the scene as it is now. While the viewer is
+        paused (``space``) the call keeps the window live and returns only when the user
+        resumes, single-steps (``n``) or closes the window, so a loop that calls ``render()``
+        after each ``step()`` pauses with it. Returns the viewer (``ms2._native.NativeViewer``:
+        ``take_keys()``, ``press_key()``, ``paused``, ``closed``, ``close()``, ...)."""
+        if self._viewer is None:
+            self._viewer = _native.NativeViewer(self._native, title=f"ms2 {self.env_id}")
+        if not self._viewer.closed:
+            self._viewer.show(self._native)
+        return self._viewer
+
+    @property
+    def viewer(self) -> Any:
+        """The viewer window of ``render_mode="human"`` (``None`` before the first render)."""
+        return self._viewer
+
     def close(self) -> None:
-        """Releases the native env."""
+        """Closes the viewer window, if any, and releases the native env."""
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None
         self._native = None  # type: ignore[assignment]
 
     # --- ManiSkill2-style extras ----------------------------------------------------------------
