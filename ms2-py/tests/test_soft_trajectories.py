@@ -79,7 +79,17 @@ def test_recorded_soft_episode_keeps_init_state_and_replays_bit_for_bit(tmp_path
 
 def test_generated_soft_demos_replay_convert_and_render(tmp_path, capsys):
     path = tmp_path / "fill.h5"
-    argv = ["demos", "generate", "Fill-v0", "--policy", "scripted", "-n", "2", "-o", str(path)]
+    argv = [
+        "demos",
+        "generate",
+        "Fill-v0",
+        "--policy",
+        "scripted",
+        "-n",
+        "2",
+        "--output",
+        str(path),
+    ]
     assert main([*argv, "--workers", "2", "-q"]) == 0
     with open_trajectory(path) as traj:
         assert traj.env_info["env_kwargs"]["mpm_freq"] == 1000.0

@@ -85,7 +85,10 @@ impl Env {
     pub fn with_engine(cfg: &EnvConfig, engine: Arc<dyn RigidEngine>) -> Result<Env, EnvError> {
         let registration = registry::registration(&cfg.env_id)?;
         let spec = registration.spec;
-        let obs_mode = ObsMode::parse(&cfg.obs_mode)?;
+        let obs_mode = ObsMode::parse(&cfg.obs_mode).map_err(|_| EnvError::UnknownObsMode {
+            got: cfg.obs_mode.clone(),
+            valid: supported_obs_modes(&spec),
+        })?;
         if !spec.supports_obs_mode(obs_mode) {
             if obs_mode.visual().is_some() {
                 return Err(EnvError::NotRenderable {
@@ -113,6 +116,12 @@ impl Env {
             if !cfg!(feature = "render") {
                 return Err(render_disabled(format!("render_mode {rm:?}")));
             }
+        }
+        if let Some(bg) = &cfg.bg_name {
+            return Err(EnvError::InvalidConfig(format!(
+                "bg_name {bg:?} is not available: ms2 ships no background scenes (ManiSkill2's \
+                 \"minimal_bedroom\" is a separately downloaded asset); use bg_name=None"
+            )));
         }
         if cfg.max_episode_steps == Some(0) {
             return Err(EnvError::InvalidConfig(
@@ -337,7 +346,9 @@ impl Env {
     pub fn observe(&self) -> ObsValue {
         let dict = self.backend.observe_state_dict();
         match self.obs_mode {
-            ObsMode::Rgbd
+            ObsMode::None => ObsValue::Dict(Vec::new()),
+            ObsMode::Image
+            | ObsMode::Rgbd
             | ObsMode::PointCloud
             | ObsMode::RgbdRobotSeg
             | ObsMode::PointCloudRobotSeg => ObsValue::Dict(crate::obs::non_privileged_state(
@@ -479,6 +490,30 @@ impl Env {
         }
         #[cfg(not(feature = "render"))]
         Err(render_disabled("render()".to_owned()))
+    }
+
+    /// Every observation camera's images, whatever the obs mode (for `render_mode =
+    /// "cameras"`): `{uid: {"rgb" u8 [H,W,3], "depth" f32 [H,W,1] (m), and "Segmentation"
+    /// u32 [H,W,4] for cameras with `add_segmentation`}}` in camera order. Without the `render`
+    /// feature: [`EnvError::FeatureDisabled`].
+    pub fn camera_images(&self) -> Result<ObsValue, EnvError> {
+        #[cfg(feature = "render")]
+        {
+            let frame = self.backend.capture_cameras()?;
+            let obs = crate::sensors::visual_obs::assemble(
+                ObsValue::Dict(Vec::new()),
+                &[],
+                frame,
+                crate::sensors::VisualLayout::Rgbd,
+                false,
+            );
+            Ok(obs
+                .get("image")
+                .cloned()
+                .unwrap_or(ObsValue::Dict(Vec::new())))
+        }
+        #[cfg(not(feature = "render"))]
+        Err(render_disabled("camera_images()".to_owned()))
     }
 
     /// The objects of the segmentation images' channel 1 (actor/link ids) as `(name, id)`
