@@ -15,6 +15,8 @@ Subcommands:
   convert a trajectory file (ms2's, or one ManiSkill2 0.5.3 wrote), writing
   ``X.<obs_mode>.<control_mode>.h5``.
 
+* ``ms2 gallery`` — one picture per task into ``docs/images/tasks/`` (``docs/tasks.md``).
+
 Short flags mean the same in every subcommand: ``-n`` how many episodes, ``-o`` obs mode, ``-c``
 control mode, ``-w`` worker threads, ``-v`` verbose, ``-q`` no progress bar.
 """
@@ -26,6 +28,17 @@ import sys
 import time
 from collections.abc import Sequence
 from typing import Any
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Shows every option's default: appended as ``(default: X)`` unless the help text
+    already says what the default is."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        if "default" in text.lower():
+            return text
+        return super()._get_help_string(action)
 
 
 def _cmd_envs(_args: argparse.Namespace) -> int:
@@ -42,6 +55,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     import ms2
 
+    if args.env_id not in ms2.env_ids():
+        raise ValueError(f"unknown env id {args.env_id!r}; valid ids: {ms2.env_ids()}")
     env = gym.make(
         args.env_id,
         obs_mode=args.obs_mode,
@@ -108,7 +123,7 @@ def _add_run_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "run",
         help="run episodes of a task with a scripted or random policy",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     p.add_argument("env_id", nargs="?", default="PickCube-v0", help="task id")
     p.add_argument(
@@ -226,7 +241,7 @@ def _cmd_demos_bench(args: argparse.Namespace) -> int:
 def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("demos", help="generate demonstrations (trajectory files)")
     demos_sub = p.add_subparsers(dest="demos_command", required=True)
-    fmt = argparse.ArgumentDefaultsHelpFormatter
+    fmt = HelpFormatter
     g = demos_sub.add_parser(
         "generate", help="write successful demonstrations (trajectory files)", formatter_class=fmt
     )
@@ -315,7 +330,7 @@ def _add_replay_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "replay",
         help="replay / convert a trajectory file (ms2's or ManiSkill2's)",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     add_replay_arguments(p)
 
@@ -327,7 +342,8 @@ def add_replay_arguments(p: argparse.ArgumentParser) -> None:
         "-o",
         "--obs-mode",
         default=None,
-        help="record observations of this mode (default: the file's env_kwargs obs_mode)",
+        help="record observations of this mode (default: the file's env_kwargs obs_mode; "
+        "none records none)",
     )
     p.add_argument(
         "-c",
@@ -335,7 +351,7 @@ def add_replay_arguments(p: argparse.ArgumentParser) -> None:
         "--target-control-mode",
         dest="target_control_mode",
         default=None,
-        help="convert actions to this control mode (default: keep the recorded one)",
+        help="convert actions to this control mode (default: the recorded one)",
     )
     p.add_argument(
         "--use-env-states", action="store_true", help="restore the recorded state after every step"
@@ -370,14 +386,33 @@ def add_replay_arguments(p: argparse.ArgumentParser) -> None:
     p.set_defaults(func=_cmd_replay)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Runs the ``ms2`` command line with ``argv`` (default: ``sys.argv[1:]``)."""
-    import ms2
+def _cmd_gallery(args: argparse.Namespace) -> int:
+    from .gallery import render_gallery
 
-    from . import bench
+    for path in render_gallery(args.out, args.env_ids or None, steps=args.steps, seed=args.seed):
+        print(f"wrote {path}")
+    return 0
+
+
+def _add_gallery_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "gallery",
+        help="render one picture per task (the docs/tasks.md gallery)",
+        formatter_class=HelpFormatter,
+    )
+    p.add_argument("env_ids", nargs="*", help="tasks to render (none given: every 3D task)")
+    p.add_argument("--out", default="docs/images/tasks", help="directory of <env_id>.png")
+    p.add_argument("--steps", type=int, default=30, help="scripted steps before the picture")
+    p.add_argument("--seed", type=int, default=0, help="episode seed")
+    p.set_defaults(func=_cmd_gallery)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``ms2`` argument parser with every subcommand."""
+    from . import __version__, bench
 
     parser = argparse.ArgumentParser(prog="ms2", description=__doc__.splitlines()[0])
-    parser.add_argument("--version", action="version", version=f"ms2 {ms2.__version__}")
+    parser.add_argument("--version", action="version", version=f"ms2 {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     p_envs = sub.add_parser("envs", help="list the registered tasks")
     p_envs.set_defaults(func=_cmd_envs)
@@ -385,6 +420,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     bench.add_parser(sub)
     _add_demos_parser(sub)
     _add_replay_parser(sub)
+    _add_gallery_parser(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Runs the ``ms2`` command line with ``argv`` (default: ``sys.argv[1:]``)."""
+    parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))

@@ -144,6 +144,9 @@ def generate(
     env_kwargs = {"obs_mode": "state", "control_mode": control_mode}
     run = _native.solve_episodes if policy == "solution" else _native.scripted_episodes
     recorded = dict(_native.recorded_env_kwargs(env_id, env_kwargs))
+    # No observations are stored: the file says so, as ManiSkill2's demonstrations do (replays
+    # record the obs mode of env_kwargs unless told another).
+    recorded["obs_mode"] = "none"
     env_info = {
         "env_id": env_id,
         "max_episode_steps": int(recorded.pop("max_episode_steps")),

@@ -6,15 +6,13 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 
-from .cli import add_replay_arguments, run_replay
+from .cli import HelpFormatter, add_replay_arguments, run_replay
 
 
 def parse_args(args: Sequence[str] | None = None) -> argparse.Namespace:
     """Parses ``ms2 replay``'s options (``--traj-path``, ``-o``, ``-c``, ``--save-traj``, ...)
     from ``args`` (default: ``sys.argv[1:]``)."""
-    parser = argparse.ArgumentParser(
-        prog="ms2 replay", formatter_class=argparse.ArgumentDefaultsHelpFormatter
-    )
+    parser = argparse.ArgumentParser(prog="ms2 replay", formatter_class=HelpFormatter)
     add_replay_arguments(parser)
     parser.set_defaults(quiet=False)
     return parser.parse_args(args)

@@ -204,9 +204,9 @@ pub(crate) fn restore_init_state(env: &mut Env, source: &DemoEpisode) -> Result<
         return Err(DemoError::InvalidEpisode {
             seed: source.episode_seed,
             reason: format!(
-                "env_init_state has {} values but a {} state in ms2 has {expected}; ms2's state \
-                 layout differs from ManiSkill2's, so trajectories recorded by ManiSkill2 (or by \
-                 another ms2 version) open but cannot be replayed in ms2 envs",
+                "env_init_state has {} values but a {} state in ms2 has {expected}; the episode \
+                 was recorded in another state layout (ManiSkill2's rigid-body layout is mapped \
+                 by the Python replay, ms2.maniskill2_states; other layouts cannot be replayed)",
                 init.len(),
                 source.env_id
             ),
