@@ -7,6 +7,7 @@ import argparse
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import ms2
 import pytest
@@ -87,3 +88,15 @@ def test_rendering_prints_nothing_on_stderr_without_xdg_runtime_dir():
     assert done.returncode == 0, done.stderr
     assert "XDG_RUNTIME_DIR" not in done.stderr
     assert done.stderr.strip() == ""
+
+
+def test_readme_example_writes_a_video_and_a_trajectory(tmp_path, monkeypatch, capsys):
+    readme = (Path(__file__).parents[2] / "README.md").read_text()
+    example = readme.split("## Example", 1)[1].split("```python", 1)[1].split("```", 1)[0]
+    assert len(example.strip().splitlines()) <= 15
+    monkeypatch.chdir(tmp_path)
+    exec(compile(example, "README.md", "exec"), {})
+    assert "success: True" in capsys.readouterr().out
+    assert (tmp_path / "out" / "episode_0.mp4").stat().st_size > 0
+    assert (tmp_path / "out" / "trajectory.h5").exists()
+    assert (tmp_path / "out" / "trajectory.json").exists()
