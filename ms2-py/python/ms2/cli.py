@@ -294,7 +294,7 @@ def _add_replay_parser(sub: argparse._SubParsersAction) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Runs the ``ms2`` command line with ``argv`` (default: ``sys.argv[1:]``)."""
-    from . import bench
+    from . import assets, bench
 
     parser = argparse.ArgumentParser(prog="ms2", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -302,6 +302,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     p_envs.set_defaults(func=_cmd_envs)
     _add_run_parser(sub)
     bench.add_parser(sub)
+    assets.add_parser(sub)
     _add_demos_parser(sub)
     _add_replay_parser(sub)
     args = parser.parse_args(argv)

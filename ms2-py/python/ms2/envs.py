@@ -14,6 +14,7 @@ import gymnasium as gym
 import numpy as np
 
 from . import _native
+from . import assets as _assets
 from .spaces import to_gym_space
 
 #: Native episode limit used when gymnasium's ``TimeLimit`` wrapper enforces the limit instead
@@ -88,6 +89,7 @@ class Ms2Env(gym.Env):
         camera_cfgs: dict[str, Any] | None = None,
         mpm_freq: float | None = None,
     ) -> None:
+        _assets.register_installed_packages()
         self._native = _native.NativeEnv(
             env_id,
             obs_mode=obs_mode,
@@ -102,6 +104,7 @@ class Ms2Env(gym.Env):
             mpm_freq=mpm_freq,
         )
         adopt_config(self, self._native.config())
+        _assets.warn_if_primitive_panda()
         self.observation_space = to_gym_space(self._native.observation_space())
         self.action_space = to_gym_space(self._native.action_space())
         self.metadata = {**self.metadata, "render_fps": self.control_freq}
