@@ -11,6 +11,7 @@
 //! * [`policy::NativeScriptedPolicy`] — the runtime's scripted (oracle) policy of an env.
 //! * [`errors`] — how runtime errors and panics become Python exceptions.
 
+mod assets;
 mod cameras;
 mod config;
 mod convert;
@@ -102,6 +103,12 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<vec_env::NativeVecEnv>()?;
     m.add_class::<policy::NativeScriptedPolicy>()?;
     m.add_function(wrap_pyfunction!(env_ids, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::asset_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::asset_group_names, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::asset_group_json, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::verify_asset_group, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::register_asset_package_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::panda_description, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(render_adapter, m)?)?;
     m.add_function(wrap_pyfunction!(default_max_episode_steps, m)?)?;
