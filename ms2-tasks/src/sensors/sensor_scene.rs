@@ -154,7 +154,7 @@ impl Sensors {
         let outputs = self
             .ctx
             .renderer()
-            .render(&[(self.scene.scene(), &cams[..])])
+            .render_sensors(&[(self.scene.scene(), &cams[..])])
             .map_err(render_err)?;
         Ok(self.frame(outputs))
     }
