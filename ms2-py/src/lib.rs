@@ -9,6 +9,7 @@
 //! * [`vec_env::NativeVecEnv`] — N envs stepped in parallel on rayon's thread pool, with
 //!   gymnasium's next-step autoreset.
 //! * [`policy::NativeScriptedPolicy`] — the runtime's scripted (oracle) policy of an env.
+//! * [`viewer::NativeViewer`] — the `render_mode="human"` window (crate `ms2-viewer`).
 //! * [`errors`] — how runtime errors and panics become Python exceptions.
 
 mod assets;
@@ -23,6 +24,7 @@ mod env;
 mod errors;
 mod policy;
 mod vec_env;
+mod viewer;
 
 use pyo3::prelude::*;
 
@@ -102,6 +104,7 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<env::NativeEnv>()?;
     m.add_class::<vec_env::NativeVecEnv>()?;
     m.add_class::<policy::NativeScriptedPolicy>()?;
+    m.add_class::<viewer::NativeViewer>()?;
     m.add_function(wrap_pyfunction!(env_ids, m)?)?;
     m.add_function(wrap_pyfunction!(assets::asset_dir, m)?)?;
     m.add_function(wrap_pyfunction!(assets::asset_group_names, m)?)?;
