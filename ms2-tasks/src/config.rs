@@ -257,9 +257,12 @@ impl RewardMode {
 }
 
 /// Render modes accepted in [`EnvConfig::render_mode`]: `rgb_array` (the render camera's
-/// view) and `cameras` (ManiSkill2's: that view tiled with every observation camera's images;
-/// the runtime renders the parts, [`crate::Env::render`] and [`crate::Env::camera_images`]).
-pub const RENDER_MODES: [&str; 2] = ["rgb_array", "cameras"];
+/// view), `cameras` (ManiSkill2's: that view tiled with every observation camera's images; the
+/// runtime renders the parts, [`crate::Env::render`] and [`crate::Env::camera_images`]) and
+/// `human` (a viewer window, which the application opens — crate `ms2-viewer`, Python's
+/// `render_mode="human"` — over [`crate::Env::view_scene`]; [`crate::Env::render`] returns the
+/// `rgb_array` image in it).
+pub const RENDER_MODES: [&str; 3] = ["rgb_array", "cameras", "human"];
 
 #[cfg(test)]
 mod tests {

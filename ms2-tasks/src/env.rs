@@ -516,6 +516,26 @@ impl Env {
         Err(render_disabled("camera_images()".to_owned()))
     }
 
+    /// Calls `f` with the env's render scene as it is now (poses synchronised, the goal marker
+    /// shown as in [`Env::render`]), its observation cameras at their poses and the render
+    /// camera: what a viewer window (crate `ms2-viewer`, `render_mode = "human"`) draws through
+    /// cameras of its own. An error for envs without a 3D scene, and
+    /// [`EnvError::FeatureDisabled`] without the `render` feature.
+    #[cfg(feature = "render")]
+    pub fn view_scene<R>(
+        &self,
+        f: impl FnOnce(&crate::sensors::SceneView<'_>) -> R,
+    ) -> Result<R, EnvError> {
+        let mut f = Some(f);
+        let mut out = None;
+        self.backend.view_scene(self.spec.goal_marker, &mut |view| {
+            if let Some(f) = f.take() {
+                out = Some(f(view));
+            }
+        })?;
+        out.ok_or_else(|| EnvError::Render("the scene view was not drawn".to_owned()))
+    }
+
     /// The objects of the segmentation images' channel 1 (actor/link ids) as `(name, id)`
     /// pairs, in id order: the ground, each actor (e.g. `"cube"`), each robot link (e.g.
     /// `"panda_hand"`) and each particle set (the soft-body tasks' `"clay"`). Builds the

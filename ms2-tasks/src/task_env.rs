@@ -151,6 +151,16 @@ impl TaskEnv {
         })
     }
 
+    /// The goal marker's position (m, world): the `extra` entry `goal_key` of the state.
+    #[cfg(feature = "render")]
+    fn goal_position(&self, goal_key: Option<&str>) -> Option<nalgebra::Vector3<f32>> {
+        let state = goal_key.map(|_| self.observe_state_dict());
+        goal_key
+            .zip(state.as_ref())
+            .and_then(|(key, state)| state.get(&format!("extra/{key}")))
+            .and_then(|g| g.as_f32().map(|v| nalgebra::Vector3::new(v[0], v[1], v[2])))
+    }
+
     /// Runs `f` on the env's sensors (built on first use) and world.
     #[cfg(feature = "render")]
     fn with_sensors<R>(
@@ -406,12 +416,18 @@ impl EnvBackend for TaskEnv {
 
     #[cfg(feature = "render")]
     fn render_human(&self, goal_key: Option<&str>) -> Result<ms2_render::CameraOutput, EnvError> {
-        let state = goal_key.map(|_| self.observe_state_dict());
-        let goal = goal_key
-            .zip(state.as_ref())
-            .and_then(|(key, state)| state.get(&format!("extra/{key}")))
-            .and_then(|g| g.as_f32().map(|v| nalgebra::Vector3::new(v[0], v[1], v[2])));
+        let goal = self.goal_position(goal_key);
         self.with_sensors(|sensors, world| sensors.render_human(world, goal))
+    }
+
+    #[cfg(feature = "render")]
+    fn view_scene(
+        &self,
+        goal_key: Option<&str>,
+        f: &mut dyn FnMut(&crate::sensors::SceneView<'_>),
+    ) -> Result<(), EnvError> {
+        let goal = self.goal_position(goal_key);
+        self.with_sensors(|sensors, world| sensors.with_view(world, goal, f))
     }
 
     #[cfg(feature = "render")]

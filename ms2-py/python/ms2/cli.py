@@ -409,7 +409,7 @@ def _add_gallery_parser(sub: argparse._SubParsersAction) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``ms2`` argument parser with every subcommand."""
-    from . import __version__, bench
+    from . import __version__, assets, bench
 
     parser = argparse.ArgumentParser(prog="ms2", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"ms2 {__version__}")
@@ -418,6 +418,7 @@ def build_parser() -> argparse.ArgumentParser:
     p_envs.set_defaults(func=_cmd_envs)
     _add_run_parser(sub)
     bench.add_parser(sub)
+    assets.add_parser(sub)
     _add_demos_parser(sub)
     _add_replay_parser(sub)
     _add_gallery_parser(sub)

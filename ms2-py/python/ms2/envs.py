@@ -14,6 +14,7 @@ import gymnasium as gym
 import numpy as np
 
 from . import _native
+from . import assets as _assets
 from .spaces import to_gym_space
 from .visualization import camera_images_to_tiles, tile_images
 
@@ -106,6 +107,7 @@ class Ms2Env(gym.Env):
         render_camera_cfgs: dict[str, Any] | None = None,
         bg_name: str | None = None,
     ) -> None:
+        _assets.register_installed_packages()
         self._native = _native.NativeEnv(
             env_id,
             obs_mode=obs_mode,
@@ -123,6 +125,7 @@ class Ms2Env(gym.Env):
             bg_name=bg_name,
         )
         adopt_config(self, self._native.config())
+        _assets.warn_if_primitive_panda()
         self.observation_space = to_gym_space(self._native.observation_space())
         self.action_space = to_gym_space(self._native.action_space())
         self.metadata = {**self.metadata, "render_fps": self.control_freq}

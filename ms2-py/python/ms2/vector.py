@@ -17,6 +17,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _native
+from . import assets as _assets
 from .envs import _seed_from, adopt_config
 from .spaces import to_gym_space
 
@@ -34,7 +35,9 @@ class Ms2VectorEnv(VectorEnv):
     def __init__(self, env_id: str = "PickCube-v0", num_envs: int = 1, **kwargs: Any) -> None:
         if int(num_envs) < 1:
             raise ValueError(f"num_envs must be at least 1, got {num_envs}")
+        _assets.register_installed_packages()
         self._native = _native.NativeVecEnv(env_id, int(num_envs), **kwargs)
+        _assets.warn_if_primitive_panda()
         adopt_config(self, self._native.config())
         self.num_envs = int(num_envs)
         self.single_observation_space = to_gym_space(self._native.single_observation_space())

@@ -67,8 +67,17 @@ enum MeshKey {
     UnitBox,
     UnitSphere,
     UnitCylinder,
-    Capsule { radius: u32, half_length: u32 },
+    Capsule {
+        radius: u32,
+        half_length: u32,
+    },
     Plane,
+    /// A triangle mesh, by a hash of its vertex and index data and its sizes.
+    TriMesh {
+        hash: u64,
+        vertices: usize,
+        triangles: usize,
+    },
 }
 
 static SHARED_CONTEXT: OnceLock<Result<Arc<RenderContext>, String>> = OnceLock::new();
@@ -128,14 +137,50 @@ impl RenderContext {
                 SPHERE_RINGS / 2,
             ),
             MeshKey::Plane => MeshData::plane(GROUND_HALF_SIZE_M, GROUND_HALF_SIZE_M),
+            MeshKey::TriMesh { .. } => {
+                return Err(EnvError::Render(
+                    "triangle meshes are uploaded by trimesh_mesh".to_owned(),
+                ))
+            }
         };
         let handle = self.renderer.add_mesh(&data).map_err(render_err)?;
         cache.insert(key, handle);
         Ok(handle)
     }
 
-    /// Meshes drawing `shape`: `(mesh, scale, pose_shape_from_mesh)` per part. Triangle meshes
-    /// and convex hulls are uploaded per call (they are not shared); primitives are cached.
+    /// The uploaded mesh of a triangle mesh: uploaded on first use, then shared by content
+    /// (every env's real-Panda link meshes are one copy on the device).
+    fn trimesh_mesh(
+        &self,
+        vertices: &[nalgebra::Point3<f32>],
+        indices: &[[u32; 3]],
+    ) -> Result<MeshHandle, EnvError> {
+        use std::hash::{Hash, Hasher};
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        for p in vertices {
+            p.coords.iter().for_each(|v| v.to_bits().hash(&mut hasher));
+        }
+        indices.hash(&mut hasher);
+        let key = MeshKey::TriMesh {
+            hash: hasher.finish(),
+            vertices: vertices.len(),
+            triangles: indices.len(),
+        };
+        let mut cache = self
+            .meshes
+            .lock()
+            .map_err(|_| EnvError::Render("mesh cache lock poisoned".to_owned()))?;
+        if let Some(&handle) = cache.get(&key) {
+            return Ok(handle);
+        }
+        let data = flat_shaded_mesh(vertices, indices);
+        let handle = self.renderer.add_mesh(&data).map_err(render_err)?;
+        cache.insert(key, handle);
+        Ok(handle)
+    }
+
+    /// Meshes drawing `shape`: `(mesh, scale, pose_shape_from_mesh)` per part. Primitives and
+    /// triangle meshes are cached (triangle meshes by content).
     fn meshes_for(
         &self,
         shape: &ShapeDesc,
@@ -172,11 +217,11 @@ impl RenderContext {
                 }
                 Ok(out)
             }
-            ShapeDesc::TriMesh { vertices, indices } => {
-                let data = flat_shaded_mesh(vertices, indices);
-                let handle = self.renderer.add_mesh(&data).map_err(render_err)?;
-                Ok(vec![(handle, Vector3::repeat(1.0), Pose3::identity())])
-            }
+            ShapeDesc::TriMesh { vertices, indices } => Ok(vec![(
+                self.trimesh_mesh(vertices, indices)?,
+                Vector3::repeat(1.0),
+                Pose3::identity(),
+            )]),
             ShapeDesc::ConvexHull { points } => Err(EnvError::Render(format!(
                 "convex-hull visual shapes ({} points) cannot be drawn yet; give the actor a \
                  triangle-mesh or primitive visual",
