@@ -21,8 +21,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use ms2_physics::{ArticulationId, BodyId, BodyKind, Pose3, ShapeDesc};
 use ms2_render::{
-    Instance, InstanceId, Material, MeshData, MeshHandle, ParticleSet, ParticleSetId, Renderer,
-    RendererConfig, Scene, SegmentationIds,
+    DirectionalLight, Instance, InstanceId, Lighting, Material, MeshData, MeshHandle, ParticleSet,
+    ParticleSetId, Renderer, RendererConfig, Scene, SegmentationIds,
 };
 use nalgebra::Vector3;
 
@@ -34,10 +34,36 @@ use crate::rigid_world::RigidWorld;
 const ROUND_SEGMENTS: u32 = 24;
 /// Latitude rings of procedural spheres (capsules use half per cap).
 const SPHERE_RINGS: u32 = 12;
-/// Half side (m) of the drawn ground square (the physics ground is an infinite plane).
-pub const GROUND_HALF_SIZE_M: f32 = 2.0;
-/// Linear RGB colour of the drawn ground.
-pub const GROUND_COLOR: [f32; 3] = [0.45, 0.42, 0.38];
+/// Half side (m) of the drawn ground square (the physics ground is an infinite plane): SAPIEN's
+/// ground of 20 × 20 m, so the ground reaches every camera's 10 m far plane and no camera
+/// looking down sees past its edge.
+pub const GROUND_HALF_SIZE_M: f32 = 10.0;
+/// Linear RGB colour of the drawn ground (ManiSkill2's dark blue-grey ground).
+pub const GROUND_COLOR: [f32; 3] = [0.06, 0.08, 0.12];
+
+/// ManiSkill2's scene lighting (its `_setup_lighting`): ambient 0.3, a white directional
+/// light travelling along (1, 1, −1) (the one that casts shadows when they are on) and one
+/// straight down, no shadows. ms2 shades Lambert (albedo · cos) where SAPIEN's PBR diffuse term
+/// is albedo · cos / π, so the directional colours are 1/π to give ManiSkill2's brightness
+/// (its red cube's top face: sRGB 230 in both).
+pub fn maniskill2_lighting() -> Lighting {
+    let white = [std::f32::consts::FRAC_1_PI; 3];
+    Lighting {
+        ambient: [0.3, 0.3, 0.3],
+        directional: vec![
+            DirectionalLight {
+                direction_world: Vector3::new(1.0, 1.0, -1.0),
+                color: white,
+            },
+            DirectionalLight {
+                direction_world: Vector3::new(0.0, 0.0, -1.0),
+                color: white,
+            },
+        ],
+        background: [0.0, 0.0, 0.0],
+        shadow: None,
+    }
+}
 
 /// Wraps a render error.
 pub(crate) fn render_err(e: ms2_render::RenderError) -> EnvError {
@@ -297,8 +323,10 @@ impl WorldRenderScene {
         ctx: &RenderContext,
         world: &dyn RigidWorld,
     ) -> Result<WorldRenderScene, EnvError> {
+        let mut scene = Scene::new();
+        scene.lighting = maniskill2_lighting();
         let mut out = WorldRenderScene {
-            scene: Scene::new(),
+            scene,
             bindings: Vec::new(),
             objects: Vec::new(),
             visual_count: 0,

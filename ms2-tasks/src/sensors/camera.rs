@@ -120,8 +120,9 @@ impl CameraConfig {
         }
     }
 
-    /// The camera of `render_mode = "rgb_array"` (ManiSkill2's `render_camera`): 512×512,
-    /// fov 1 rad, at (1, 1, 0.8) looking at (0, 0, 0.35).
+    /// The camera of `render_mode = "rgb_array"` (ManiSkill2 0.5.3's `render_camera` of its
+    /// Panda pick-and-place tasks): 512×512, fov 1 rad, near 0.01 m, far 10 m, at
+    /// (0.4, 0.4, 0.8) looking at (0, 0, 0.4).
     pub fn render_camera() -> CameraConfig {
         CameraConfig {
             uid: "render_camera".to_owned(),
@@ -131,7 +132,7 @@ impl CameraConfig {
             near: 0.01,
             far: 10.0,
             mount: CameraMount::World {
-                pose_world_from_camera: look_at_robotics([1.0, 1.0, 0.8], [0.0, 0.0, 0.35]),
+                pose_world_from_camera: look_at_robotics([0.4, 0.4, 0.8], [0.0, 0.0, 0.4]),
             },
             segmentation: false,
         }
