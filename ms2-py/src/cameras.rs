@@ -107,6 +107,16 @@ pub fn camera_updates_from_py(cfgs: &Bound<'_, PyDict>) -> Result<CameraCfgUpdat
                 }
             }
             updates.per_camera.push((key, update));
+        } else if CameraConfig::panda_defaults().iter().any(|c| c.uid == key) {
+            return Err(NativeError::Input(format!(
+                "camera_cfgs[{key:?}] must be a dict of camera fields {CAMERA_UPDATE_KEYS:?}, \
+                 got {} {value}",
+                value
+                    .get_type()
+                    .name()
+                    .map(|n| n.to_string())
+                    .unwrap_or_default()
+            )));
         } else if !set_field(&mut updates.all, &format!("{key:?}"), &key, &value)? {
             return Err(NativeError::Input(format!(
                 "camera_cfgs has unknown key {key:?}: {}",

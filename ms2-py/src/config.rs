@@ -2,9 +2,9 @@
 
 use ms2_tasks::EnvConfig;
 use pyo3::conversion::FromPyObjectOwned;
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBool, PyDict, PyFloat};
 
 use crate::cameras::{cameras_from_py, render_camera_from_py};
 
@@ -38,13 +38,41 @@ fn extract_kwarg<'py, T: FromPyObjectOwned<'py>>(
     expected: &str,
 ) -> PyResult<T> {
     value.extract().map_err(|_| {
-        let type_name = value
-            .get_type()
-            .name()
-            .map(|n| n.to_string())
-            .unwrap_or_else(|_| "?".to_owned());
-        PyTypeError::new_err(format!("{key} must be {expected}, got {type_name} {value}"))
+        PyTypeError::new_err(format!(
+            "{key} must be {expected}, got {} {value}",
+            type_name(value)
+        ))
     })
+}
+
+/// The Python type name of `value`, for messages.
+fn type_name(value: &Bound<'_, PyAny>) -> String {
+    value
+        .get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".to_owned())
+}
+
+/// An int keyword (Python `int` or numpy integer; `bool` refused), or a `TypeError`.
+fn extract_int(key: &str, value: &Bound<'_, PyAny>, expected: &str) -> PyResult<i128> {
+    if value.is_instance_of::<PyBool>() || value.is_instance_of::<PyFloat>() {
+        return Err(PyTypeError::new_err(format!(
+            "{key} must be {expected}, got {} {value}",
+            type_name(value)
+        )));
+    }
+    extract_kwarg(key, value, expected)
+}
+
+/// A frequency keyword (Hz): a real number (int or float; `bool` and complex refused).
+fn extract_real(key: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    if value.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err(format!(
+            "{key} must be a number (Hz), got bool {value}"
+        )));
+    }
+    extract_kwarg(key, value, "a real number (Hz)")
 }
 
 /// The config of env `env_id` made with `kwargs` (keys from [`ENV_KWARGS`]). An unknown key
@@ -70,15 +98,22 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
             "control_mode" => cfg.control_mode = Some(extract_kwarg(&key, &value, "a str")?),
             "reward_mode" => cfg.reward_mode = Some(extract_kwarg(&key, &value, "a str")?),
             "render_mode" => cfg.render_mode = Some(extract_kwarg(&key, &value, "a str")?),
-            "sim_freq" => cfg.sim_freq = extract_kwarg(&key, &value, "a number (Hz)")?,
-            "control_freq" => cfg.control_freq = extract_kwarg(&key, &value, "a number (Hz)")?,
-            "mpm_freq" => cfg.mpm_freq = Some(extract_kwarg(&key, &value, "a number (Hz)")?),
+            "sim_freq" => cfg.sim_freq = extract_real(&key, &value)?,
+            "control_freq" => cfg.control_freq = extract_real(&key, &value)?,
+            "mpm_freq" => cfg.mpm_freq = Some(extract_real(&key, &value)?),
             "max_episode_steps" => {
-                cfg.max_episode_steps = Some(extract_kwarg(
-                    &key,
-                    &value,
-                    "a non-negative int (env steps)",
-                )?)
+                let steps: i128 = extract_int(&key, &value, "an int (env steps)")?;
+                let max = ms2_tasks::MAX_EPISODE_STEPS;
+                cfg.max_episode_steps = Some(
+                    u32::try_from(steps)
+                        .ok()
+                        .filter(|s| (1..=max).contains(s))
+                        .ok_or_else(|| {
+                            PyValueError::new_err(format!(
+                                "max_episode_steps must be in 1..={max} env steps, got {steps}"
+                            ))
+                        })?,
+                )
             }
             "camera_cfgs" => {
                 let dict = value.cast::<PyDict>().map_err(|_| {

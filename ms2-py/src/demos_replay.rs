@@ -1,7 +1,11 @@
 //! `replay_episodes`: replays / converts recorded episodes in parallel
 //! (`ms2_tasks::demos::replay_episode`).
 
-use ms2_tasks::demos::{replay_episode, DemoEpisode, ReplayOptions, ReplayedEpisode};
+use std::sync::atomic::Ordering;
+
+use ms2_tasks::demos::{
+    replay_episode, DemoEpisode, DemoError, ReplayOptions, ReplayedEpisode,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
@@ -9,7 +13,6 @@ use rayon::prelude::*;
 use crate::config::config_from_kwargs;
 use crate::convert::stack_obs;
 use crate::demos_common::{demo_error_to_py, episode_from_py, episode_to_py, in_pool};
-use crate::errors::catch_panics;
 
 /// Replays each episode of `episodes` (dicts with `episode_seed`, `control_mode`, `actions`
 /// float32 [T, A], `env_states` float32 [T+1, S] or, for soft-body episodes, `env_init_state`
@@ -53,16 +56,18 @@ pub fn replay_episodes<'py>(
         record_obs,
         max_retry,
     };
-    let results: Vec<Result<ReplayedEpisode, _>> = py.detach(|| {
-        catch_panics(|| {
-            in_pool(num_workers, || {
-                sources
-                    .par_iter()
-                    .map(|ep| replay_episode(&cfg, ep, &opts))
-                    .collect()
-            })
-        })
-    })?;
+    let results: Vec<Result<ReplayedEpisode, _>> =
+        in_pool(py, num_workers, sources.len(), |cancel| {
+            sources
+                .par_iter()
+                .map(|ep| {
+                    if cancel.load(Ordering::Relaxed) {
+                        return Err(DemoError::Interrupted);
+                    }
+                    replay_episode(&cfg, ep, &opts)
+                })
+                .collect()
+        })?;
     let out = PyList::empty(py);
     for result in results {
         let replayed = result.map_err(|e| demo_error_to_py(&e))?;

@@ -365,6 +365,24 @@ impl EnvBackend for TaskEnv {
         state
     }
 
+    fn state_layout(&self) -> crate::state_check::StateLayout {
+        let controller = self
+            .scene
+            .agent
+            .controller()
+            .state_entries()
+            .into_iter()
+            .flat_map(|e| {
+                (0..e.values.len()).map(move |i| format!("controller {} {}[{i}]", e.part, e.key))
+            });
+        let task = (0..self.task.task_state_len()).map(|i| format!("task state element {i}"));
+        crate::state_check::StateLayout::new(
+            self.scene.world.state_layout(),
+            self.scene.world.state_len(),
+            controller.chain(task).collect::<Vec<_>>(),
+        )
+    }
+
     fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError> {
         let world_len = self.scene.world.state_len();
         let parts = self.scene.agent.controller().state();

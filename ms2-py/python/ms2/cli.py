@@ -435,7 +435,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         # Trajectory files are committed chunk by chunk: what is on disk is complete.
         print(f"ms2 {args.command}: interrupted", file=sys.stderr)
         return 130
-    except (ValueError, RuntimeError, FileNotFoundError) as err:
+    except (ValueError, TypeError, RuntimeError, OSError, OverflowError) as err:
+        # OSError: unwritable or missing paths (PermissionError, NotADirectoryError, ...).
         print(f"ms2 {args.command}: error: {err}", file=sys.stderr)
         return 2
 

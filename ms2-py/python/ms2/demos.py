@@ -28,7 +28,14 @@ from pathlib import Path
 from typing import Any
 
 from . import _native
-from .trajectory import TrajectoryFileError, TrajectoryWriter, is_soft_episode, open_trajectory
+from .trajectory import (
+    MAX_SEED,
+    TrajectoryFileError,
+    TrajectoryWriter,
+    check_output_path,
+    is_soft_episode,
+    open_trajectory,
+)
 
 #: Control mode the demonstration sources produce.
 SOURCE_CONTROL_MODE = "pd_joint_pos"
@@ -38,6 +45,20 @@ SOURCE_CONTROL_MODE = "pd_joint_pos"
 SOFT_SOURCE_CONTROL_MODE = "pd_joint_delta_pos"
 #: Demonstration sources of :func:`generate`.
 POLICIES = ("solution", "scripted")
+#: Most native worker threads a call starts (also capped at the seeds or episodes to run).
+MAX_WORKERS = 256
+#: Most demonstrations one :func:`generate` call writes.
+MAX_EPISODES = 10_000_000
+
+
+def _check_int(name: str, value: Any, low: int, high: int | None) -> None:
+    """Refuses a non-int (``bool`` included: ``TypeError``) or an int outside ``[low, high]``
+    (``ValueError``), naming ``name`` and the range."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise TypeError(f"{name} must be an int, got {type(value).__name__} {value!r}")
+    if value < low or (high is not None and value > high):
+        bound = f"[{low}, {high}]" if high is not None else f">= {low}"
+        raise ValueError(f"{name} must be {bound}, got {value}")
 
 
 def _progress(total: int, desc: str, enabled: bool) -> Any:
@@ -118,12 +139,14 @@ def generate(
     without that policy; ``RuntimeError`` when fewer episodes than asked succeeded within
     ``max_seeds`` (the file then holds those that did).
     """
-    if num_episodes < 1:
-        raise ValueError(f"num_episodes must be at least 1, got {num_episodes}")
-    if num_workers < 1:
-        raise ValueError(f"num_workers must be at least 1, got {num_workers}")
-    if seed < 0:
-        raise ValueError(f"seed must be non-negative, got {seed}")
+    _check_int("num_episodes", num_episodes, 1, MAX_EPISODES)
+    _check_int("num_workers", num_workers, 1, None)
+    _check_int("seed", seed, 0, MAX_SEED)
+    if max_seeds is not None:
+        _check_int("max_seeds", max_seeds, 1, None)
+    if chunk_size is not None:
+        _check_int("chunk_size", chunk_size, 1, None)
+    check_output_path(Path(output))
     if policy not in POLICIES:
         raise ValueError(f"unknown policy {policy!r}; valid: {list(POLICIES)}")
     if policy == "solution" and env_id not in _native.solution_env_ids():
@@ -140,6 +163,13 @@ def generate(
             "(convert with ms2 replay, or use policy='scripted')"
         )
     max_seeds = 4 * num_episodes + 20 if max_seeds is None else max_seeds
+    if seed + max_seeds - 1 > MAX_SEED:
+        raise ValueError(
+            f"seeds {seed}..{seed + max_seeds - 1} would pass the largest seed {MAX_SEED} "
+            f"(2**64 - 1); use a seed of at most {MAX_SEED - max_seeds + 1}"
+        )
+    # No more threads than seeds to try, nor than MAX_WORKERS.
+    num_workers = min(num_workers, max_seeds, MAX_WORKERS)
     chunk_size = chunk_size or 4 * num_workers
     env_kwargs = {"obs_mode": "state", "control_mode": control_mode}
     run = _native.solve_episodes if policy == "solution" else _native.scripted_episodes
@@ -376,13 +406,14 @@ def replay(
         count: replay only the first ``count`` episodes.
         progress: show a progress bar.
     """
-    if num_workers < 1:
-        raise ValueError(f"num_workers must be at least 1, got {num_workers}")
-    if max_retry < 0:
-        raise ValueError(f"max_retry must be non-negative, got {max_retry}")
+    _check_int("num_workers", num_workers, 1, None)
+    _check_int("max_retry", max_retry, 0, 1000)
+    if count is not None:
+        _check_int("count", count, 0, None)
     started, cpu_started = time.perf_counter(), time.process_time()
     with open_trajectory(traj_path) as traj:
         episodes_meta = traj.episodes[: count if count is not None else len(traj.episodes)]
+        num_workers = min(num_workers, max(len(episodes_meta), 1), MAX_WORKERS)
         env_kwargs = dict(traj.env_info.get("env_kwargs") or {})
         source_modes = {ep["control_mode"] for ep in episodes_meta} or {
             env_kwargs.get("control_mode", SOURCE_CONTROL_MODE)
@@ -404,6 +435,14 @@ def replay(
             obs_mode = None
         native_kwargs["obs_mode"] = obs_mode or "state"
         native_kwargs["max_episode_steps"] = traj.env_info.get("max_episode_steps")
+        try:
+            _native.recorded_env_kwargs(traj.env_id, native_kwargs)
+        except (ValueError, TypeError) as e:
+            raise TrajectoryFileError(
+                f"{traj_path}: its env_info (env_id {traj.env_id!r}, env_kwargs "
+                f"{traj.env_info.get('env_kwargs')!r}, max_episode_steps "
+                f"{traj.env_info.get('max_episode_steps')!r}) cannot make an env: {e}"
+            ) from e
         _check_soft_episodes(traj, list(range(len(episodes_meta))), use_env_states, native_kwargs)
         templates = _state_templates(
             traj.env_id, {ep["control_mode"] for ep in episodes_meta}, native_kwargs
@@ -434,17 +473,23 @@ def replay(
                 for chunk in _chunks(indices, 4 * num_workers):
                     sources = [traj.read_episode(i) for i in chunk]
                     foreign = [_map_foreign_states(traj, ep, templates) for ep in sources]
-                    replayed = _native.replay_episodes(
-                        traj.env_id,
-                        sources,
-                        native_kwargs,
-                        target_control_mode,
-                        use_env_states,
-                        obs_mode is not None,
-                        max_retry,
-                        num_workers,
-                        use_first_env_state=use_first_env_state or any(foreign),
-                    )
+                    try:
+                        replayed = _native.replay_episodes(
+                            traj.env_id,
+                            sources,
+                            native_kwargs,
+                            target_control_mode,
+                            use_env_states,
+                            obs_mode is not None,
+                            max_retry,
+                            num_workers,
+                            use_first_env_state=use_first_env_state or any(foreign),
+                        )
+                    except (ValueError, TypeError) as e:
+                        ids = [int(src["episode_id"]) for src in sources]
+                        raise TrajectoryFileError(
+                            f"{traj_path}: cannot replay episodes {ids}: {e}"
+                        ) from e
                     for source, episode in zip(sources, replayed, strict=True):
                         result.num_episodes += 1
                         result.attempts += int(episode["attempts"])

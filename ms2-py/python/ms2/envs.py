@@ -8,6 +8,7 @@ released.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import gymnasium as gym
@@ -39,6 +40,57 @@ def adopt_config(env: Any, config: dict[str, Any]) -> None:
         "mpm_freq",
     ):
         setattr(env, key, config[key])
+
+
+#: Largest accepted seed: seeds are unsigned 64-bit integers, ``0 <= seed <= 2**64 - 1``
+#: (ManiSkill2's own seeds, drawn by ``np.random.RandomState``, are below ``2**32``).
+MAX_SEED = 2**64 - 1
+
+
+def check_seed(seed: Any, name: str = "seed") -> int | None:
+    """``seed`` as an int in ``[0, MAX_SEED]`` (``None`` passes): ``TypeError`` for a non-int
+    (``bool`` and floats included), ``ValueError`` naming the range otherwise."""
+    if seed is None:
+        return None
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)):
+        raise TypeError(f"{name} must be an int or None, got {type(seed).__name__} {seed!r}")
+    if not 0 <= int(seed) <= MAX_SEED:
+        raise ValueError(f"{name} must be in [0, 2**64 - 1], got {seed}")
+    return int(seed)
+
+
+def check_options(options: Any, valid: tuple[str, ...]) -> dict[str, Any]:
+    """``reset``'s ``options`` as a dict (``None`` = empty): ``TypeError`` for a non-mapping,
+    ``ValueError`` for an unknown key (naming the valid ones)."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise TypeError(
+            f"options must be a dict or None, got {type(options).__name__} {options!r}"
+        )
+    unknown = [k for k in options if k not in valid]
+    if unknown:
+        raise ValueError(f"unknown reset option(s) {unknown}; valid options: {list(valid)}")
+    return dict(options)
+
+
+def real_array(value: Any, what: str) -> np.ndarray:
+    """``value`` as a contiguous float32 array; ``TypeError`` for complex, string, bytes or
+    object data (which a float32 cast would silently mangle)."""
+    array = np.asarray(value)
+    if array.dtype.kind not in "biuf":
+        raise TypeError(f"{what} must hold real numbers, got dtype {array.dtype}")
+    return np.ascontiguousarray(array, dtype=np.float32)
+
+
+class _Closed:
+    """Stands in for the native env after ``close()``: every use raises a clear error."""
+
+    def __init__(self, what: str) -> None:
+        self._what = what
+
+    def __getattr__(self, name: str) -> Any:
+        raise ValueError(f"this {self._what} is closed; make a new one")
 
 
 def _seed_from(rng: np.random.Generator) -> int:
@@ -139,22 +191,24 @@ class Ms2Env(gym.Env):
         """Starts an episode. ``seed`` makes it reproducible; ``seed=None`` continues the env's
         random sequence (seeded from OS entropy on the first reset). ``options={"reconfigure":
         True}`` rebuilds the scene (ManiSkill2's option)."""
-        if seed is not None:
-            if not isinstance(seed, (int, np.integer)) or seed < 0:
-                raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
-            seed = int(seed)
+        seed = check_seed(seed)
+        options = check_options(options, ("reconfigure",))
+        reconfigure = options.get("reconfigure", False)
+        if not isinstance(reconfigure, (bool, np.bool_)):
+            raise TypeError(f"options['reconfigure'] must be a bool, got {reconfigure!r}")
+        self._native.config  # a closed env raises here, before gymnasium's seeding
         super().reset(seed=seed)
         if seed is None and not self._seeded:
             seed = _seed_from(self.np_random)
         if seed is not None:
             self._seeded = True
-        reconfigure = bool((options or {}).get("reconfigure", False))
+        reconfigure = bool(reconfigure)
         return self._native.reset(seed=seed, reconfigure=reconfigure)
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """One control step (``sim_freq / control_freq`` physics steps). ``action`` must have the
         action space's shape and be finite (``ValueError`` otherwise)."""
-        action = np.ascontiguousarray(action, dtype=np.float32)
+        action = real_array(action, "action")
         if action.shape != self.action_space.shape:
             raise ValueError(
                 f"action for control_mode {self.control_mode!r} must have shape "
@@ -182,8 +236,8 @@ class Ms2Env(gym.Env):
         return self._native.get_obs()
 
     def close(self) -> None:
-        """Releases the native env."""
-        self._native = None  # type: ignore[assignment]
+        """Releases the native env; any later call raises ``ValueError`` (the env is closed)."""
+        self._native = _Closed("Ms2Env")  # type: ignore[assignment]
 
     # --- ManiSkill2-style extras ----------------------------------------------------------------
 
@@ -192,8 +246,11 @@ class Ms2Env(gym.Env):
         return self._native.get_state()
 
     def set_state(self, state: np.ndarray) -> None:
-        """Restores a state from :meth:`get_state` (``ValueError`` on a wrong length or NaN)."""
-        state = np.ascontiguousarray(state, dtype=np.float32)
+        """Restores a state from :meth:`get_state`. ``ValueError`` on a wrong length, NaN, or an
+        impossible value (a joint outside its limits, a body too fast or too far away, a
+        non-unit quaternion), naming the index and its meaning (bounds:
+        ``docs/tasks.md``, "State bounds")."""
+        state = real_array(state, "state")
         if state.ndim != 1:
             raise ValueError(f"state must be a 1-D array, got shape {state.shape}")
         self._native.set_state(state)
