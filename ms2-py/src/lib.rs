@@ -12,6 +12,7 @@
 //! * [`viewer::NativeViewer`] — the `render_mode="human"` window (crate `ms2-viewer`).
 //! * [`errors`] — how runtime errors and panics become Python exceptions.
 
+mod assets;
 mod cameras;
 mod config;
 mod convert;
@@ -105,6 +106,12 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<policy::NativeScriptedPolicy>()?;
     m.add_class::<viewer::NativeViewer>()?;
     m.add_function(wrap_pyfunction!(env_ids, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::asset_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::asset_group_names, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::asset_group_json, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::verify_asset_group, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::register_asset_package_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::panda_description, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(render_adapter, m)?)?;
     m.add_function(wrap_pyfunction!(default_max_episode_steps, m)?)?;

@@ -47,8 +47,12 @@ pub(crate) trait EnvBackend: Send {
     fn state_len(&self) -> usize;
     /// Flat float32 simulation + task state.
     fn get_state(&self) -> Vec<f32>;
-    /// Restores a state (length and finiteness already checked).
+    /// Restores a state (length, finiteness and bounds already checked).
     fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError>;
+    /// The meaning and bounds of each state element (default: none known, finiteness only).
+    fn state_layout(&self) -> crate::state_check::StateLayout {
+        crate::state_check::StateLayout::new(None, self.state_len(), [])
+    }
     /// Renders the observation cameras (robot tasks only).
     #[cfg(feature = "render")]
     fn capture_cameras(&self) -> Result<crate::sensors::CameraFrame, EnvError> {

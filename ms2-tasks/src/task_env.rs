@@ -45,6 +45,12 @@ pub(crate) struct TaskEnv {
     /// The observation cameras (checked when the env is made, in every build).
     #[cfg(feature = "render")]
     camera_cfgs: Vec<CameraConfig>,
+    /// The camera of `render()` (checked when the env is made).
+    #[cfg(feature = "render")]
+    render_camera: CameraConfig,
+    /// Whether the first directional light casts shadows (`enable_shadow`).
+    #[cfg(feature = "render")]
+    enable_shadow: bool,
     /// Cameras and render scene, built on the first render (state-only envs never render).
     #[cfg(feature = "render")]
     sensors: Mutex<Option<Sensors>>,
@@ -117,6 +123,13 @@ impl TaskEnv {
         for cam in &camera_cfgs {
             cam.validate()?;
         }
+        let render_camera = cfg
+            .render_camera
+            .clone()
+            .unwrap_or_else(CameraConfig::render_camera);
+        render_camera.validate()?;
+        #[cfg(not(feature = "render"))]
+        let _ = render_camera;
         Ok(Self {
             task,
             scene,
@@ -129,6 +142,10 @@ impl TaskEnv {
             action_space,
             #[cfg(feature = "render")]
             camera_cfgs,
+            #[cfg(feature = "render")]
+            render_camera,
+            #[cfg(feature = "render")]
+            enable_shadow: cfg.enable_shadow,
             #[cfg(feature = "render")]
             sensors: Mutex::new(None),
         })
@@ -171,8 +188,9 @@ impl TaskEnv {
             self.scene.world.as_ref(),
             Some(self.scene.agent.articulation()),
             self.camera_cfgs.clone(),
-            CameraConfig::render_camera(),
+            self.render_camera.clone(),
         )?;
+        sensors.set_shadows(self.enable_shadow);
         for visual in self
             .task
             .soft()
@@ -345,6 +363,24 @@ impl EnvBackend for TaskEnv {
         state.extend(self.controller_state());
         state.extend(self.task.task_state());
         state
+    }
+
+    fn state_layout(&self) -> crate::state_check::StateLayout {
+        let controller = self
+            .scene
+            .agent
+            .controller()
+            .state_entries()
+            .into_iter()
+            .flat_map(|e| {
+                (0..e.values.len()).map(move |i| format!("controller {} {}[{i}]", e.part, e.key))
+            });
+        let task = (0..self.task.task_state_len()).map(|i| format!("task state element {i}"));
+        crate::state_check::StateLayout::new(
+            self.scene.world.state_layout(),
+            self.scene.world.state_len(),
+            controller.chain(task).collect::<Vec<_>>(),
+        )
     }
 
     fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError> {

@@ -120,6 +120,16 @@ impl Sensors {
         Ok(self.particle_sets.len() - 1)
     }
 
+    /// Turns the shadows of the scene's first directional light on (a 1.5 m sphere around the
+    /// table, 2048² texels, as ManiSkill2's `enable_shadow`) or off.
+    pub fn set_shadows(&mut self, on: bool) {
+        self.scene.scene_mut().lighting.shadow = on.then_some(ms2_render::Shadow {
+            center_world: Vector3::new(0.0, 0.0, 0.3),
+            radius_m: 1.5,
+            resolution: 2048,
+        });
+    }
+
     /// Number of particle sets.
     pub fn particle_set_count(&self) -> usize {
         self.particle_sets.len()
@@ -167,7 +177,7 @@ impl Sensors {
         let outputs = self
             .ctx
             .renderer()
-            .render(&[(self.scene.scene(), &cams[..])])
+            .render_sensors(&[(self.scene.scene(), &cams[..])])
             .map_err(render_err)?;
         Ok(self.frame(outputs))
     }
@@ -199,6 +209,7 @@ impl Sensors {
             uids: self.cameras.iter().map(|c| c.uid.clone()).collect(),
             outputs,
             robot_ids: self.robot_ids.clone(),
+            segmentation: self.cameras.iter().map(|c| c.segmentation).collect(),
         }
     }
 
