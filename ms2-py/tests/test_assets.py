@@ -17,9 +17,8 @@ import sys
 import zipfile
 from pathlib import Path
 
-import pytest
-
 import ms2.assets as assets
+import pytest
 
 GROUP = "franka_description"
 
