@@ -21,28 +21,14 @@ from pathlib import Path
 import ms2
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from conftest import leaves
+from hypothesis import given
 from hypothesis import strategies as st
 from ms2 import cli
-
-from conftest import leaves
 
 #: No single call may take longer than this (s): a bound against hangs, generous on purpose.
 CALL_DEADLINE_S = 30.0
 
-settings.register_profile(
-    "ci",
-    max_examples=25,
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
-settings.register_profile(
-    "heavy",
-    max_examples=500,
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-)
-settings.load_profile("ci")
 
 _pool = ThreadPoolExecutor(max_workers=1)
 
@@ -72,7 +58,7 @@ def assert_names_value(err: Exception, *candidates) -> None:
     assert any(t in msg for t in texts), f"{type(err).__name__}: {msg!r} names none of {texts}"
 
 
-# ---- env configs -------------------------------------------------------------------------------
+# ---- env configs ----
 
 _numbers = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
@@ -121,7 +107,7 @@ def test_env_configs_are_accepted_cleanly_or_refused_by_name(env_id, cfg):
         assert_finite(obs, reward)
 
 
-# ---- actions -------------------------------------------------------------------------------------
+# ---- actions ----
 
 _elements = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True, width=64),
@@ -162,7 +148,7 @@ def test_actions_step_finitely_or_are_refused_by_name(pick_env, action):
     assert_finite(obs, reward)
 
 
-# ---- states ----------------------------------------------------------------------------------------
+# ---- states ----
 
 
 @pytest.fixture(scope="module")
@@ -219,7 +205,7 @@ def test_states_of_real_episodes_are_accepted(recorded_states):
         np.testing.assert_array_equal(env.get_state(), state)
 
 
-# ---- seeds and reset options -------------------------------------------------------------------------
+# ---- seeds and reset options ----
 
 _seeds = st.one_of(
     st.integers(min_value=-(2**70), max_value=2**70),
@@ -285,7 +271,7 @@ def test_closed_env_says_so():
             call()
 
 
-# ---- CLI -------------------------------------------------------------------------------------------
+# ---- CLI ----
 
 
 @given(
@@ -313,8 +299,14 @@ def _trajectory(factory) -> Path:
         from ms2 import demos
 
         path = factory.mktemp("traj") / "dummy.h5"
-        demos.generate("Dummy-v0", 2, path, policy="scripted", progress=False,
-                       control_mode="pd_joint_delta_pos")
+        demos.generate(
+            "Dummy-v0",
+            2,
+            path,
+            policy="scripted",
+            progress=False,
+            control_mode="pd_joint_delta_pos",
+        )
         _TRAJ.append(path)
     return _TRAJ[0]
 
@@ -347,7 +339,7 @@ def test_demos_generate_cli_arguments(tmp_path, capsys, n, seed, workers, output
         assert out.exists()
 
 
-# ---- the process never aborts --------------------------------------------------------------------
+# ---- the process never aborts ----
 
 _ABORTERS = r"""
 import ms2, numpy as np

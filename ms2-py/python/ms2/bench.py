@@ -40,6 +40,7 @@ MANISKILL2_VISUAL_STEPS_PER_S = 18.0
 #: rendering, a single environment runs at around 17-18 FPS" (RTX Titan GPU).
 MANISKILL2_SOFT_RENDER_STEPS_PER_S = 17.5
 
+
 def _cpu_seconds() -> float:
     """This process's CPU time (user + system, all threads) in seconds."""
     usage = resource.getrusage(resource.RUSAGE_SELF)
@@ -184,9 +185,30 @@ def _runner_name(kind: str, n: int) -> str:
     return "gym.make (1 env)" if kind == "single" else f"make_vec({n})"
 
 
+def _soak(args: argparse.Namespace) -> int:
+    """``ms2 bench --soak``: see :mod:`ms2.soak`."""
+    from .soak import run_soak
+
+    steps = 1_000_000 if args.steps is None else args.steps
+    if steps < 1:
+        raise ValueError(f"--steps must be at least 1, got {steps}")
+    print(
+        f"ms2 bench --soak: {steps} env steps over every task and obs mode, load average "
+        f"{os.getloadavg()[0]:.1f}",
+        flush=True,
+    )
+    total = run_soak(steps)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(total, f, indent=2)
+    return 0 if total["non_finite"] == 0 and total["errors"] == 0 else 1
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     if args.worker:
         return _worker(args)
+    if args.soak:
+        return _soak(args)
     num_envs_list = [int(n) for n in args.num_envs.split(",") if n]
     if args.visual:
         return _bench_visual(args, num_envs_list)
@@ -344,6 +366,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         choices=["random", "scripted"],
         default="random",
         help="actions: uniform random (default) or the task's scripted solution (single envs)",
+    )
+    p.add_argument(
+        "--soak",
+        action="store_true",
+        help="robustness soak instead: --steps (default 1,000,000) env steps over every task and "
+        "obs mode with resets and set_state of recorded states; reports RSS, NaN and errors",
     )
     p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     p.add_argument("--worker", default=None, help=argparse.SUPPRESS)

@@ -63,9 +63,7 @@ def check_options(options: Any, valid: tuple[str, ...]) -> dict[str, Any]:
     if options is None:
         return {}
     if not isinstance(options, Mapping):
-        raise TypeError(
-            f"options must be a dict or None, got {type(options).__name__} {options!r}"
-        )
+        raise TypeError(f"options must be a dict or None, got {type(options).__name__} {options!r}")
     unknown = [k for k in options if k not in valid]
     if unknown:
         raise ValueError(f"unknown reset option(s) {unknown}; valid options: {list(valid)}")

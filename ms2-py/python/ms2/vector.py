@@ -36,9 +36,7 @@ class Ms2VectorEnv(VectorEnv):
 
     def __init__(self, env_id: str = "PickCube-v0", num_envs: int = 1, **kwargs: Any) -> None:
         if isinstance(num_envs, (bool, np.bool_)) or not isinstance(num_envs, (int, np.integer)):
-            raise TypeError(
-                f"num_envs must be an int, got {type(num_envs).__name__} {num_envs!r}"
-            )
+            raise TypeError(f"num_envs must be an int, got {type(num_envs).__name__} {num_envs!r}")
         if not 1 <= num_envs <= MAX_NUM_ENVS:
             raise ValueError(f"num_envs must be in 1..={MAX_NUM_ENVS}, got {num_envs}")
         self._native = _native.NativeVecEnv(env_id, int(num_envs), **kwargs)
