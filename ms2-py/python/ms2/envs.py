@@ -78,7 +78,8 @@ def real_array(value: Any, what: str) -> np.ndarray:
     array = np.asarray(value)
     if array.dtype.kind not in "biuf":
         raise TypeError(f"{what} must hold real numbers, got dtype {array.dtype}")
-    return np.ascontiguousarray(array, dtype=np.float32)
+    with np.errstate(over="ignore"):  # values beyond float32 become inf, refused natively
+        return np.ascontiguousarray(array, dtype=np.float32)
 
 
 class _Closed:
@@ -199,25 +200,26 @@ class Ms2Env(gym.Env):
         reconfigure = options.get("reconfigure", False)
         if not isinstance(reconfigure, (bool, np.bool_)):
             raise TypeError(f"options['reconfigure'] must be a bool, got {reconfigure!r}")
-        self._native.config  # a closed env raises here, before gymnasium's seeding
+        native_reset = self._native.reset  # a closed env raises here
         super().reset(seed=seed)
         if seed is None and not self._seeded:
             seed = _seed_from(self.np_random)
         if seed is not None:
             self._seeded = True
         reconfigure = bool(reconfigure)
-        return self._native.reset(seed=seed, reconfigure=reconfigure)
+        return native_reset(seed=seed, reconfigure=reconfigure)
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """One control step (``sim_freq / control_freq`` physics steps). ``action`` must have the
         action space's shape and be finite (``ValueError`` otherwise)."""
+        native_step = self._native.step  # a closed env raises here
         action = real_array(action, "action")
         if action.shape != self.action_space.shape:
             raise ValueError(
                 f"action for control_mode {self.control_mode!r} must have shape "
                 f"{self.action_space.shape}, got {action.shape}"
             )
-        return self._native.step(action)
+        return native_step(action)
 
     def render(self) -> np.ndarray | None:
         """An RGB image (uint8 [H, W, 3]): with ``render_mode="rgb_array"`` the render
