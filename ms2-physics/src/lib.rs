@@ -64,6 +64,7 @@ pub mod panda;
 pub mod shape;
 #[cfg(feature = "rapier")]
 pub mod state;
+pub mod state_layout;
 pub mod urdf;
 #[cfg(feature = "rapier")]
 pub mod world;
@@ -80,9 +81,10 @@ pub use ids::{ArticulationId, BodyId, BodyKind};
 pub use math::Pose3;
 pub use mesh::{MeshCollision, MeshError};
 #[cfg(feature = "rapier")]
-pub use panda::{add_panda, add_panda_from_urdf};
+pub use panda::{add_panda, add_panda_from_file, add_panda_from_urdf};
 pub use panda::{PandaOptions, PANDA_FINGER_FRICTION};
 pub use shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
+pub use state_layout::{StateField, StateQuantity};
 pub use urdf::{parse_urdf_file, parse_urdf_str, UrdfLoadOptions};
 #[cfg(feature = "rapier")]
 pub use world::World;

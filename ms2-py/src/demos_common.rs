@@ -8,7 +8,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::info_to_py;
-use crate::errors::{env_error_to_py, NativeError};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+
+use crate::errors::{catch_panics, env_error_to_py, NativeError};
 
 /// The Python exception for a [`DemoError`]: env errors as in `errors`, unsupported conversions,
 /// missing solutions and invalid episodes as `ValueError`, planning failures as `RuntimeError`.
@@ -142,16 +145,55 @@ pub fn recorded_env_kwargs<'py>(
     Ok(dict)
 }
 
-/// Runs `f` on a rayon pool of `num_workers` threads (at least 1).
+/// Most worker threads a demonstration call starts, whatever `num_workers` says.
+pub const MAX_WORKERS: usize = 256;
+
+/// How often (s) a waiting native call checks for Ctrl-C.
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Runs `f` on a rayon pool of `num_workers` threads, capped at the `work` items there are and at
+/// [`MAX_WORKERS`], with the GIL released; a panic becomes `RuntimeError`.
+///
+/// Ctrl-C interrupts it: while `f` runs, the calling thread checks Python's signal handlers
+/// every 100 ms; on a pending `KeyboardInterrupt` it sets the flag handed to `f` (whose items
+/// skip their work once it is set), waits for the items in progress and raises the interrupt.
 pub fn in_pool<T: Send>(
+    py: Python<'_>,
     num_workers: usize,
-    f: impl FnOnce() -> T + Send,
-) -> Result<T, NativeError> {
+    work: usize,
+    f: impl FnOnce(&AtomicBool) -> T + Send,
+) -> PyResult<T> {
+    let threads = num_workers.clamp(1, work.clamp(1, MAX_WORKERS));
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(num_workers.max(1))
+        .num_threads(threads)
         .build()
-        .map_err(|e| {
-            NativeError::Input(format!("cannot start {num_workers} worker threads: {e}"))
-        })?;
-    Ok(pool.install(f))
+        .map_err(|e| NativeError::Input(format!("cannot start {threads} worker threads: {e}")))?;
+    let cancel = AtomicBool::new(false);
+    let (tx, mut rx) = mpsc::channel();
+    std::thread::scope(|scope| {
+        let (pool, cancel_ref) = (&pool, &cancel);
+        scope.spawn(move || {
+            let _ = tx.send(catch_panics(|| Ok(pool.install(|| f(cancel_ref)))));
+        });
+        loop {
+            // A `&mut` of the receiver is `Send` (the receiver itself is not `Sync`).
+            let receiver = &mut rx;
+            match py.detach(move || receiver.recv_timeout(SIGNAL_POLL)) {
+                Ok(result) => return result.map_err(PyErr::from),
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if let Err(interrupt) = py.check_signals() {
+                        cancel.store(true, Ordering::Relaxed);
+                        let receiver = &mut rx;
+                        let _ = py.detach(move || receiver.recv());
+                        return Err(interrupt);
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(PyRuntimeError::new_err(
+                        "ms2 internal error: a worker pool ended without a result",
+                    ))
+                }
+            }
+        }
+    })
 }

@@ -1,7 +1,11 @@
 //! `replay_episodes`: replays / converts recorded episodes in parallel
 //! (`ms2_tasks::demos::replay_episode`).
 
-use ms2_tasks::demos::{replay_episode, DemoEpisode, ReplayOptions, ReplayedEpisode};
+use std::sync::atomic::Ordering;
+
+use ms2_tasks::demos::{
+    replay_episode, DemoEpisode, DemoError, ReplayOptions, ReplayedEpisode,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
@@ -9,7 +13,6 @@ use rayon::prelude::*;
 use crate::config::config_from_kwargs;
 use crate::convert::stack_obs;
 use crate::demos_common::{demo_error_to_py, episode_from_py, episode_to_py, in_pool};
-use crate::errors::catch_panics;
 
 /// Replays each episode of `episodes` (dicts with `episode_seed`, `control_mode`, `actions`
 /// float32 [T, A], `env_states` float32 [T+1, S] or, for soft-body episodes, `env_init_state`
@@ -17,7 +20,8 @@ use crate::errors::catch_panics;
 /// threads with the GIL released.
 ///
 /// `target_control_mode` (`None` = each episode's own) converts actions closed-loop;
-/// `use_env_states` restores the recorded states after every step; `record_obs` collects the
+/// `use_env_states` restores the recorded states after every step; `use_first_env_state`
+/// restores `env_states[0]` after the reset (also when converting); `record_obs` collects the
 /// observations of `env_kwargs["obs_mode"]`; `max_retry` retries failed conversions.
 ///
 /// Returns one dict per episode, in order: the replayed episode (keys as `solve_episodes`'s, in
@@ -25,7 +29,8 @@ use crate::errors::catch_panics;
 /// `record_obs`). Bad input raises `ValueError`; a failing simulation `RuntimeError`.
 #[pyfunction]
 #[pyo3(signature = (env_id, episodes, env_kwargs=None, target_control_mode=None,
-                    use_env_states=false, record_obs=false, max_retry=0, num_workers=1))]
+                    use_env_states=false, record_obs=false, max_retry=0, num_workers=1,
+                    use_first_env_state=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn replay_episodes<'py>(
     py: Python<'py>,
@@ -37,6 +42,7 @@ pub fn replay_episodes<'py>(
     record_obs: bool,
     max_retry: u32,
     num_workers: usize,
+    use_first_env_state: bool,
 ) -> PyResult<Bound<'py, PyList>> {
     let cfg = config_from_kwargs(&env_id, env_kwargs)?;
     let sources: Vec<DemoEpisode> = episodes
@@ -46,19 +52,22 @@ pub fn replay_episodes<'py>(
     let opts = ReplayOptions {
         target_control_mode,
         use_env_states,
+        use_first_env_state,
         record_obs,
         max_retry,
     };
-    let results: Vec<Result<ReplayedEpisode, _>> = py.detach(|| {
-        catch_panics(|| {
-            in_pool(num_workers, || {
-                sources
-                    .par_iter()
-                    .map(|ep| replay_episode(&cfg, ep, &opts))
-                    .collect()
-            })
-        })
-    })?;
+    let results: Vec<Result<ReplayedEpisode, _>> =
+        in_pool(py, num_workers, sources.len(), |cancel| {
+            sources
+                .par_iter()
+                .map(|ep| {
+                    if cancel.load(Ordering::Relaxed) {
+                        return Err(DemoError::Interrupted);
+                    }
+                    replay_episode(&cfg, ep, &opts)
+                })
+                .collect()
+        })?;
     let out = PyList::empty(py);
     for result in results {
         let replayed = result.map_err(|e| demo_error_to_py(&e))?;

@@ -1,14 +1,15 @@
 //! `scripted_episodes`: demonstrations recorded from the scripted oracle
 //! (`ms2_tasks::demos::scripted_episode`), in parallel.
 
-use ms2_tasks::demos::scripted_episode;
+use std::sync::atomic::Ordering;
+
+use ms2_tasks::demos::{scripted_episode, DemoError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 
 use crate::config::config_from_kwargs;
 use crate::demos_common::{demo_error_to_py, episode_to_py, in_pool};
-use crate::errors::catch_panics;
 
 /// Records the scripted oracle of `env_id` (control mode `env_kwargs["control_mode"]`, default
 /// `pd_joint_pos`) for each seed on `num_workers` threads with the GIL released. Returns one dict
@@ -24,15 +25,16 @@ pub fn scripted_episodes<'py>(
     num_workers: usize,
 ) -> PyResult<Bound<'py, PyList>> {
     let cfg = config_from_kwargs(&env_id, env_kwargs)?;
-    let results: Vec<_> = py.detach(|| {
-        catch_panics(|| {
-            in_pool(num_workers, || {
-                seeds
-                    .par_iter()
-                    .map(|&seed| scripted_episode(&cfg, seed))
-                    .collect()
+    let results: Vec<_> = in_pool(py, num_workers, seeds.len(), |cancel| {
+        seeds
+            .par_iter()
+            .map(|&seed| {
+                if cancel.load(Ordering::Relaxed) {
+                    return Err(DemoError::Interrupted);
+                }
+                scripted_episode(&cfg, seed)
             })
-        })
+            .collect()
     })?;
     let out = PyList::empty(py);
     for result in results {

@@ -1,5 +1,7 @@
 //! `solve_episodes`: runs the motion-planning solutions over seeds in parallel.
 
+use std::sync::atomic::Ordering;
+
 use ms2_tasks::demos::solutions::{solution_env_ids as native_solution_env_ids, DemoSolver};
 use ms2_tasks::demos::{DemoEpisode, DemoError};
 use pyo3::prelude::*;
@@ -8,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::config::config_from_kwargs;
 use crate::demos_common::{demo_error_to_py, episode_to_py, in_pool};
-use crate::errors::{catch_panics, NativeError};
+use crate::errors::NativeError;
 
 /// Env ids that have a motion-planning solution.
 #[pyfunction]
@@ -33,28 +35,33 @@ pub fn solve_episodes<'py>(
     num_workers: usize,
 ) -> PyResult<Bound<'py, PyList>> {
     let cfg = config_from_kwargs(&env_id, env_kwargs)?;
-    let results: Vec<Result<DemoEpisode, DemoError>> = py.detach(|| {
-        catch_panics(|| {
-            in_pool(num_workers, || {
-                // Seeds go out in chunks (a few per worker, for balance); each chunk builds one
-                // solver (env + planners) and reuses it for its seeds. A solver that cannot be
-                // built fails the whole call with its error.
-                let chunk = seeds.len().div_ceil(4 * num_workers.max(1)).max(1);
-                seeds
-                    .par_chunks(chunk)
-                    .map(|chunk| {
-                        let mut solver = DemoSolver::new(&cfg)?;
-                        Ok(chunk
-                            .iter()
-                            .map(|&seed| solver.solve(seed).map(|(episode, _)| episode))
-                            .collect::<Vec<_>>())
-                    })
-                    .collect::<Result<Vec<_>, DemoError>>()
-                    .map(|chunks| chunks.into_iter().flatten().collect())
-            })?
-            .map_err(NativeError::from)
-        })
-    })?;
+    let results: Vec<Result<DemoEpisode, DemoError>> =
+        in_pool(py, num_workers, seeds.len(), |cancel| {
+            // Seeds go out in chunks (a few per worker, for balance); each chunk builds one
+            // solver (env + planners) and reuses it for its seeds. A solver that cannot be
+            // built fails the whole call with its error.
+            let chunk = seeds.len().div_ceil(4 * num_workers.max(1)).max(1);
+            seeds
+                .par_chunks(chunk)
+                .map(|chunk| {
+                    if cancel.load(Ordering::Relaxed) {
+                        return Ok(chunk.iter().map(|_| Err(DemoError::Interrupted)).collect());
+                    }
+                    let mut solver = DemoSolver::new(&cfg)?;
+                    Ok(chunk
+                        .iter()
+                        .map(|&seed| {
+                            if cancel.load(Ordering::Relaxed) {
+                                return Err(DemoError::Interrupted);
+                            }
+                            solver.solve(seed).map(|(episode, _)| episode)
+                        })
+                        .collect::<Vec<_>>())
+                })
+                .collect::<Result<Vec<_>, DemoError>>()
+                .map(|chunks| chunks.into_iter().flatten().collect())
+        })?
+        .map_err(NativeError::from)?;
     let out = PyList::empty(py);
     for (seed, result) in seeds.iter().zip(results) {
         match result {

@@ -79,6 +79,7 @@ fn is_input_error(err: &EnvError) -> bool {
             | EnvError::NonFiniteAction { .. }
             | EnvError::StateShape { .. }
             | EnvError::NonFiniteState { .. }
+            | EnvError::StateOutOfBounds { .. }
             | EnvError::SeedCount { .. }
             | EnvError::InvalidConfig(_)
             | EnvError::NoScriptedPolicy { .. }

@@ -204,7 +204,27 @@ const VERTEX_BYTES: u64 = 32;
 /// Bytes per instance record: model rows (3 vec4), normal rows (3 vec4), colour, ids.
 pub(crate) const INSTANCE_BYTES: u64 = 128;
 
+/// Environment variable that turns off Mesa's implicit `VK_LAYER_MESA_device_select` Vulkan
+/// layer (its manifest's `disable_environment`).
+pub const MESA_DEVICE_SELECT_OFF_VAR: &str = "NODEVICE_SELECT";
+
+/// Turns off Mesa's device-select layer for this process unless the user set
+/// [`MESA_DEVICE_SELECT_OFF_VAR`] themselves. The layer only reorders adapters (ms2 ranks them
+/// itself, see [`pick_adapter`]), but to find "the display's GPU" it connects to the Wayland
+/// compositor whenever `WAYLAND_DISPLAY` is set; without `XDG_RUNTIME_DIR` (headless shells,
+/// containers, CI) libwayland then prints `error: XDG_RUNTIME_DIR is invalid or not set in the
+/// environment.` on every Vulkan instance. Headless rendering needs no display, so the probe is
+/// skipped at its source.
+fn disable_mesa_device_select() {
+    if std::env::var_os(MESA_DEVICE_SELECT_OFF_VAR).is_none() {
+        // Done once, before the first Vulkan instance of the process; no other thread reads
+        // this variable (only the Vulkan loader does, inside instance creation below).
+        std::env::set_var(MESA_DEVICE_SELECT_OFF_VAR, "1");
+    }
+}
+
 fn pick_adapter(choice: BackendChoice) -> Result<wgpu::Adapter, RenderError> {
+    disable_mesa_device_select();
     let choice = match choice {
         BackendChoice::Auto => match std::env::var(BACKEND_ENV_VAR) {
             Ok(v) => BackendChoice::parse(&v)?,

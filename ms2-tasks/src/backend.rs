@@ -47,8 +47,12 @@ pub(crate) trait EnvBackend: Send {
     fn state_len(&self) -> usize;
     /// Flat float32 simulation + task state.
     fn get_state(&self) -> Vec<f32>;
-    /// Restores a state (length and finiteness already checked).
+    /// Restores a state (length, finiteness and bounds already checked).
     fn set_state(&mut self, state: &[f32]) -> Result<(), EnvError>;
+    /// The meaning and bounds of each state element (default: none known, finiteness only).
+    fn state_layout(&self) -> crate::state_check::StateLayout {
+        crate::state_check::StateLayout::new(None, self.state_len(), [])
+    }
     /// Renders the observation cameras (robot tasks only).
     #[cfg(feature = "render")]
     fn capture_cameras(&self) -> Result<crate::sensors::CameraFrame, EnvError> {
@@ -72,6 +76,16 @@ pub(crate) trait EnvBackend: Send {
     /// only).
     #[cfg(feature = "render")]
     fn render_human(&self, _goal_key: Option<&str>) -> Result<ms2_render::CameraOutput, EnvError> {
+        Err(self.not_renderable())
+    }
+    /// Calls `f` with the scene as of now, goal marker at the `extra` entry `goal_key` shown
+    /// (robot tasks only).
+    #[cfg(feature = "render")]
+    fn view_scene(
+        &self,
+        _goal_key: Option<&str>,
+        _f: &mut dyn FnMut(&crate::sensors::SceneView<'_>),
+    ) -> Result<(), EnvError> {
         Err(self.not_renderable())
     }
     /// Channel-1 segmentation ids by object name (robot tasks only).

@@ -12,8 +12,10 @@ use crate::sensors::{CameraConfig, VisualLayout};
 pub struct EnvConfig {
     /// Registered environment id, e.g. `"PickCube-v0"` (see [`crate::env_ids`]).
     pub env_id: String,
-    /// Observation mode: `"state_dict"`, `"state"`, `"rgbd"`, `"pointcloud"`,
-    /// `"rgbd_robot_seg"` or `"pointcloud_robot_seg"`.
+    /// Observation mode ([`ObsMode`]): `"state"`, `"state_dict"`, `"none"`, `"image"`,
+    /// `"rgbd"`, `"pointcloud"`, `"rgbd_robot_seg"`, `"pointcloud_robot_seg"` or (soft-body
+    /// tasks) `"particles"`. [`EnvConfig::new`] takes `state_dict`; the Python keyword's
+    /// default is ManiSkill2's `state`.
     pub obs_mode: String,
     /// Robot uid (ManiSkill2's `robot=`, e.g. `"panda"`); `None` = the task's default (see
     /// [`crate::spec::TaskSpec::robots`]).
@@ -37,6 +39,17 @@ pub struct EnvConfig {
     /// the task's default (1000 Hz; ManiSkill2 uses 2000). Must be a whole multiple of
     /// `sim_freq`; setting it on an env without soft bodies is an error.
     pub mpm_freq: Option<f64>,
+    /// Whether the first directional light casts shadows in every image (observation cameras
+    /// and `render()`; ManiSkill2's `enable_shadow`, default off).
+    pub enable_shadow: bool,
+    /// The camera of `render()` (`render_mode` `rgb_array` / `cameras`); `None` = the task's
+    /// default ([`CameraConfig::render_camera`]). ManiSkill2's `render_camera_cfgs` keyword
+    /// changes it field by field.
+    pub render_camera: Option<CameraConfig>,
+    /// ManiSkill2's `bg_name` (a visual background scene replacing the default lights);
+    /// `None` = the default scene. ms2 ships no background scenes, so any name is refused with
+    /// [`EnvError::InvalidConfig`].
+    pub bg_name: Option<String>,
 }
 
 impl Default for EnvConfig {
@@ -53,6 +66,9 @@ impl Default for EnvConfig {
             control_freq: 20.0,
             max_episode_steps: None,
             mpm_freq: None,
+            enable_shadow: false,
+            render_camera: None,
+            bg_name: None,
         }
     }
 }
@@ -72,12 +88,39 @@ impl EnvConfig {
     }
 
     /// Number of physics substeps per env step (`sim_freq / control_freq`), after checking that
-    /// both are finite, positive and that the ratio is a whole number.
+    /// both are within their bounds ([`SIM_FREQ_RANGE`], [`CONTROL_FREQ_RANGE`]), that the
+    /// ratio is a whole number and at most [`MAX_SUBSTEPS`].
     pub fn substeps(&self) -> Result<u32, EnvError> {
-        whole_multiple(
+        check_range("sim_freq", self.sim_freq, SIM_FREQ_RANGE, "Hz")?;
+        check_range("control_freq", self.control_freq, CONTROL_FREQ_RANGE, "Hz")?;
+        let substeps = whole_multiple(
             ("sim_freq", self.sim_freq),
             ("control_freq", self.control_freq),
-        )
+        )?;
+        if substeps > MAX_SUBSTEPS {
+            return Err(EnvError::InvalidConfig(format!(
+                "sim_freq / control_freq = {} / {} = {substeps} physics substeps per env step; \
+                 at most {MAX_SUBSTEPS} are allowed",
+                self.sim_freq, self.control_freq
+            )));
+        }
+        Ok(substeps)
+    }
+
+    /// Checks the sizes of the config that do not need the task: `max_episode_steps` within
+    /// 1..=[`MAX_EPISODE_STEPS`] and the frequencies (see [`EnvConfig::substeps`]).
+    pub fn check_bounds(&self) -> Result<(), EnvError> {
+        if let Some(steps) = self.max_episode_steps {
+            if !(1..=MAX_EPISODE_STEPS).contains(&steps) {
+                return Err(EnvError::InvalidConfig(format!(
+                    "max_episode_steps must be in 1..={MAX_EPISODE_STEPS} env steps, got {steps}"
+                )));
+            }
+        }
+        if let Some(hz) = self.mpm_freq {
+            check_range("mpm_freq", hz, MPM_FREQ_RANGE, "Hz")?;
+        }
+        self.substeps().map(|_| ())
     }
 
     /// The MPM substep length (s) of a soft-body task whose default MPM frequency is
@@ -94,9 +137,44 @@ impl EnvConfig {
     /// ```
     pub fn mpm_substep_dt(&self, default_hz: f64) -> Result<f32, EnvError> {
         let mpm = self.mpm_freq.unwrap_or(default_hz);
+        check_range("mpm_freq", mpm, MPM_FREQ_RANGE, "Hz")?;
         whole_multiple(("mpm_freq", mpm), ("sim_freq", self.sim_freq))?;
+        let per_env_step = mpm / self.control_freq;
+        if per_env_step > f64::from(MAX_MPM_SUBSTEPS) {
+            return Err(EnvError::InvalidConfig(format!(
+                "mpm_freq / control_freq = {mpm} / {} = {per_env_step} MPM substeps per env step; \
+                 at most {MAX_MPM_SUBSTEPS} are allowed",
+                self.control_freq
+            )));
+        }
         Ok((1.0 / mpm) as f32)
     }
+}
+
+/// Accepted physics frequencies (Hz): ManiSkill2's default is 500; below 10 Hz the time step
+/// exceeds the rigid engine's 0.1 s limit, above 10 kHz an env step costs seconds for nothing.
+pub const SIM_FREQ_RANGE: (f64, f64) = (10.0, 10_000.0);
+/// Accepted control (env step) frequencies (Hz); ManiSkill2's default is 20.
+pub const CONTROL_FREQ_RANGE: (f64, f64) = (0.1, 10_000.0);
+/// Accepted MPM substep frequencies (Hz) of the soft-body tasks (default 1000, ManiSkill2 2000).
+pub const MPM_FREQ_RANGE: (f64, f64) = (10.0, 20_000.0);
+/// Most physics substeps per env step (`sim_freq / control_freq`; 25 by default): bounds the
+/// time one `step` takes (well under a second for the rigid tasks).
+pub const MAX_SUBSTEPS: u32 = 1000;
+/// Most MPM substeps per env step (`mpm_freq / control_freq`; 50 by default, 100 at ManiSkill2's
+/// 2 kHz): bounds the time one soft-body `step` takes (a few seconds at most).
+pub const MAX_MPM_SUBSTEPS: u32 = 2000;
+/// Longest accepted episode limit in env steps (ManiSkill2's tasks use 200-350).
+pub const MAX_EPISODE_STEPS: u32 = i32::MAX as u32;
+
+/// Refuses `value` (named `name`, in `unit`) outside the inclusive `(low, high)`, or NaN.
+fn check_range(name: &str, value: f64, (low, high): (f64, f64), unit: &str) -> Result<(), EnvError> {
+    if !(value >= low && value <= high) {
+        return Err(EnvError::InvalidConfig(format!(
+            "{name} must be in [{low}, {high}] {unit}, got {value}"
+        )));
+    }
+    Ok(())
 }
 
 /// `high / low` for two named frequencies (Hz), after checking that both are finite and
@@ -139,13 +217,21 @@ pub enum ObsMode {
     PointCloudRobotSeg,
     /// `state_dict` plus `particles` (soft-body envs: `{"x": [N, 3]}` particle positions).
     Particles,
+    /// No observation: an empty dict (ManiSkill2's `none`, used when recording demonstrations).
+    None,
+    /// Raw camera textures per camera, as ManiSkill2's `image` mode (see
+    /// [`crate::sensors::visual_obs`]): `Color`, `Position` and, with `add_segmentation`,
+    /// `Segmentation`; no point cloud.
+    Image,
 }
 
 impl ObsMode {
-    /// All supported modes.
-    pub const ALL: [ObsMode; 7] = [
-        ObsMode::StateDict,
+    /// All supported modes, ManiSkill2's order (`state` first: its default).
+    pub const ALL: [ObsMode; 9] = [
         ObsMode::State,
+        ObsMode::StateDict,
+        ObsMode::None,
+        ObsMode::Image,
         ObsMode::Rgbd,
         ObsMode::PointCloud,
         ObsMode::RgbdRobotSeg,
@@ -163,13 +249,16 @@ impl ObsMode {
             ObsMode::RgbdRobotSeg => "rgbd_robot_seg",
             ObsMode::PointCloudRobotSeg => "pointcloud_robot_seg",
             ObsMode::Particles => "particles",
+            ObsMode::None => "none",
+            ObsMode::Image => "image",
         }
     }
 
     /// The visual layout and whether a robot mask is added; `None` for the state modes.
     pub fn visual(self) -> Option<(VisualLayout, bool)> {
         match self {
-            ObsMode::StateDict | ObsMode::State | ObsMode::Particles => None,
+            ObsMode::StateDict | ObsMode::State | ObsMode::Particles | ObsMode::None => None,
+            ObsMode::Image => Some((VisualLayout::Image, false)),
             ObsMode::Rgbd => Some((VisualLayout::Rgbd, false)),
             ObsMode::PointCloud => Some((VisualLayout::PointCloud, false)),
             ObsMode::RgbdRobotSeg => Some((VisualLayout::Rgbd, true)),
@@ -229,8 +318,13 @@ impl RewardMode {
     }
 }
 
-/// Render modes accepted in [`EnvConfig::render_mode`].
-pub const RENDER_MODES: [&str; 1] = ["rgb_array"];
+/// Render modes accepted in [`EnvConfig::render_mode`]: `rgb_array` (the render camera's
+/// view), `cameras` (ManiSkill2's: that view tiled with every observation camera's images; the
+/// runtime renders the parts, [`crate::Env::render`] and [`crate::Env::camera_images`]) and
+/// `human` (a viewer window, which the application opens — crate `ms2-viewer`, Python's
+/// `render_mode="human"` — over [`crate::Env::view_scene`]; [`crate::Env::render`] returns the
+/// `rgb_array` image in it).
+pub const RENDER_MODES: [&str; 3] = ["rgb_array", "cameras", "human"];
 
 #[cfg(test)]
 mod tests {
@@ -243,7 +337,16 @@ mod tests {
 
     #[test]
     fn substeps_rejects_bad_frequencies() {
-        for (sim, ctrl) in [(500.0, 30.0), (0.0, 20.0), (f64::NAN, 20.0), (10.0, 20.0)] {
+        for (sim, ctrl) in [
+            (500.0, 30.0),
+            (0.0, 20.0),
+            (f64::NAN, 20.0),
+            (10.0, 20.0),
+            (1e-3, 1e-3),
+            (1.0, 1.0),
+            (1e9, 20.0),
+            (10_000.0, 1.0),
+        ] {
             let cfg = EnvConfig {
                 sim_freq: sim,
                 control_freq: ctrl,
@@ -254,6 +357,27 @@ mod tests {
                 "{sim}/{ctrl}"
             );
         }
+    }
+
+    #[test]
+    fn bounds_name_the_value_and_the_range() {
+        let cfg = EnvConfig {
+            sim_freq: 1e9,
+            ..EnvConfig::default()
+        };
+        let msg = cfg.check_bounds().unwrap_err().to_string();
+        assert!(msg.contains("sim_freq") && msg.contains("1000000000") && msg.contains("10000"));
+        let cfg = EnvConfig {
+            max_episode_steps: Some(0),
+            ..EnvConfig::default()
+        };
+        assert!(cfg.check_bounds().unwrap_err().to_string().contains("max_episode_steps"));
+        let cfg = EnvConfig {
+            mpm_freq: Some(1e7),
+            ..EnvConfig::new("Excavate-v0")
+        };
+        assert!(cfg.check_bounds().unwrap_err().to_string().contains("mpm_freq"));
+        assert!(EnvConfig::default().check_bounds().is_ok());
     }
 
     #[test]

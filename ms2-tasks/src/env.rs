@@ -56,6 +56,8 @@ pub struct Env {
     elapsed_steps: u32,
     max_episode_steps: u32,
     observation_space: Space,
+    /// Set when a step failed or went non-finite: the next reset rebuilds the scene.
+    needs_rebuild: bool,
 }
 
 impl std::fmt::Debug for Env {
@@ -85,7 +87,10 @@ impl Env {
     pub fn with_engine(cfg: &EnvConfig, engine: Arc<dyn RigidEngine>) -> Result<Env, EnvError> {
         let registration = registry::registration(&cfg.env_id)?;
         let spec = registration.spec;
-        let obs_mode = ObsMode::parse(&cfg.obs_mode)?;
+        let obs_mode = ObsMode::parse(&cfg.obs_mode).map_err(|_| EnvError::UnknownObsMode {
+            got: cfg.obs_mode.clone(),
+            valid: supported_obs_modes(&spec),
+        })?;
         if !spec.supports_obs_mode(obs_mode) {
             if obs_mode.visual().is_some() {
                 return Err(EnvError::NotRenderable {
@@ -114,11 +119,13 @@ impl Env {
                 return Err(render_disabled(format!("render_mode {rm:?}")));
             }
         }
-        if cfg.max_episode_steps == Some(0) {
-            return Err(EnvError::InvalidConfig(
-                "max_episode_steps must be at least 1, got 0".to_owned(),
-            ));
+        if let Some(bg) = &cfg.bg_name {
+            return Err(EnvError::InvalidConfig(format!(
+                "bg_name {bg:?} is not available: ms2 ships no background scenes (ManiSkill2's \
+                 \"minimal_bedroom\" is a separately downloaded asset); use bg_name=None"
+            )));
         }
+        cfg.check_bounds()?;
         let robot = match cfg.robot.as_deref() {
             None => spec.robots.first().map(|r| r.uid),
             Some(uid) => {
@@ -164,6 +171,7 @@ impl Env {
             seeding: Seeding::from_entropy(),
             elapsed_steps: 0,
             observation_space: Space::Dict(Vec::new()),
+            needs_rebuild: false,
         };
         // The backend built its scene when it was made; sample a first episode.
         let mut rng = episode_rng(CONSTRUCTION_SEED);
@@ -252,8 +260,10 @@ impl Env {
     /// Seeds and samples a new episode; the info of its first state.
     fn start_episode(&mut self, seed: Option<u64>, reconfigure: bool) -> Result<Info, EnvError> {
         let mut rng = self.seeding.start_episode(seed);
-        if reconfigure {
+        if reconfigure || self.needs_rebuild {
+            // A step that failed or went non-finite may have left the world broken: rebuild.
             self.backend.reconfigure(&mut rng)?;
+            self.needs_rebuild = false;
         }
         self.backend.initialize_episode(&mut rng)?;
         self.elapsed_steps = 0;
@@ -265,7 +275,10 @@ impl Env {
     /// truncated, info).
     fn advance(&mut self, action: &[f32]) -> Result<(f64, bool, bool, Info), EnvError> {
         self.check_action(action)?;
-        self.backend.apply_action(action)?;
+        if let Err(err) = self.backend.apply_action(action) {
+            self.needs_rebuild = true;
+            return Err(err);
+        }
         self.elapsed_steps = self.elapsed_steps.saturating_add(1);
         let eval = self.backend.evaluate();
         let reward = match self.reward_mode {
@@ -275,9 +288,38 @@ impl Env {
                 self.backend.dense_reward(&eval, action) / self.backend.max_dense_reward()
             }
         };
+        self.check_finite_outcome(reward)?;
         let terminated = eval.success;
         let truncated = self.elapsed_steps >= self.max_episode_steps;
         Ok((reward, terminated, truncated, self.make_info(eval)))
+    }
+
+    /// Refuses a step whose state observation, particles or reward went non-finite (never
+    /// handing NaN to the caller), and marks the scene for a rebuild at the next reset.
+    fn check_finite_outcome(&mut self, reward: f64) -> Result<(), EnvError> {
+        let bad = self
+            .backend
+            .observe_state_dict()
+            .first_non_finite()
+            .map(|(path, v)| (format!("observation {path}"), f64::from(v)))
+            .or_else(|| {
+                self.backend
+                    .observe_particles()
+                    .and_then(|p| p.first_non_finite())
+                    .map(|(path, v)| (format!("particles {path}"), f64::from(v)))
+            })
+            .or_else(|| (!reward.is_finite()).then(|| ("reward".to_owned(), reward)));
+        match bad {
+            None => Ok(()),
+            Some((what, value)) => {
+                self.needs_rebuild = true;
+                Err(EnvError::NonFiniteSimulation {
+                    what,
+                    value,
+                    step: self.elapsed_steps,
+                })
+            }
+        }
     }
 
     fn check_action(&self, action: &[f32]) -> Result<(), EnvError> {
@@ -337,7 +379,9 @@ impl Env {
     pub fn observe(&self) -> ObsValue {
         let dict = self.backend.observe_state_dict();
         match self.obs_mode {
-            ObsMode::Rgbd
+            ObsMode::None => ObsValue::Dict(Vec::new()),
+            ObsMode::Image
+            | ObsMode::Rgbd
             | ObsMode::PointCloud
             | ObsMode::RgbdRobotSeg
             | ObsMode::PointCloudRobotSeg => ObsValue::Dict(crate::obs::non_privileged_state(
@@ -402,6 +446,7 @@ impl Env {
         if let Some((index, &value)) = state.iter().enumerate().find(|(_, v)| !v.is_finite()) {
             return Err(EnvError::NonFiniteState { index, value });
         }
+        self.backend.state_layout().check(state)?;
         self.backend.set_state(state)
     }
 
@@ -479,6 +524,50 @@ impl Env {
         }
         #[cfg(not(feature = "render"))]
         Err(render_disabled("render()".to_owned()))
+    }
+
+    /// Every observation camera's images, whatever the obs mode (for `render_mode =
+    /// "cameras"`): `{uid: {"rgb" u8 [H,W,3], "depth" f32 [H,W,1] (m), and "Segmentation"
+    /// u32 [H,W,4] for cameras with `add_segmentation`}}` in camera order. Without the `render`
+    /// feature: [`EnvError::FeatureDisabled`].
+    pub fn camera_images(&self) -> Result<ObsValue, EnvError> {
+        #[cfg(feature = "render")]
+        {
+            let frame = self.backend.capture_cameras()?;
+            let obs = crate::sensors::visual_obs::assemble(
+                ObsValue::Dict(Vec::new()),
+                &[],
+                frame,
+                crate::sensors::VisualLayout::Rgbd,
+                false,
+            );
+            Ok(obs
+                .get("image")
+                .cloned()
+                .unwrap_or(ObsValue::Dict(Vec::new())))
+        }
+        #[cfg(not(feature = "render"))]
+        Err(render_disabled("camera_images()".to_owned()))
+    }
+
+    /// Calls `f` with the env's render scene as it is now (poses synchronised, the goal marker
+    /// shown as in [`Env::render`]), its observation cameras at their poses and the render
+    /// camera: what a viewer window (crate `ms2-viewer`, `render_mode = "human"`) draws through
+    /// cameras of its own. An error for envs without a 3D scene, and
+    /// [`EnvError::FeatureDisabled`] without the `render` feature.
+    #[cfg(feature = "render")]
+    pub fn view_scene<R>(
+        &self,
+        f: impl FnOnce(&crate::sensors::SceneView<'_>) -> R,
+    ) -> Result<R, EnvError> {
+        let mut f = Some(f);
+        let mut out = None;
+        self.backend.view_scene(self.spec.goal_marker, &mut |view| {
+            if let Some(f) = f.take() {
+                out = Some(f(view));
+            }
+        })?;
+        out.ok_or_else(|| EnvError::Render("the scene view was not drawn".to_owned()))
     }
 
     /// The objects of the segmentation images' channel 1 (actor/link ids) as `(name, id)`

@@ -91,6 +91,34 @@ pub enum EnvError {
         /// Its value.
         value: f32,
     },
+    /// A state vector given to `set_state` holds a finite but impossible value (outside joint
+    /// limits, too fast, too far from the scene, a non-unit quaternion): see
+    /// [`crate::state_check`] for the bounds.
+    #[error("state[{index}] = {value} ({meaning}) is outside {expected}")]
+    StateOutOfBounds {
+        /// Index of the first out-of-bounds element.
+        index: usize,
+        /// Its value.
+        value: f32,
+        /// What the element is (e.g. `"qpos of panda_joint1"`).
+        meaning: String,
+        /// The accepted range, with its unit.
+        expected: String,
+    },
+    /// The simulation produced NaN or an infinity (an internal failure, not bad input): the
+    /// step is refused and the next `reset` rebuilds the scene.
+    #[error(
+        "the simulation became non-finite: {what} = {value} after step {step}; \
+         the env rebuilds its scene at the next reset"
+    )]
+    NonFiniteSimulation {
+        /// What went non-finite (an observation key and index, or the reward).
+        what: String,
+        /// The value.
+        value: f64,
+        /// The episode step at which it happened.
+        step: u32,
+    },
     /// `VecEnv::reset` got a seed list of the wrong length.
     #[error("expected one seed entry per env ({expected}), got {got}")]
     SeedCount {

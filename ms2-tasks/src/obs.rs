@@ -138,6 +138,24 @@ impl ObsValue {
         }
     }
 
+    /// The first NaN or infinite float32 element in depth-first key order, as
+    /// (`key/path[index]`, value); `None` when every float leaf is finite.
+    pub fn first_non_finite(&self) -> Option<(String, f32)> {
+        match self {
+            ObsValue::Array(a) => a.as_f32().and_then(|v| {
+                v.iter()
+                    .position(|x| !x.is_finite())
+                    .map(|i| (format!("[{i}]"), v[i]))
+            }),
+            ObsValue::Dict(entries) => entries.iter().find_map(|(k, v)| {
+                v.first_non_finite().map(|(path, value)| {
+                    let sep = if path.starts_with('[') { "" } else { "/" };
+                    (format!("{k}{sep}{path}"), value)
+                })
+            }),
+        }
+    }
+
     /// Leaf key paths (`/`-separated) with their element counts, in flattening order.
     pub fn leaf_layout(&self) -> Vec<(String, usize)> {
         fn walk(v: &ObsValue, prefix: &str, out: &mut Vec<(String, usize)>) {

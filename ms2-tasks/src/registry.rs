@@ -51,6 +51,9 @@ pub struct TaskRegistration {
     /// Its motion-planning solution, if it has one.
     #[cfg(feature = "demos")]
     pub solution: Option<&'static dyn crate::demos::solutions::Solution>,
+    /// Whether the task is listed ([`env_ids`], [`task_specs`], gymnasium, `ms2 envs`); test
+    /// envs such as `Dummy-v0` are not, but can still be made by id.
+    pub public: bool,
 }
 
 impl std::fmt::Debug for TaskRegistration {
@@ -71,6 +74,16 @@ impl TaskRegistration {
             scripted_policy: None,
             #[cfg(feature = "demos")]
             solution: None,
+            public: true,
+        }
+    }
+
+    /// The same registration as a test env: makeable by id, but left out of [`env_ids`],
+    /// [`task_specs`] and hence the gymnasium registry and `ms2 envs`.
+    pub fn test_only(self) -> Self {
+        Self {
+            public: false,
+            ..self
         }
     }
 
@@ -157,18 +170,21 @@ pub fn register_family(register: fn(&mut Registrar)) -> Result<(), EnvError> {
     Ok(())
 }
 
-/// Registered environment ids, in registration order.
+/// Public environment ids, in registration order (test envs registered with
+/// [`TaskRegistration::test_only`], such as `Dummy-v0`, are left out but can be made by id).
 ///
 /// ```
-/// assert!(ms2_tasks::env_ids().contains(&"Dummy-v0"));
+/// assert!(ms2_tasks::env_ids().contains(&"PickCube-v0"));
+/// assert!(!ms2_tasks::env_ids().contains(&"Dummy-v0"));
+/// assert!(ms2_tasks::task_spec("Dummy-v0").is_ok());
 /// ```
 pub fn env_ids() -> Vec<&'static str> {
-    read(|r| r.iter().map(|t| t.spec.env_id).collect())
+    read(|r| r.iter().filter(|t| t.public).map(|t| t.spec.env_id).collect())
 }
 
-/// Every registered task's spec, in registration order.
+/// Every public task's spec, in registration order.
 pub fn task_specs() -> Vec<TaskSpec> {
-    read(|r| r.iter().map(|t| t.spec).collect())
+    read(|r| r.iter().filter(|t| t.public).map(|t| t.spec).collect())
 }
 
 /// The registration of `env_id`; an error lists the registered ids.

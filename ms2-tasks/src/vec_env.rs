@@ -27,6 +27,10 @@ pub enum EnvCommand<'a> {
     Keep,
 }
 
+/// Most envs one [`VecEnv`] holds (each rigid-task env takes a few MB; more envs than this
+/// only queue on the CPU cores).
+pub const MAX_NUM_ENVS: usize = 4096;
+
 /// `num_envs` copies of one env config, reset and stepped in parallel (no autoreset: the Python
 /// layer implements gymnasium's).
 ///
@@ -56,13 +60,14 @@ pub struct VecEnv {
 }
 
 impl VecEnv {
-    /// Makes `num_envs >= 1` envs from `cfg`.
+    /// Makes `num_envs` envs (1..=[`MAX_NUM_ENVS`]) from `cfg`.
     pub fn new(cfg: &EnvConfig, num_envs: usize) -> Result<VecEnv, EnvError> {
-        if num_envs == 0 {
-            return Err(EnvError::InvalidConfig(
-                "num_envs must be at least 1, got 0".to_owned(),
-            ));
+        if !(1..=MAX_NUM_ENVS).contains(&num_envs) {
+            return Err(EnvError::InvalidConfig(format!(
+                "num_envs must be in 1..={MAX_NUM_ENVS}, got {num_envs}"
+            )));
         }
+        cfg.check_bounds()?;
         let envs = (0..num_envs)
             .into_par_iter()
             .map(|_| Env::new(cfg))

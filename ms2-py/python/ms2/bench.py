@@ -349,13 +349,17 @@ def _write_json(path: str | None, rows: list[dict]) -> None:
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Adds the ``bench`` subcommand to the ``ms2`` command line."""
-    p = sub.add_parser("bench", help="benchmark env steps/s (single env and make_vec) and memory")
-    p.add_argument("--env-id", default="PickCube-v0")
+    p = sub.add_parser(
+        "bench",
+        help="benchmark env steps/s (single env and make_vec) and memory",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    p.add_argument("--env-id", default="PickCube-v0", help="task id")
     p.add_argument(
         "--steps",
         type=int,
         default=None,
-        help="env steps per configuration (default 4000; --visual: 1000, soft-body envs 200)",
+        help="env steps per configuration (None: 4000; --visual: 1000, soft-body envs 200)",
     )
     p.add_argument(
         "--visual",
@@ -367,14 +371,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--control-modes",
         default=None,
-        help="comma-separated (default pd_ee_delta_pose,pd_joint_delta_pos; --visual: the first "
+        help="comma-separated (None: pd_ee_delta_pose,pd_joint_delta_pos; --visual: the first "
         "one given, else pd_joint_delta_pos)",
     )
     p.add_argument(
         "--policy",
         choices=["random", "scripted"],
         default="random",
-        help="actions: uniform random (default) or the task's scripted solution (single envs)",
+        help="actions: uniform random or the task's scripted solution (single envs)",
     )
     p.add_argument(
         "--peer-python",

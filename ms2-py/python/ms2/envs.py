@@ -8,13 +8,16 @@ released.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
 from . import _native
+from . import assets as _assets
 from .spaces import to_gym_space
+from .visualization import camera_images_to_tiles, tile_images
 
 #: Native episode limit used when gymnasium's ``TimeLimit`` wrapper enforces the limit instead
 #: (``gymnasium.make`` applies one with the registered or the given ``max_episode_steps``).
@@ -39,6 +42,57 @@ def adopt_config(env: Any, config: dict[str, Any]) -> None:
         setattr(env, key, config[key])
 
 
+#: Largest accepted seed: seeds are unsigned 64-bit integers, ``0 <= seed <= 2**64 - 1``
+#: (ManiSkill2's own seeds, drawn by ``np.random.RandomState``, are below ``2**32``).
+MAX_SEED = 2**64 - 1
+
+
+def check_seed(seed: Any, name: str = "seed") -> int | None:
+    """``seed`` as an int in ``[0, MAX_SEED]`` (``None`` passes): ``TypeError`` for a non-int
+    (``bool`` and floats included), ``ValueError`` naming the range otherwise."""
+    if seed is None:
+        return None
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)):
+        raise TypeError(f"{name} must be an int or None, got {type(seed).__name__} {seed!r}")
+    if not 0 <= int(seed) <= MAX_SEED:
+        raise ValueError(f"{name} must be in [0, 2**64 - 1], got {seed}")
+    return int(seed)
+
+
+def check_options(options: Any, valid: tuple[str, ...]) -> dict[str, Any]:
+    """``reset``'s ``options`` as a dict (``None`` = empty): ``TypeError`` for a non-mapping,
+    ``ValueError`` for an unknown key (naming the valid ones)."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise TypeError(
+            f"options must be a dict or None, got {type(options).__name__} {options!r}"
+        )
+    unknown = [k for k in options if k not in valid]
+    if unknown:
+        raise ValueError(f"unknown reset option(s) {unknown}; valid options: {list(valid)}")
+    return dict(options)
+
+
+def real_array(value: Any, what: str) -> np.ndarray:
+    """``value`` as a contiguous float32 array; ``TypeError`` for complex, string, bytes or
+    object data (which a float32 cast would silently mangle)."""
+    array = np.asarray(value)
+    if array.dtype.kind not in "biuf":
+        raise TypeError(f"{what} must hold real numbers, got dtype {array.dtype}")
+    return np.ascontiguousarray(array, dtype=np.float32)
+
+
+class _Closed:
+    """Stands in for the native env after ``close()``: every use raises a clear error."""
+
+    def __init__(self, what: str) -> None:
+        self._what = what
+
+    def __getattr__(self, name: str) -> Any:
+        raise ValueError(f"this {self._what} is closed; make a new one")
+
+
 def _seed_from(rng: np.random.Generator) -> int:
     """A 63-bit seed drawn from ``rng``."""
     return int(rng.integers(0, 2**63 - 1))
@@ -49,12 +103,18 @@ class Ms2Env(gym.Env):
 
     Args:
         env_id: registered task id (``ms2.env_ids()`` lists them).
-        obs_mode: ``"state_dict"`` (nested dict of arrays) or ``"state"`` (one flat float32 array).
+        obs_mode: ``"state"`` (default, ManiSkill2's: one flat float32 array), ``"state_dict"``
+            (nested dict of arrays), ``"none"`` (an empty dict), ``"image"`` (raw camera
+            textures ``Color`` / ``Position``), ``"rgbd"``, ``"pointcloud"``,
+            ``"rgbd_robot_seg"``, ``"pointcloud_robot_seg"``, and ``"particles"`` on the
+            soft-body tasks; ``supported_obs_modes`` lists an env's.
         robot: robot uid, ManiSkill2's keyword (``"panda"``); ``None`` = the task's default.
             A robot the task does not support raises ``ValueError`` listing the valid ones.
         control_mode: e.g. ``"pd_ee_delta_pose"``; ``None`` = ``"pd_joint_delta_pos"``.
         reward_mode: ``"sparse"``, ``"dense"`` or ``"normalized_dense"`` (``None``).
-        render_mode: ``None`` or ``"rgb_array"``.
+        render_mode: ``None``, ``"rgb_array"`` (the render camera's 512×512 view) or
+            ``"cameras"`` (that view tiled with every observation camera's images: RGB, depth
+            and, with ``add_segmentation``, the two segmentation channels, as ManiSkill2).
         sim_freq: physics frequency in Hz (500 by default).
         control_freq: env step frequency in Hz (20 by default); ``sim_freq`` must be a multiple.
         max_episode_steps: episode limit in env steps after which ``truncated`` is set;
@@ -63,21 +123,29 @@ class Ms2Env(gym.Env):
             keyword: ``{"width": 64, "height": 64, "fov": 1.2}`` sets fields of every camera,
             ``{"base_camera": {"p": [..], "q": [..]}}`` of one camera (fields: ``width``,
             ``height``, ``fov`` (vertical, radians), ``near``, ``far`` (m), ``p``, ``q`` (pose
-            in the mount's frame, quaternion wxyz)). Unknown keys or bad values raise
-            ``ValueError``.
+            in the mount's frame, quaternion wxyz), ``add_segmentation`` (adds
+            ``Segmentation`` u32 [H, W, 4] to the ``image`` / ``rgbd`` observations)). Unknown
+            keys or bad values raise ``ValueError``.
         mpm_freq: MPM substep frequency in Hz of the soft-body tasks (``Excavate-v0``,
             ``Fill-v0``); ``None`` = the task's default (1000; ManiSkill2 uses 2000). Must be a
             whole multiple of ``sim_freq``; ``ValueError`` on envs without soft bodies.
+        enable_shadow: whether the first directional light casts shadows in every image
+            (ManiSkill2's keyword; off by default).
+        render_camera_cfgs: changes to the camera of ``render()``, as ``camera_cfgs``
+            (``{"width": 256, "height": 256, "fov": 1.2, "p": [..], "q": [..]}``, also under
+            the key ``"render_camera"``).
+        bg_name: ManiSkill2's visual background; only ``None`` (ms2 ships no background
+            scenes: any name raises ``ValueError``).
 
     Unknown ids or modes raise ``ValueError`` listing the valid ones.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+    metadata = {"render_modes": ["rgb_array", "cameras"], "render_fps": 20}
 
     def __init__(
         self,
         env_id: str = "PickCube-v0",
-        obs_mode: str = "state_dict",
+        obs_mode: str = "state",
         robot: str | None = None,
         control_mode: str | None = None,
         reward_mode: str | None = None,
@@ -87,7 +155,11 @@ class Ms2Env(gym.Env):
         max_episode_steps: int | None = None,
         camera_cfgs: dict[str, Any] | None = None,
         mpm_freq: float | None = None,
+        enable_shadow: bool = False,
+        render_camera_cfgs: dict[str, Any] | None = None,
+        bg_name: str | None = None,
     ) -> None:
+        _assets.register_installed_packages()
         self._native = _native.NativeEnv(
             env_id,
             obs_mode=obs_mode,
@@ -100,8 +172,12 @@ class Ms2Env(gym.Env):
             max_episode_steps=max_episode_steps,
             camera_cfgs=camera_cfgs,
             mpm_freq=mpm_freq,
+            enable_shadow=enable_shadow,
+            render_camera_cfgs=render_camera_cfgs,
+            bg_name=bg_name,
         )
         adopt_config(self, self._native.config())
+        _assets.warn_if_primitive_panda()
         self.observation_space = to_gym_space(self._native.observation_space())
         self.action_space = to_gym_space(self._native.action_space())
         self.metadata = {**self.metadata, "render_fps": self.control_freq}
@@ -115,22 +191,24 @@ class Ms2Env(gym.Env):
         """Starts an episode. ``seed`` makes it reproducible; ``seed=None`` continues the env's
         random sequence (seeded from OS entropy on the first reset). ``options={"reconfigure":
         True}`` rebuilds the scene (ManiSkill2's option)."""
-        if seed is not None:
-            if not isinstance(seed, (int, np.integer)) or seed < 0:
-                raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
-            seed = int(seed)
+        seed = check_seed(seed)
+        options = check_options(options, ("reconfigure",))
+        reconfigure = options.get("reconfigure", False)
+        if not isinstance(reconfigure, (bool, np.bool_)):
+            raise TypeError(f"options['reconfigure'] must be a bool, got {reconfigure!r}")
+        self._native.config  # a closed env raises here, before gymnasium's seeding
         super().reset(seed=seed)
         if seed is None and not self._seeded:
             seed = _seed_from(self.np_random)
         if seed is not None:
             self._seeded = True
-        reconfigure = bool((options or {}).get("reconfigure", False))
+        reconfigure = bool(reconfigure)
         return self._native.reset(seed=seed, reconfigure=reconfigure)
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """One control step (``sim_freq / control_freq`` physics steps). ``action`` must have the
         action space's shape and be finite (``ValueError`` otherwise)."""
-        action = np.ascontiguousarray(action, dtype=np.float32)
+        action = real_array(action, "action")
         if action.shape != self.action_space.shape:
             raise ValueError(
                 f"action for control_mode {self.control_mode!r} must have shape "
@@ -139,17 +217,27 @@ class Ms2Env(gym.Env):
         return self._native.step(action)
 
     def render(self) -> np.ndarray | None:
-        """An RGB image (uint8 [H, W, 3]) of the scene when ``render_mode="rgb_array"``."""
+        """An RGB image (uint8 [H, W, 3]): with ``render_mode="rgb_array"`` the render
+        camera's view (goal markers shown); with ``"cameras"`` that view tiled with every
+        observation camera's RGB, depth and segmentation images (ManiSkill2's layout)."""
         if self.render_mode is None:
             gym.logger.warn(
                 "render() called without render_mode; make the env with render_mode='rgb_array'"
             )
             return None
-        return self._native.render()
+        view = self._native.render()
+        if self.render_mode == "cameras":
+            return tile_images([view, *camera_images_to_tiles(self._native.camera_images())])
+        return view
+
+    def get_obs(self) -> Any:
+        """The observation of the current state in the env's obs mode, without stepping
+        (ManiSkill2's ``env.get_obs()``)."""
+        return self._native.get_obs()
 
     def close(self) -> None:
-        """Releases the native env."""
-        self._native = None  # type: ignore[assignment]
+        """Releases the native env; any later call raises ``ValueError`` (the env is closed)."""
+        self._native = _Closed("Ms2Env")  # type: ignore[assignment]
 
     # --- ManiSkill2-style extras ----------------------------------------------------------------
 
@@ -158,8 +246,11 @@ class Ms2Env(gym.Env):
         return self._native.get_state()
 
     def set_state(self, state: np.ndarray) -> None:
-        """Restores a state from :meth:`get_state` (``ValueError`` on a wrong length or NaN)."""
-        state = np.ascontiguousarray(state, dtype=np.float32)
+        """Restores a state from :meth:`get_state`. ``ValueError`` on a wrong length, NaN, or an
+        impossible value (a joint outside its limits, a body too fast or too far away, a
+        non-unit quaternion), naming the index and its meaning (bounds:
+        ``docs/tasks.md``, "State bounds")."""
+        state = real_array(state, "state")
         if state.ndim != 1:
             raise ValueError(f"state must be a 1-D array, got shape {state.shape}")
         self._native.set_state(state)

@@ -31,6 +31,7 @@ complete version. Opening a missing, truncated or foreign file raises ``FileNotF
 
 from __future__ import annotations
 
+import glob
 import json
 import os
 import shutil
@@ -52,6 +53,11 @@ EPISODE_KEYS = (
 )
 #: Per-step states (rigid-body episodes) and the state after reset only (soft-body episodes).
 STATE_KEYS = ("env_states", "env_init_state")
+
+
+#: Largest episode seed (and episode id) a trajectory file may hold: seeds are unsigned 64-bit
+#: integers (``reset(seed=...)`` accepts ``0 <= seed <= MAX_SEED``).
+MAX_SEED = 2**64 - 1
 
 
 class TrajectoryFileError(ValueError):
@@ -176,7 +182,10 @@ class TrajectoryWriter:
         self.path = Path(path)
         if self.path.suffix != ".h5":
             raise ValueError(f"trajectory path must end in .h5, got {str(self.path)!r}")
+        check_output_path(self.path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        for tmp in stale_temporaries(self.path):
+            tmp.unlink(missing_ok=True)
         self.json_path = json_path_of(self.path)
         self.env_info = _to_json_value(dict(env_info))
         self.episodes: list[dict[str, Any]] = []
@@ -200,13 +209,19 @@ class TrajectoryWriter:
                 self._file = h5py.File(self._tmp, "w")
         return self._file
 
-    def append(self, episode: Mapping[str, Any], obs: Any = None) -> int:
+    def append(
+        self, episode: Mapping[str, Any], obs: Any = None, episode_id: int | None = None
+    ) -> int:
         """Adds one episode (a dict with ``episode_seed``, ``control_mode``, ``actions``,
         ``env_states`` — or ``env_init_state`` for a soft-body episode —, ``success``,
         ``elapsed_steps``, ``info``; optional ``reset_kwargs``) and its observations
-        ``[T+1, ...]`` (optional). Returns its ``episode_id``."""
+        ``[T+1, ...]`` (optional) as group ``traj_<episode_id>`` (``None``: the next number
+        after the episodes written so far; a used id raises ``ValueError``). Returns the id."""
         actions, success, state_key, states = _check_episode_arrays(episode)
-        episode_id = len(self.episodes)
+        if episode_id is None:
+            episode_id = max((e["episode_id"] + 1 for e in self.episodes), default=0)
+        elif any(e["episode_id"] == episode_id for e in self.episodes):
+            raise ValueError(f"episode_id {episode_id} was already written to {self.path}")
         group = self._working_file().create_group(f"traj_{episode_id}")
         group.create_dataset("actions", data=actions)
         group.create_dataset("success", data=success)
@@ -315,10 +330,20 @@ class Trajectory:
             raise TrajectoryFileError(
                 f"{self.path}: episode {name} is unreadable or incomplete ({e})"
             ) from e
+        except (ValueError, TypeError) as e:
+            raise TrajectoryFileError(
+                f"{self.path}: episode {name} holds arrays of the wrong type ({e}); actions and "
+                "states must be float32, success bool"
+            ) from e
         try:
             _check_episode_arrays(out)
         except ValueError as e:
             raise TrajectoryFileError(f"{self.path}: {name}: {e}") from e
+        if int(meta["elapsed_steps"]) != out["actions"].shape[0]:
+            raise TrajectoryFileError(
+                f"{self.path}: {name}: elapsed_steps in {json_path_of(self.path).name} is "
+                f"{meta['elapsed_steps']} but the episode has {out['actions'].shape[0]} actions"
+            )
         return out
 
 
@@ -341,11 +366,76 @@ def _load_meta(json_file: Path, h5_path: Path) -> dict[str, Any]:
     missing = [k for k in ENV_INFO_KEYS if k not in meta["env_info"]]
     if missing:
         raise TrajectoryFileError(f"{json_file}: env_info lacks {missing}")
+    if not isinstance(meta["episodes"], list):
+        raise TrajectoryFileError(f"{json_file}: 'episodes' must be a list")
     for i, ep in enumerate(meta["episodes"]):
+        if not isinstance(ep, dict):
+            raise TrajectoryFileError(f"{json_file}: episodes[{i}] must be an object, got {ep!r}")
         missing = [k for k in EPISODE_KEYS if k not in ep]
         if missing:
             raise TrajectoryFileError(f"{json_file}: episodes[{i}] lacks {missing}")
+        for key, high in (("episode_id", MAX_SEED), ("episode_seed", MAX_SEED)):
+            _check_json_int(json_file, i, key, ep[key], high)
+        _check_json_int(json_file, i, "elapsed_steps", ep["elapsed_steps"], 2**31 - 1)
+        if not isinstance(ep["control_mode"], str):
+            raise TrajectoryFileError(
+                f"{json_file}: episodes[{i}]['control_mode'] must be a string, got "
+                f"{ep['control_mode']!r}"
+            )
     return meta
+
+
+def _check_json_int(json_file: Path, i: int, key: str, value: Any, high: int) -> None:
+    """Refuses a JSON episode entry that is not an int in ``[0, high]``, naming the file."""
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= high:
+        raise TrajectoryFileError(
+            f"{json_file}: episodes[{i}]['{key}'] must be an integer in [0, {high}], got "
+            f"{value!r}"
+        )
+
+
+def stale_temporaries(path: Path) -> list[Path]:
+    """Working copies (``.X.h5.<pid>.tmp``, ``.X.json.<pid>.tmp``) that a killed writer of
+    ``path`` left behind: those whose process no longer runs."""
+    stale = []
+    for target in (path, json_path_of(path)):
+        for tmp in target.parent.glob(f".{glob.escape(target.name)}.*.tmp"):
+            pid_text = tmp.name[len(target.name) + 2 : -len(".tmp")]
+            if pid_text.isdigit() and not _process_alive(int(pid_text)):
+                stale.append(tmp)
+    return stale
+
+
+def _process_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True  # another user's process
+    except OverflowError:
+        return False
+    return True
+
+
+def check_output_path(path: Path) -> None:
+    """Refuses, before any work, a trajectory output that cannot be written: ``path`` or its
+    ``.json`` is a directory, an ancestor is a file, or the nearest existing directory is not
+    writable. Raises ``ValueError`` naming the path."""
+    for target in (path, json_path_of(path)):
+        if target.is_dir():
+            raise ValueError(f"output {target} is a directory; give a file path ending in .h5")
+    ancestor = path.parent
+    while not ancestor.exists():
+        if ancestor.parent == ancestor:
+            break
+        ancestor = ancestor.parent
+    if ancestor.exists() and not ancestor.is_dir():
+        raise ValueError(f"output {path}: {ancestor} is a file, not a directory")
+    if not os.access(ancestor, os.W_OK | os.X_OK):
+        raise ValueError(f"output {path}: directory {ancestor} is not writable")
 
 
 def open_trajectory(path: str | os.PathLike[str]) -> Trajectory:
@@ -392,6 +482,7 @@ __all__ = [
     "Trajectory",
     "TrajectoryFileError",
     "TrajectoryWriter",
+    "check_output_path",
     "is_soft_episode",
     "json_path_of",
     "open_trajectory",

@@ -64,6 +64,9 @@ pub enum DemoError {
         /// The supported conversions, in words.
         supported: String,
     },
+    /// The caller cancelled the work before this episode started (Ctrl-C).
+    #[error("interrupted before the episode started")]
+    Interrupted,
     /// The replay options are inconsistent with each other or with the episode.
     #[error("invalid replay options: {0}")]
     InvalidOptions(String),

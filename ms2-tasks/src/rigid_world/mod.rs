@@ -21,7 +21,7 @@ use std::sync::Arc;
 
 use ms2_physics::{
     ActorDesc, ArticulationDesc, ArticulationId, ArticulationOptions, BodyId, BodyKind,
-    DriveParams, JointInfo, PhysicsError, Pose3, ShapeSpec, VisualShape, WorldConfig,
+    DriveParams, JointInfo, PhysicsError, Pose3, ShapeSpec, StateField, VisualShape, WorldConfig,
 };
 use nalgebra::{Point3, Vector3};
 
@@ -51,6 +51,12 @@ pub trait RigidWorld: Send {
     fn get_state(&self) -> Vec<f32>;
     /// Restores a state from [`RigidWorld::get_state`] of the same scene.
     fn set_state(&mut self, state: &[f32]) -> PortResult<()>;
+    /// What each element of [`RigidWorld::get_state`] means (names for errors, quantities for
+    /// bounds checks), [`RigidWorld::state_len`] entries. The default names every element
+    /// `"world state"` with no physical meaning known, so only finiteness is checked.
+    fn state_layout(&self) -> Option<Vec<StateField>> {
+        None
+    }
     /// Forgets warm-start and contact caches, so that the next steps depend on the current
     /// state alone (called at every episode start).
     fn forget_solver_history(&mut self) -> PortResult<()>;

@@ -47,6 +47,10 @@ impl RigidWorld for World {
         World::set_state(self, state)
     }
 
+    fn state_layout(&self) -> Option<Vec<ms2_physics::StateField>> {
+        Some(World::state_layout(self))
+    }
+
     fn forget_solver_history(&mut self) -> PortResult<()> {
         World::forget_solver_history(self)
     }

@@ -50,6 +50,10 @@ pub struct CameraConfig {
     pub far: f32,
     /// Where the camera is.
     pub mount: CameraMount,
+    /// Whether the `image` / `rgbd` observations of this camera include its `Segmentation`
+    /// image (u32 [H, W, 4]; ManiSkill2's `camera_cfgs={"add_segmentation": True}`). Off by
+    /// default, as in ManiSkill2.
+    pub segmentation: bool,
 }
 
 /// Pose (robotics convention: x forward, z up) of a camera at `eye` looking at `target`.
@@ -86,6 +90,7 @@ impl CameraConfig {
             mount: CameraMount::World {
                 pose_world_from_camera: look_at_robotics([0.3, 0.0, 0.6], [-0.1, 0.0, 0.1]),
             },
+            segmentation: false,
         }
     }
 
@@ -111,6 +116,7 @@ impl CameraConfig {
                     )),
                 ),
             },
+            segmentation: false,
         }
     }
 
@@ -128,6 +134,7 @@ impl CameraConfig {
             mount: CameraMount::World {
                 pose_world_from_camera: look_at_robotics([0.4, 0.4, 0.8], [0.0, 0.0, 0.4]),
             },
+            segmentation: false,
         }
     }
 

@@ -38,6 +38,7 @@ pub const DUMMY: TaskSpec = TaskSpec {
     obs_modes: &[
         crate::config::ObsMode::State,
         crate::config::ObsMode::StateDict,
+        crate::config::ObsMode::None,
     ],
     non_privileged_extra_keys: &["tcp_pose", "goal_pos"],
     goal_marker: None,
@@ -45,12 +46,16 @@ pub const DUMMY: TaskSpec = TaskSpec {
     assets: &[],
 };
 
-/// Registers `Dummy-v0` with its scripted policy.
+/// Registers `Dummy-v0` (a test env: makeable by id, not listed) with its scripted policy.
 pub fn register(r: &mut Registrar) {
     let make = |cfg: &EnvConfig, substeps| -> Result<Box<dyn EnvBackend>, EnvError> {
         Ok(Box::new(DummyEnv::new(cfg, substeps)?))
     };
-    r.add(TaskRegistration::with_backend(DUMMY, make).scripted(|_| Ok(Box::new(DummyReachPolicy))));
+    r.add(
+        TaskRegistration::with_backend(DUMMY, make)
+            .scripted(|_| Ok(Box::new(DummyReachPolicy)))
+            .test_only(),
+    );
 }
 const MAX_DELTA: f32 = 0.05;
 const GOAL_THRESHOLD: f32 = 0.025;
