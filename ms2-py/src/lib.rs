@@ -87,14 +87,21 @@ fn num_threads() -> usize {
     rayon::current_num_threads()
 }
 
-/// The adapter the process-wide renderer draws with, e.g. `"llvmpipe (LLVM 15.0.6, 256 bits)
-/// (Vulkan, Cpu)"`; creates the renderer on first call. `RuntimeError` when no adapter exists.
+/// The adapter the process-wide renderer draws with and how it draws sensor images, e.g.
+/// `"llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu), sensors by Raycast"`; creates the renderer
+/// on first call. `RuntimeError` when no adapter exists.
 #[pyfunction]
 fn render_adapter() -> PyResult<String> {
     let ctx =
         ms2_tasks::adapters::RenderContext::shared().map_err(|e| errors::env_error_to_py(&e))?;
     let a = ctx.renderer().adapter();
-    Ok(format!("{} ({}, {})", a.name, a.backend, a.device_type))
+    Ok(format!(
+        "{} ({}, {}), sensors by {:?}",
+        a.name,
+        a.backend,
+        a.device_type,
+        ctx.renderer().sensor_backend()
+    ))
 }
 
 /// The extension module `ms2._native`.
