@@ -66,4 +66,14 @@ else
   echo "$REQ_HASH" >.venv/.ms2-installed
 fi
 python -c 'import ms2'
+
+# --- Fetched assets -----------------------------------------------------------------------------
+# The real Panda's meshes (Franka's franka_description, Apache-2.0; never part of this repository)
+# into the asset directory ($MS2_ASSET_DIR, default ~/.ms2/data): from an installed mani_skill2
+# package, else the mani-skill2==0.5.3 wheel from PyPI (pip, ~12 MB, checksum-verified). A no-op
+# when present and verified. Without them ms2 uses its primitive Panda (with one warning).
+if ! python -m ms2 assets fetch franka_description --quiet; then
+  echo "[setup] warning: could not fetch the real Panda's meshes; the primitive Panda is used." \
+    "Retry with: ms2 assets fetch franka_description" >&2
+fi
 echo "[setup] done: activate the venv with '. $ROOT/.venv/bin/activate'"

@@ -1,20 +1,40 @@
 //! PickCube scene throughput: Panda at (-0.615, 0, 0) + 4 cm cube + ground at 500 Hz, single
 //! thread. Reports raw physics steps and env steps (25 substeps) per second.
 //!
-//! `cargo bench -p ms2-physics`
+//! `cargo bench -p ms2-physics` (with `physics_step/real_panda_default` when the real Panda's
+//! files are in the asset store, `MS2_ASSET_DIR`)
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ms2_physics::{
-    add_panda, ActorDesc, ActorKind, BodyId, Material, PandaOptions, Pose3, ShapeDesc, ShapeSpec,
-    World, WorldConfig,
+    add_panda, add_panda_from_file, ActorDesc, ActorKind, BodyId, Material, PandaOptions, Pose3,
+    ShapeDesc, ShapeSpec, World, WorldConfig,
 };
 
+/// The real Panda's URDF (franka_description in the asset store), if fetched.
+fn real_panda_urdf() -> Option<std::path::PathBuf> {
+    let group = ms2_assets::find_group(ms2_assets::FRANKA_DESCRIPTION).ok()?;
+    ms2_assets::locate(group).ok().map(|found| found.entry)
+}
+
 fn pick_cube_scene(substeps: usize, pgs_iterations: usize) -> (World, BodyId) {
+    pick_cube_scene_with(substeps, pgs_iterations, None)
+}
+
+/// The scene with the primitive Panda, or the real one from `real_urdf`.
+fn pick_cube_scene_with(
+    substeps: usize,
+    pgs_iterations: usize,
+    real_urdf: Option<&std::path::Path>,
+) -> (World, BodyId) {
     let mut config = WorldConfig::default();
     config.solver.solver_iterations = substeps;
     config.solver.pgs_iterations = pgs_iterations;
     let mut world = World::new(config).expect("valid config");
-    add_panda(&mut world, &PandaOptions::default()).expect("panda loads");
+    match real_urdf {
+        Some(path) => add_panda_from_file(&mut world, &PandaOptions::default(), path),
+        None => add_panda(&mut world, &PandaOptions::default()),
+    }
+    .expect("panda loads");
     let cube = world
         .add_actor(
             ActorDesc::new("cube", ActorKind::Dynamic)
@@ -50,6 +70,23 @@ fn bench(c: &mut Criterion) {
     group.bench_function("env_step_25_substeps/default", |b| {
         b.iter(|| world.step_n(25))
     });
+    // The real Panda (convex hulls of Franka's collision meshes), when fetched.
+    match real_panda_urdf() {
+        Some(urdf) => {
+            let (mut world, _cube) = pick_cube_scene_with(
+                defaults.solver_iterations,
+                defaults.pgs_iterations,
+                Some(&urdf),
+            );
+            group.bench_function("physics_step/real_panda_default", |b| {
+                b.iter(|| world.step())
+            });
+        }
+        None => eprintln!(
+            "pick_cube: real Panda not fetched (ms2 assets fetch franka_description): \
+             physics_step/real_panda_default skipped"
+        ),
+    }
     let (mut world, _cube) = pick_cube_scene(defaults.solver_iterations, defaults.pgs_iterations);
     group.bench_function("get_state_then_set_state/default", |b| {
         b.iter(|| {

@@ -81,7 +81,7 @@ pub use ids::{ArticulationId, BodyId, BodyKind};
 pub use math::Pose3;
 pub use mesh::{MeshCollision, MeshError};
 #[cfg(feature = "rapier")]
-pub use panda::{add_panda, add_panda_from_urdf};
+pub use panda::{add_panda, add_panda_from_file, add_panda_from_urdf};
 pub use panda::{PandaOptions, PANDA_FINGER_FRICTION};
 pub use shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
 pub use state_layout::{StateField, StateQuantity};

@@ -63,8 +63,39 @@ pub enum MeshError {
     },
 }
 
+/// One part of a mesh file: a triangle mesh and the diffuse colour of its material, if the
+/// file gives one (COLLADA files give one per geometry; STL none).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshPart {
+    /// The part's triangles (m, file frame, scaled).
+    pub mesh: TriangleMesh,
+    /// Diffuse RGBA of the part's material, as written in the file.
+    pub diffuse_rgba: Option<[f32; 4]>,
+}
+
 /// Reads every mesh of an OBJ / STL / DAE file into one triangle mesh, scaled per axis.
 pub fn load_mesh_file(path: &Path, scale: Vector3<f32>) -> Result<TriangleMesh, MeshError> {
+    let parts = load_mesh_parts(path, scale)?;
+    let mut out = TriangleMesh {
+        vertices: Vec::new(),
+        indices: Vec::new(),
+    };
+    for part in parts {
+        let base = out.vertices.len() as u32;
+        out.vertices.extend(part.mesh.vertices);
+        out.indices.extend(
+            part.mesh
+                .indices
+                .iter()
+                .map(|f| [f[0] + base, f[1] + base, f[2] + base]),
+        );
+    }
+    Ok(out)
+}
+
+/// Reads the meshes of an OBJ / STL / DAE file as separate parts with their material colours,
+/// scaled per axis. Parts without triangles are dropped; a file with none is an error.
+pub fn load_mesh_parts(path: &Path, scale: Vector3<f32>) -> Result<Vec<MeshPart>, MeshError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -76,34 +107,46 @@ pub fn load_mesh_file(path: &Path, scale: Vector3<f32>) -> Result<TriangleMesh, 
     let scene = mesh_loader::Loader::default()
         .load(path)
         .map_err(|source| MeshError::Parse { source })?;
-    let mut out = TriangleMesh {
-        vertices: Vec::new(),
-        indices: Vec::new(),
-    };
-    for m in &scene.meshes {
-        let base = out.vertices.len() as u32;
-        out.vertices.extend(
-            m.vertices
+    let mut parts = Vec::with_capacity(scene.meshes.len());
+    for (i, m) in scene.meshes.iter().enumerate() {
+        if m.vertices.is_empty() || m.faces.is_empty() {
+            continue;
+        }
+        let n = m.vertices.len() as u32;
+        if let Some(f) = m.faces.iter().find(|f| f.iter().any(|&v| v >= n)) {
+            return Err(MeshError::Parse {
+                source: std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    format!("face {f:?} indexes past the {n} vertices of its mesh"),
+                ),
+            });
+        }
+        let mesh = TriangleMesh {
+            vertices: m
+                .vertices
                 .iter()
-                .map(|v| Point3::new(v[0] * scale.x, v[1] * scale.y, v[2] * scale.z)),
-        );
-        out.indices.extend(
-            m.faces
-                .iter()
-                .map(|f| [f[0] + base, f[1] + base, f[2] + base]),
-        );
+                .map(|v| Point3::new(v[0] * scale.x, v[1] * scale.y, v[2] * scale.z))
+                .collect(),
+            indices: m.faces.clone(),
+        };
+        if let Some(p) = mesh
+            .vertices
+            .iter()
+            .find(|p| !p.coords.iter().all(|v| v.is_finite()))
+        {
+            return Err(MeshError::NonFiniteVertex { vertex: *p });
+        }
+        let diffuse_rgba = scene
+            .materials
+            .get(i)
+            .and_then(|mat| mat.color.diffuse)
+            .filter(|c| c.iter().all(|v| v.is_finite()));
+        parts.push(MeshPart { mesh, diffuse_rgba });
     }
-    if out.vertices.is_empty() || out.indices.is_empty() {
+    if parts.is_empty() {
         return Err(MeshError::NoTriangles);
     }
-    if let Some(p) = out
-        .vertices
-        .iter()
-        .find(|p| !p.coords.iter().all(|v| v.is_finite()))
-    {
-        return Err(MeshError::NonFiniteVertex { vertex: *p });
-    }
-    Ok(out)
+    Ok(parts)
 }
 
 /// Turns a triangle mesh into a convex collision shape description.

@@ -76,6 +76,35 @@ pub fn add_panda(world: &mut World, options: &PandaOptions) -> Result<Articulati
     )
 }
 
+/// [`add_panda`] from a URDF file of the same robot, meshes resolved relative to the file
+/// (e.g. the real Panda: ManiSkill2's `panda_v2.urdf` with Franka's meshes, collision meshes
+/// as convex hulls), with the same options, drives and targets.
+#[cfg(feature = "rapier")]
+pub fn add_panda_from_file(
+    world: &mut World,
+    options: &PandaOptions,
+    path: &std::path::Path,
+) -> Result<ArticulationId> {
+    let desc = crate::urdf::parse_urdf_file(path, &UrdfLoadOptions::default())?;
+    let source = path.display().to_string();
+    let art = world.add_articulation_from(&desc, &options.articulation_options(), &source)?;
+    set_panda_drives(world, art, options)?;
+    Ok(art)
+}
+
+#[cfg(feature = "rapier")]
+fn set_panda_drives(world: &mut World, art: ArticulationId, options: &PandaOptions) -> Result<()> {
+    for i in 0..7 {
+        world.set_drive(art, i, options.arm_drive)?;
+    }
+    for i in 7..9 {
+        world.set_drive(art, i, options.gripper_drive)?;
+    }
+    world.set_drive_targets(art, &options.qpos)?;
+    world.set_drive_velocity_targets(art, &[0.0; 9])?;
+    Ok(())
+}
+
 /// [`add_panda`] from another description of the same robot: `urdf` must have the Panda's
 /// joints and finger links (e.g. `ms2_assets::PANDA_BUCKET_URDF`, the Panda with a tool fixed
 /// to its hand); `source` names it in errors.
@@ -93,13 +122,6 @@ pub fn add_panda_from_urdf(
         &UrdfLoadOptions::default(),
     )?;
     let art = world.add_articulation_from(&desc, &options.articulation_options(), source)?;
-    for i in 0..7 {
-        world.set_drive(art, i, options.arm_drive)?;
-    }
-    for i in 7..9 {
-        world.set_drive(art, i, options.gripper_drive)?;
-    }
-    world.set_drive_targets(art, &options.qpos)?;
-    world.set_drive_velocity_targets(art, &[0.0; 9])?;
+    set_panda_drives(world, art, options)?;
     Ok(art)
 }

@@ -17,7 +17,9 @@ use crate::error::UrdfError;
 #[cfg(feature = "rapier")]
 use crate::ids::ArticulationId;
 use crate::math::{pose_f64_to_f32, pose_from_xyz_rpy};
-use crate::mesh::{load_mesh_file, mesh_collision_shape, MeshCollision, MeshError};
+use crate::mesh::{
+    load_mesh_file, load_mesh_parts, mesh_collision_shape, MeshCollision, MeshError,
+};
 use crate::shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
 #[cfg(feature = "rapier")]
 use crate::world::World;
@@ -110,8 +112,7 @@ pub fn parse_urdf_str(
         }
         let mut visuals = Vec::new();
         for v in &l.visual {
-            let shape = geometry(&v.geometry, base_dir, file, &l.name, "visual", None)?;
-            let rgba = v
+            let urdf_rgba = v
                 .material
                 .as_ref()
                 .and_then(|m| {
@@ -123,16 +124,16 @@ pub fn parse_urdf_str(
                             .and_then(|g| g.color.as_ref().map(|c| c.rgba.0))
                     })
                 })
-                .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32])
-                .unwrap_or(DEFAULT_VISUAL_RGBA);
-            visuals.push(VisualShape {
-                shape,
-                pose_body_from_shape: pose_f64_to_f32(&pose_from_xyz_rpy(
-                    v.origin.xyz.0,
-                    v.origin.rpy.0,
-                )),
-                rgba,
-            });
+                .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32]);
+            let pose_body_from_shape =
+                pose_f64_to_f32(&pose_from_xyz_rpy(v.origin.xyz.0, v.origin.rpy.0));
+            for (shape, file_rgba) in visual_geometry(&v.geometry, base_dir, file, &l.name)? {
+                visuals.push(VisualShape {
+                    shape,
+                    pose_body_from_shape,
+                    rgba: urdf_rgba.or(file_rgba).unwrap_or(DEFAULT_VISUAL_RGBA),
+                });
+            }
         }
         links.push(LinkDesc {
             name: l.name.clone(),
@@ -247,6 +248,53 @@ fn resolve_mesh_path(filename: &str, base_dir: &Path) -> PathBuf {
     } else {
         base_dir.join(p)
     }
+}
+
+/// A visual's geometry: one shape for primitives, one triangle mesh per part (with the part's
+/// material colour from the file) for meshes.
+fn visual_geometry(
+    g: &urdf_rs::Geometry,
+    base_dir: &Path,
+    file: &str,
+    link: &str,
+) -> std::result::Result<Vec<(ShapeDesc, Option<[f32; 4]>)>, UrdfError> {
+    let urdf_rs::Geometry::Mesh { filename, scale } = g else {
+        return Ok(vec![(
+            geometry(g, base_dir, file, link, "visual", None)?,
+            None,
+        )]);
+    };
+    let path = resolve_mesh_path(filename, base_dir);
+    if !path.is_file() {
+        return Err(UrdfError::MissingMesh {
+            file: file.into(),
+            link: link.into(),
+            element: "visual",
+            mesh: path,
+        });
+    }
+    let s = scale.as_ref().map(|s| s.0).unwrap_or([1.0; 3]);
+    let parts = load_mesh_parts(&path, Vector3::from(s).cast::<f32>()).map_err(|source| {
+        UrdfError::MeshLoad {
+            file: file.into(),
+            link: link.into(),
+            element: "visual",
+            mesh: path.clone(),
+            source,
+        }
+    })?;
+    Ok(parts
+        .into_iter()
+        .map(|p| {
+            (
+                ShapeDesc::TriMesh {
+                    vertices: p.mesh.vertices,
+                    indices: p.mesh.indices,
+                },
+                p.diffuse_rgba,
+            )
+        })
+        .collect())
 }
 
 fn geometry(

@@ -169,3 +169,81 @@ fn negative_inertia_is_an_invalid_element_error() {
         other => panic!("expected an invalid-element error, got {other:?}"),
     }
 }
+
+/// A COLLADA file with two triangles, each its own geometry with its own material colour.
+const TWO_MATERIAL_DAE: &str = r##"<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Z_UP</up_axis></asset>
+  <library_effects>
+    <effect id="red-fx"><profile_COMMON><technique sid="common"><phong>
+      <diffuse><color sid="diffuse">0.8 0.1 0.1 1</color></diffuse>
+    </phong></technique></profile_COMMON></effect>
+    <effect id="black-fx"><profile_COMMON><technique sid="common"><phong>
+      <diffuse><color sid="diffuse">0.05 0.05 0.05 1</color></diffuse>
+    </phong></technique></profile_COMMON></effect>
+  </library_effects>
+  <library_materials>
+    <material id="red" name="red"><instance_effect url="#red-fx"/></material>
+    <material id="black" name="black"><instance_effect url="#black-fx"/></material>
+  </library_materials>
+  <library_geometries>
+    <geometry id="a"><mesh>
+      <source id="a-pos"><float_array id="a-arr" count="9">0 0 0 1 0 0 0 1 0</float_array>
+        <technique_common><accessor source="#a-arr" count="3" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common></source>
+      <vertices id="a-v"><input semantic="POSITION" source="#a-pos"/></vertices>
+      <triangles material="red-mat" count="1"><input semantic="VERTEX" source="#a-v" offset="0"/><p>0 1 2</p></triangles>
+    </mesh></geometry>
+    <geometry id="b"><mesh>
+      <source id="b-pos"><float_array id="b-arr" count="9">0 0 1 1 0 1 0 1 1</float_array>
+        <technique_common><accessor source="#b-arr" count="3" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common></source>
+      <vertices id="b-v"><input semantic="POSITION" source="#b-pos"/></vertices>
+      <triangles material="black-mat" count="1"><input semantic="VERTEX" source="#b-v" offset="0"/><p>0 1 2</p></triangles>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="na"><instance_geometry url="#a"><bind_material><technique_common>
+      <instance_material symbol="red-mat" target="#red"/></technique_common></bind_material></instance_geometry></node>
+    <node id="nb"><instance_geometry url="#b"><bind_material><technique_common>
+      <instance_material symbol="black-mat" target="#black"/></technique_common></bind_material></instance_geometry></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>"##;
+
+#[test]
+fn dae_visual_becomes_one_part_per_material_with_its_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "two.dae", TWO_MATERIAL_DAE);
+    let text = TWO_LINKS.replace("TYPE", "revolute").replace(
+        "GEOMETRY",
+        r#"<visual><geometry><mesh filename="two.dae" scale="0.1 0.1 0.1"/></geometry></visual>"#,
+    );
+    let p = write(dir.path(), "robot.urdf", &text);
+    let desc = ms2_physics::parse_urdf_file(&p, &ms2_physics::UrdfLoadOptions::default()).unwrap();
+    let arm = desc.links.iter().find(|l| l.name == "arm").unwrap();
+    assert_eq!(arm.visuals.len(), 2);
+    let mut colours: Vec<[f32; 4]> = arm.visuals.iter().map(|v| v.rgba).collect();
+    colours.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    assert_eq!(colours, vec![[0.05, 0.05, 0.05, 1.0], [0.8, 0.1, 0.1, 1.0]]);
+    for v in &arm.visuals {
+        let ms2_physics::ShapeDesc::TriMesh { vertices, indices } = &v.shape else {
+            panic!("mesh visual is a triangle mesh");
+        };
+        assert_eq!(indices.len(), 1);
+        // Scaled to 10 cm.
+        assert!(vertices.iter().all(|p| p.coords.amax() <= 0.1 + 1e-6));
+    }
+    // A URDF material colour overrides the file's.
+    let text = TWO_LINKS.replace("TYPE", "revolute").replace(
+        "GEOMETRY",
+        r#"<visual><geometry><mesh filename="two.dae"/></geometry>
+           <material name="w"><color rgba="1 1 1 1"/></material></visual>"#,
+    );
+    let p = write(dir.path(), "robot2.urdf", &text);
+    let desc = ms2_physics::parse_urdf_file(&p, &ms2_physics::UrdfLoadOptions::default()).unwrap();
+    let arm = desc.links.iter().find(|l| l.name == "arm").unwrap();
+    assert!(arm.visuals.iter().all(|v| v.rgba == [1.0, 1.0, 1.0, 1.0]));
+}

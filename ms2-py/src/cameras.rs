@@ -61,6 +61,18 @@ fn set_field(
         "far" => update.far = Some(finite_float(path, value)?),
         "p" => update.p = Some(floats::<3>(path, value)?),
         "q" => update.q = Some(floats::<4>(path, value)?),
+        "add_segmentation" => match value.extract::<bool>() {
+            Ok(on) if value.is_instance_of::<pyo3::types::PyBool>() => {
+                update.add_segmentation = Some(on)
+            }
+            _ => return Err(bad(path, "a bool", value)),
+        },
+        "use_stereo_depth" | "hide_link" | "actor_uid" | "texture_names" | "intrinsic" => {
+            return Err(NativeError::Input(format!(
+                "camera_cfgs[{path}]: ManiSkill2's {key:?} is not supported by ms2; supported \
+                 fields: {CAMERA_UPDATE_KEYS:?}"
+            )))
+        }
         _ => return Ok(false),
     }
     Ok(true)
@@ -113,6 +125,14 @@ pub fn camera_updates_from_py(cfgs: &Bound<'_, PyDict>) -> Result<CameraCfgUpdat
         }
     }
     Ok(updates)
+}
+
+/// The render camera of `render()` with ManiSkill2's `render_camera_cfgs` applied: camera
+/// fields at the top level or under the camera's uid `"render_camera"`.
+pub fn render_camera_from_py(cfgs: &Bound<'_, PyDict>) -> Result<CameraConfig, NativeError> {
+    let updates = camera_updates_from_py(cfgs)?;
+    let mut cams = updates.applied_to(vec![CameraConfig::render_camera()])?;
+    Ok(cams.remove(0))
 }
 
 /// The observation cameras of the robot tasks with `camera_cfgs` applied (`None` = defaults).

@@ -6,13 +6,13 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat};
 
-use crate::cameras::cameras_from_py;
+use crate::cameras::{cameras_from_py, render_camera_from_py};
 
 /// The keyword arguments every native env constructor and demonstration binding accepts, with
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
-/// ([`EnvConfig::new`]: `state_dict`, the task's control/reward mode, 500 Hz / 20 Hz, the task's
+/// (ManiSkill2's `state` obs mode, then [`EnvConfig::new`]'s: the task's control/reward mode, 500 Hz / 20 Hz, the task's
 /// episode limit, no render mode, the task's default robot and cameras, the soft-body task's MPM frequency).
-pub const ENV_KWARGS: [&str; 10] = [
+pub const ENV_KWARGS: [&str; 13] = [
     "obs_mode",
     "robot",
     "control_mode",
@@ -23,7 +23,13 @@ pub const ENV_KWARGS: [&str; 10] = [
     "max_episode_steps",
     "camera_cfgs",
     "mpm_freq",
+    "enable_shadow",
+    "render_camera_cfgs",
+    "bg_name",
 ];
+
+/// The obs mode of an env made from Python without `obs_mode` (ManiSkill2's default).
+pub const DEFAULT_OBS_MODE: &str = "state";
 
 /// `value` extracted as a `T`, or a `TypeError` naming the keyword and the expected type.
 fn extract_kwarg<'py, T: FromPyObjectOwned<'py>>(
@@ -74,7 +80,10 @@ fn extract_real(key: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
 /// of the wrong type raises `TypeError` naming the key; bad camera configs raise `ValueError`.
 /// Values are checked further (modes, frequencies) when the env is made.
 pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<EnvConfig> {
-    let mut cfg = EnvConfig::new(env_id);
+    let mut cfg = EnvConfig {
+        obs_mode: DEFAULT_OBS_MODE.to_owned(),
+        ..EnvConfig::new(env_id)
+    };
     let Some(kwargs) = kwargs else {
         return Ok(cfg);
     };
@@ -112,6 +121,21 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                 })?;
                 cfg.camera_cfgs = cameras_from_py(Some(dict))?;
             }
+            "render_camera_cfgs" => {
+                let dict = value.cast::<PyDict>().map_err(|_| {
+                    PyTypeError::new_err(format!("render_camera_cfgs must be a dict, got {value}"))
+                })?;
+                cfg.render_camera = Some(render_camera_from_py(dict)?);
+            }
+            "enable_shadow" => {
+                if !value.is_instance_of::<pyo3::types::PyBool>() {
+                    return Err(PyTypeError::new_err(format!(
+                        "enable_shadow must be a bool, got {value}"
+                    )));
+                }
+                cfg.enable_shadow = value.extract()?;
+            }
+            "bg_name" => cfg.bg_name = Some(extract_kwarg(&key, &value, "a str")?),
             other => {
                 return Err(PyTypeError::new_err(format!(
                     "unexpected keyword argument {other:?}; valid keywords: {ENV_KWARGS:?}"
@@ -135,5 +159,7 @@ pub fn config_to_py<'py>(py: Python<'py>, cfg: &EnvConfig) -> PyResult<Bound<'py
     dict.set_item("control_freq", cfg.control_freq)?;
     dict.set_item("max_episode_steps", cfg.max_episode_steps)?;
     dict.set_item("mpm_freq", cfg.mpm_freq)?;
+    dict.set_item("enable_shadow", cfg.enable_shadow)?;
+    dict.set_item("bg_name", &cfg.bg_name)?;
     Ok(dict)
 }

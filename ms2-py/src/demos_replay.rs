@@ -20,7 +20,8 @@ use crate::demos_common::{demo_error_to_py, episode_from_py, episode_to_py, in_p
 /// threads with the GIL released.
 ///
 /// `target_control_mode` (`None` = each episode's own) converts actions closed-loop;
-/// `use_env_states` restores the recorded states after every step; `record_obs` collects the
+/// `use_env_states` restores the recorded states after every step; `use_first_env_state`
+/// restores `env_states[0]` after the reset (also when converting); `record_obs` collects the
 /// observations of `env_kwargs["obs_mode"]`; `max_retry` retries failed conversions.
 ///
 /// Returns one dict per episode, in order: the replayed episode (keys as `solve_episodes`'s, in
@@ -28,7 +29,8 @@ use crate::demos_common::{demo_error_to_py, episode_from_py, episode_to_py, in_p
 /// `record_obs`). Bad input raises `ValueError`; a failing simulation `RuntimeError`.
 #[pyfunction]
 #[pyo3(signature = (env_id, episodes, env_kwargs=None, target_control_mode=None,
-                    use_env_states=false, record_obs=false, max_retry=0, num_workers=1))]
+                    use_env_states=false, record_obs=false, max_retry=0, num_workers=1,
+                    use_first_env_state=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn replay_episodes<'py>(
     py: Python<'py>,
@@ -40,6 +42,7 @@ pub fn replay_episodes<'py>(
     record_obs: bool,
     max_retry: u32,
     num_workers: usize,
+    use_first_env_state: bool,
 ) -> PyResult<Bound<'py, PyList>> {
     let cfg = config_from_kwargs(&env_id, env_kwargs)?;
     let sources: Vec<DemoEpisode> = episodes
@@ -49,6 +52,7 @@ pub fn replay_episodes<'py>(
     let opts = ReplayOptions {
         target_control_mode,
         use_env_states,
+        use_first_env_state,
         record_obs,
         max_retry,
     };

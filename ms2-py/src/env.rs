@@ -95,6 +95,13 @@ impl NativeEnv {
         )
     }
 
+    /// The observation of the current state in the env's obs mode (rendering in visual modes),
+    /// without stepping: ManiSkill2's `env.get_obs()`.
+    fn get_obs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let obs = self.with_env(py, |env| Ok(env.try_observe()?))?;
+        obs_to_py(py, obs)
+    }
+
     /// The observation space as a tree of `("box", shape, low, high, dtype)` leaves.
     fn observation_space<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let space = self.read(|env| env.observation_space().clone())?;
@@ -160,6 +167,13 @@ impl NativeEnv {
     fn render<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let frame = self.with_env(py, |env| Ok(env.render()?))?;
         obs_to_py(py, ms2_tasks::ObsValue::Array(frame))
+    }
+
+    /// Every observation camera's images whatever the obs mode (`render_mode="cameras"`):
+    /// `{uid: {"rgb", "depth", and "Segmentation" with add_segmentation}}` (GIL released).
+    fn camera_images<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let images = self.with_env(py, |env| Ok(env.camera_images()?))?;
+        obs_to_py(py, images)
     }
 
     /// Triangles drawn per observation camera in the last render (0 before any render).

@@ -9,8 +9,10 @@
 //! * [`vec_env::NativeVecEnv`] — N envs stepped in parallel on rayon's thread pool, with
 //!   gymnasium's next-step autoreset.
 //! * [`policy::NativeScriptedPolicy`] — the runtime's scripted (oracle) policy of an env.
+//! * [`viewer::NativeViewer`] — the `render_mode="human"` window (crate `ms2-viewer`).
 //! * [`errors`] — how runtime errors and panics become Python exceptions.
 
+mod assets;
 mod cameras;
 mod config;
 mod convert;
@@ -22,6 +24,7 @@ mod env;
 mod errors;
 mod policy;
 mod vec_env;
+mod viewer;
 
 use pyo3::prelude::*;
 
@@ -84,14 +87,21 @@ fn num_threads() -> usize {
     rayon::current_num_threads()
 }
 
-/// The adapter the process-wide renderer draws with, e.g. `"llvmpipe (LLVM 15.0.6, 256 bits)
-/// (Vulkan, Cpu)"`; creates the renderer on first call. `RuntimeError` when no adapter exists.
+/// The adapter the process-wide renderer draws with and how it draws sensor images, e.g.
+/// `"llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu), sensors by Raycast"`; creates the renderer
+/// on first call. `RuntimeError` when no adapter exists.
 #[pyfunction]
 fn render_adapter() -> PyResult<String> {
     let ctx =
         ms2_tasks::adapters::RenderContext::shared().map_err(|e| errors::env_error_to_py(&e))?;
     let a = ctx.renderer().adapter();
-    Ok(format!("{} ({}, {})", a.name, a.backend, a.device_type))
+    Ok(format!(
+        "{} ({}, {}), sensors by {:?}",
+        a.name,
+        a.backend,
+        a.device_type,
+        ctx.renderer().sensor_backend()
+    ))
 }
 
 /// The extension module `ms2._native`.
@@ -101,7 +111,14 @@ fn native_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<env::NativeEnv>()?;
     m.add_class::<vec_env::NativeVecEnv>()?;
     m.add_class::<policy::NativeScriptedPolicy>()?;
+    m.add_class::<viewer::NativeViewer>()?;
     m.add_function(wrap_pyfunction!(env_ids, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::asset_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::asset_group_names, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::asset_group_json, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::verify_asset_group, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::register_asset_package_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(assets::panda_description, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(render_adapter, m)?)?;
     m.add_function(wrap_pyfunction!(default_max_episode_steps, m)?)?;

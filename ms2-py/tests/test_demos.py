@@ -27,7 +27,7 @@ NUM_DEMOS = 4
 def demo_file(tmp_path_factory) -> Path:
     """Four successful scripted PickCube demonstrations written by ``ms2 demos generate``."""
     path = tmp_path_factory.mktemp("demos") / "PickCube-v0.h5"
-    argv = ["demos", "generate", ENV_ID, "-n", str(NUM_DEMOS), "-o", str(path)]
+    argv = ["demos", "generate", ENV_ID, "-n", str(NUM_DEMOS), "--output", str(path)]
     assert main([*argv, "--workers", "2", "--policy", "scripted", "-q"]) == 0
     return path
 
@@ -276,7 +276,7 @@ def test_interrupted_writer_keeps_the_last_commit(tmp_path):
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT])
 def test_interrupted_generate_leaves_a_valid_file_of_finished_episodes(tmp_path, sig):
     path = tmp_path / "killed.h5"
-    cmd = [sys.executable, "-m", "ms2", "demos", "generate", ENV_ID, "-n", "400", "-o",
+    cmd = [sys.executable, "-m", "ms2", "demos", "generate", ENV_ID, "-n", "400", "--output",
            str(path), "--workers", "1", "--policy", "scripted", "-q"]  # fmt: skip
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 120

@@ -79,8 +79,8 @@ def test_every_obs_control_and_reward_mode_steps(env_id):
     base = ms2.Ms2Env(env_id)
     rng = np.random.default_rng(0)
     # State modes here; the visual modes have their own tests (test_visual.py).
-    state_modes = [m for m in base.supported_obs_modes if m in ("state", "state_dict")]
-    assert state_modes == ["state_dict", "state"]
+    state_modes = [m for m in base.supported_obs_modes if m in ("state", "state_dict", "none")]
+    assert state_modes == ["state", "state_dict", "none"]
     for obs_mode in state_modes:
         for control_mode in base.supported_control_modes:
             for reward_mode in base.supported_reward_modes:

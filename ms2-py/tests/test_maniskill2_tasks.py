@@ -17,7 +17,7 @@ def test_registered_with_maniskill2_defaults(env_id):
     assert gym.spec(env_id).max_episode_steps == 200
     env = gym.make(env_id)
     unwrapped = env.unwrapped
-    assert unwrapped.obs_mode == "state_dict"
+    assert unwrapped.obs_mode == "state"  # ManiSkill2's SUPPORTED_OBS_MODES[0]
     assert unwrapped.control_mode == "pd_joint_delta_pos"
     assert unwrapped.reward_mode == "normalized_dense"
     assert env.action_space.shape == (8,)

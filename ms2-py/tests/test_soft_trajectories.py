@@ -42,7 +42,9 @@ def _recorded_soft_episode(tmp_path: Path) -> tuple[Path, np.ndarray, np.ndarray
 def test_recorded_soft_episode_keeps_init_state_and_replays_bit_for_bit(tmp_path):
     path, final_state, final_x, success = _recorded_soft_episode(tmp_path)
     with h5py.File(path, "r") as f:
-        assert set(f["traj_0"].keys()) == {"actions", "success", "env_init_state"}
+        # ManiSkill2's RecordEpisode layout: the observations (obs) and, soft-body, the
+        # initial state only.
+        assert set(f["traj_0"].keys()) == {"actions", "success", "env_init_state", "obs"}
         init = f["traj_0/env_init_state"]
         assert init.dtype == np.float32 and init.shape == final_state.shape
     meta = json.loads(path.with_suffix(".json").read_text())
@@ -79,7 +81,17 @@ def test_recorded_soft_episode_keeps_init_state_and_replays_bit_for_bit(tmp_path
 
 def test_generated_soft_demos_replay_convert_and_render(tmp_path, capsys):
     path = tmp_path / "fill.h5"
-    argv = ["demos", "generate", "Fill-v0", "--policy", "scripted", "-n", "2", "-o", str(path)]
+    argv = [
+        "demos",
+        "generate",
+        "Fill-v0",
+        "--policy",
+        "scripted",
+        "-n",
+        "2",
+        "--output",
+        str(path),
+    ]
     assert main([*argv, "--workers", "2", "-q"]) == 0
     with open_trajectory(path) as traj:
         assert traj.env_info["env_kwargs"]["mpm_freq"] == 1000.0

@@ -163,6 +163,22 @@ fn main() {
                     pending.wait().unwrap();
                 }),
             ),
+            (
+                "ray cast (CPU), 1 camera",
+                1,
+                Box::new(|| {
+                    renderer
+                        .render_raycast(&[(&template, &[cam0][..])])
+                        .unwrap();
+                }),
+            ),
+            (
+                "ray cast (CPU), 2 cameras x 16 scenes",
+                32,
+                Box::new(|| {
+                    renderer.render_raycast(&views).unwrap();
+                }),
+            ),
         ];
         let rates = measure_side_by_side(rounds, budget, &mut modes);
         for ((name, _, _), rate) in modes.iter().zip(&rates) {

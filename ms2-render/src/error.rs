@@ -24,6 +24,12 @@ pub enum RenderError {
         /// The value given.
         value: String,
     },
+    /// `MS2_SENSOR_BACKEND` or a configuration named an unknown sensor path.
+    #[error("unknown sensor backend {value:?}: expected one of \"raycast\", \"raster\", \"auto\"")]
+    UnknownSensorBackend {
+        /// The value given.
+        value: String,
+    },
     /// The adapter refused to create a device.
     #[error("could not create a device on adapter {adapter:?}: {reason}")]
     DeviceCreation {

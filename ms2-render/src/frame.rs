@@ -12,7 +12,7 @@ use crate::renderer::{Renderer, ResourceStore, CAMERA_BLOCK_BYTES, INSTANCE_BYTE
 use crate::scene::MAX_DIRECTIONAL_LIGHTS;
 use crate::shadow::light_clip_from_world;
 use crate::targets::{linear_to_srgb8, CameraTargets, FrameResources};
-use crate::{Camera, CameraOutput, RenderError, Scene};
+use crate::{Camera, CameraOutput, RenderError, Scene, SensorBackend};
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
 
@@ -153,6 +153,8 @@ pub struct PendingFrame {
     cameras: Vec<Camera>,
     /// Background colour of each camera's scene, sRGB.
     backgrounds: Vec<[u8; 3]>,
+    /// Images finished before submission returned (the ray-cast path), handed out by `wait`.
+    finished: Vec<CameraOutput>,
 }
 
 impl Renderer {
@@ -181,6 +183,7 @@ impl Renderer {
                 work: None,
                 cameras,
                 backgrounds: Vec::new(),
+                finished: Vec::new(),
             });
         }
         let store = self
@@ -337,7 +340,36 @@ impl Renderer {
             work: Some((resources, submission, map_state)),
             cameras,
             backgrounds,
+            finished: Vec::new(),
         })
+    }
+
+    /// Draws the observation cameras of every scene with the renderer's sensor path
+    /// ([`Renderer::sensor_backend`]): ray casting or rasterizing, same outputs and order as
+    /// [`Renderer::render`].
+    pub fn render_sensors(
+        &self,
+        views: &[(&Scene, &[Camera])],
+    ) -> Result<Vec<CameraOutput>, RenderError> {
+        self.submit_sensors(views)?.wait()
+    }
+
+    /// [`Renderer::submit`] on the sensor path: rasterizing submits without waiting; ray
+    /// casting renders at once (on rayon's pool) and the returned frame is already ready.
+    pub fn submit_sensors(
+        &self,
+        views: &[(&Scene, &[Camera])],
+    ) -> Result<PendingFrame, RenderError> {
+        match self.sensor_backend() {
+            SensorBackend::Raycast => Ok(PendingFrame {
+                renderer: self.clone(),
+                work: None,
+                cameras: Vec::new(),
+                backgrounds: Vec::new(),
+                finished: self.render_raycast(views)?,
+            }),
+            _ => self.submit(views),
+        }
     }
 }
 
@@ -466,7 +498,7 @@ impl PendingFrame {
     /// submission order.
     pub fn wait(mut self) -> Result<Vec<CameraOutput>, RenderError> {
         let Some((resources, submission, state)) = self.work.take() else {
-            return Ok(Vec::new());
+            return Ok(std::mem::take(&mut self.finished));
         };
         let device = &self.renderer.inner.gpu.device;
         let mapped = loop {

@@ -50,8 +50,10 @@ pub mod mesh;
 mod output;
 mod particle_gpu;
 pub mod particles;
+mod raycast;
 mod renderer;
 pub mod scene;
+pub mod sensor_backend;
 mod shadow;
 mod targets;
 
@@ -68,6 +70,7 @@ pub use renderer::{
 pub use scene::{
     DirectionalLight, Instance, InstanceId, Lighting, Material, Scene, SegmentationIds, Shadow,
 };
+pub use sensor_backend::{SensorBackend, SENSOR_BACKEND_ENV_VAR};
 
 #[cfg(test)]
 mod send_sync {

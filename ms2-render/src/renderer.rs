@@ -2,6 +2,8 @@
 
 use crate::error::INSTALL_ADVICE;
 use crate::particle_gpu::ParticleGpu;
+use crate::raycast::{CpuMesh, CpuTexture};
+use crate::sensor_backend::SensorBackend;
 use crate::shadow::{shadow_bind_group_layout, ShadowGpu};
 use crate::targets::FramePool;
 use crate::{MeshData, RenderError};
@@ -43,6 +45,8 @@ impl BackendChoice {
 pub struct RendererConfig {
     /// Backend to use.
     pub backend: BackendChoice,
+    /// How observation images are drawn ([`Renderer::render_sensors`]).
+    pub sensor_backend: SensorBackend,
 }
 
 /// Handle to a mesh in a renderer's shared store.
@@ -95,6 +99,9 @@ pub(crate) struct GpuMesh {
 pub(crate) struct ResourceStore {
     pub(crate) meshes: Vec<GpuMesh>,
     pub(crate) textures: Vec<wgpu::BindGroup>,
+    /// CPU copies for ray casting, same indices as `meshes` and `textures`.
+    pub(crate) cpu_meshes: Vec<Arc<CpuMesh>>,
+    pub(crate) cpu_textures: Vec<Arc<CpuTexture>>,
 }
 
 /// GPU objects shared by every frame.
@@ -118,6 +125,8 @@ pub(crate) struct RendererInner {
     pub(crate) triangle_counts: RwLock<Vec<usize>>,
     pub(crate) pool: Mutex<FramePool>,
     pub(crate) adapter: AdapterSummary,
+    /// The resolved sensor path (never `Auto`).
+    pub(crate) sensor_backend: SensorBackend,
 }
 
 /// A headless renderer. Cheap to clone (clones share one device and one resource store) and
@@ -195,7 +204,27 @@ const VERTEX_BYTES: u64 = 32;
 /// Bytes per instance record: model rows (3 vec4), normal rows (3 vec4), colour, ids.
 pub(crate) const INSTANCE_BYTES: u64 = 128;
 
+/// Environment variable that turns off Mesa's implicit `VK_LAYER_MESA_device_select` Vulkan
+/// layer (its manifest's `disable_environment`).
+pub const MESA_DEVICE_SELECT_OFF_VAR: &str = "NODEVICE_SELECT";
+
+/// Turns off Mesa's device-select layer for this process unless the user set
+/// [`MESA_DEVICE_SELECT_OFF_VAR`] themselves. The layer only reorders adapters (ms2 ranks them
+/// itself, see [`pick_adapter`]), but to find "the display's GPU" it connects to the Wayland
+/// compositor whenever `WAYLAND_DISPLAY` is set; without `XDG_RUNTIME_DIR` (headless shells,
+/// containers, CI) libwayland then prints `error: XDG_RUNTIME_DIR is invalid or not set in the
+/// environment.` on every Vulkan instance. Headless rendering needs no display, so the probe is
+/// skipped at its source.
+fn disable_mesa_device_select() {
+    if std::env::var_os(MESA_DEVICE_SELECT_OFF_VAR).is_none() {
+        // Done once, before the first Vulkan instance of the process; no other thread reads
+        // this variable (only the Vulkan loader does, inside instance creation below).
+        std::env::set_var(MESA_DEVICE_SELECT_OFF_VAR, "1");
+    }
+}
+
 fn pick_adapter(choice: BackendChoice) -> Result<wgpu::Adapter, RenderError> {
+    disable_mesa_device_select();
     let choice = match choice {
         BackendChoice::Auto => match std::env::var(BACKEND_ENV_VAR) {
             Ok(v) => BackendChoice::parse(&v)?,
@@ -264,6 +293,7 @@ impl Renderer {
             reason: e.to_string(),
         })?;
         let gpu = Gpu::new(device, queue);
+        let sensor_backend = config.sensor_backend.resolve(&summary.device_type)?;
         Ok(Renderer {
             inner: Arc::new(RendererInner {
                 gpu,
@@ -271,8 +301,16 @@ impl Renderer {
                 triangle_counts: RwLock::new(Vec::new()),
                 pool: Mutex::new(FramePool::default()),
                 adapter: summary,
+                sensor_backend,
             }),
         })
+    }
+
+    /// How observation images are drawn: [`SensorBackend::Raycast`] or
+    /// [`SensorBackend::Raster`] (resolved from the configuration, `MS2_SENSOR_BACKEND` and the
+    /// adapter).
+    pub fn sensor_backend(&self) -> SensorBackend {
+        self.inner.sensor_backend
     }
 
     /// The adapter this renderer runs on.
@@ -304,12 +342,14 @@ impl Renderer {
             }),
             index_count: mesh.indices.len() as u32,
         };
+        let cpu_mesh = Arc::new(CpuMesh::new(mesh));
         let mut store = self
             .inner
             .store
             .write()
             .expect("resource store lock poisoned");
         store.meshes.push(gpu_mesh);
+        store.cpu_meshes.push(cpu_mesh);
         self.inner
             .triangle_counts
             .write()
@@ -341,6 +381,7 @@ impl Renderer {
             .write()
             .expect("resource store lock poisoned");
         store.textures.push(bind_group);
+        store.cpu_textures.push(Arc::new(CpuTexture::new(texture)));
         Ok(TextureHandle(store.textures.len() as u32 - 1))
     }
 

@@ -16,6 +16,7 @@ fn missing_drivers_give_no_adapter_with_install_advice() {
     std::env::remove_var(ms2_render::BACKEND_ENV_VAR);
     match Renderer::new(RendererConfig {
         backend: BackendChoice::Auto,
+        ..Default::default()
     }) {
         Err(error @ RenderError::NoAdapter { .. }) => {
             let message = error.to_string();

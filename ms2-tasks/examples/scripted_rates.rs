@@ -37,6 +37,12 @@ fn main() -> Result<(), EnvError> {
             .map(str::to_owned)
             .to_vec()
     };
+    let panda = ms2_tasks::agents::panda_model()?;
+    println!(
+        "Panda description: {:?} ({} visual triangles)",
+        panda.source,
+        panda.visual_triangles()
+    );
     for id in ids {
         let mut env = make_env(&EnvConfig {
             obs_mode: "state".to_owned(),

@@ -78,6 +78,16 @@ pub(crate) trait EnvBackend: Send {
     fn render_human(&self, _goal_key: Option<&str>) -> Result<ms2_render::CameraOutput, EnvError> {
         Err(self.not_renderable())
     }
+    /// Calls `f` with the scene as of now, goal marker at the `extra` entry `goal_key` shown
+    /// (robot tasks only).
+    #[cfg(feature = "render")]
+    fn view_scene(
+        &self,
+        _goal_key: Option<&str>,
+        _f: &mut dyn FnMut(&crate::sensors::SceneView<'_>),
+    ) -> Result<(), EnvError> {
+        Err(self.not_renderable())
+    }
     /// Channel-1 segmentation ids by object name (robot tasks only).
     #[cfg(feature = "render")]
     fn segmentation_ids(&self) -> Result<Vec<(String, u32)>, EnvError> {

@@ -12,8 +12,10 @@ use crate::sensors::{CameraConfig, VisualLayout};
 pub struct EnvConfig {
     /// Registered environment id, e.g. `"PickCube-v0"` (see [`crate::env_ids`]).
     pub env_id: String,
-    /// Observation mode: `"state_dict"`, `"state"`, `"rgbd"`, `"pointcloud"`,
-    /// `"rgbd_robot_seg"` or `"pointcloud_robot_seg"`.
+    /// Observation mode ([`ObsMode`]): `"state"`, `"state_dict"`, `"none"`, `"image"`,
+    /// `"rgbd"`, `"pointcloud"`, `"rgbd_robot_seg"`, `"pointcloud_robot_seg"` or (soft-body
+    /// tasks) `"particles"`. [`EnvConfig::new`] takes `state_dict`; the Python keyword's
+    /// default is ManiSkill2's `state`.
     pub obs_mode: String,
     /// Robot uid (ManiSkill2's `robot=`, e.g. `"panda"`); `None` = the task's default (see
     /// [`crate::spec::TaskSpec::robots`]).
@@ -37,6 +39,17 @@ pub struct EnvConfig {
     /// the task's default (1000 Hz; ManiSkill2 uses 2000). Must be a whole multiple of
     /// `sim_freq`; setting it on an env without soft bodies is an error.
     pub mpm_freq: Option<f64>,
+    /// Whether the first directional light casts shadows in every image (observation cameras
+    /// and `render()`; ManiSkill2's `enable_shadow`, default off).
+    pub enable_shadow: bool,
+    /// The camera of `render()` (`render_mode` `rgb_array` / `cameras`); `None` = the task's
+    /// default ([`CameraConfig::render_camera`]). ManiSkill2's `render_camera_cfgs` keyword
+    /// changes it field by field.
+    pub render_camera: Option<CameraConfig>,
+    /// ManiSkill2's `bg_name` (a visual background scene replacing the default lights);
+    /// `None` = the default scene. ms2 ships no background scenes, so any name is refused with
+    /// [`EnvError::InvalidConfig`].
+    pub bg_name: Option<String>,
 }
 
 impl Default for EnvConfig {
@@ -53,6 +66,9 @@ impl Default for EnvConfig {
             control_freq: 20.0,
             max_episode_steps: None,
             mpm_freq: None,
+            enable_shadow: false,
+            render_camera: None,
+            bg_name: None,
         }
     }
 }
@@ -201,13 +217,21 @@ pub enum ObsMode {
     PointCloudRobotSeg,
     /// `state_dict` plus `particles` (soft-body envs: `{"x": [N, 3]}` particle positions).
     Particles,
+    /// No observation: an empty dict (ManiSkill2's `none`, used when recording demonstrations).
+    None,
+    /// Raw camera textures per camera, as ManiSkill2's `image` mode (see
+    /// [`crate::sensors::visual_obs`]): `Color`, `Position` and, with `add_segmentation`,
+    /// `Segmentation`; no point cloud.
+    Image,
 }
 
 impl ObsMode {
-    /// All supported modes.
-    pub const ALL: [ObsMode; 7] = [
-        ObsMode::StateDict,
+    /// All supported modes, ManiSkill2's order (`state` first: its default).
+    pub const ALL: [ObsMode; 9] = [
         ObsMode::State,
+        ObsMode::StateDict,
+        ObsMode::None,
+        ObsMode::Image,
         ObsMode::Rgbd,
         ObsMode::PointCloud,
         ObsMode::RgbdRobotSeg,
@@ -225,13 +249,16 @@ impl ObsMode {
             ObsMode::RgbdRobotSeg => "rgbd_robot_seg",
             ObsMode::PointCloudRobotSeg => "pointcloud_robot_seg",
             ObsMode::Particles => "particles",
+            ObsMode::None => "none",
+            ObsMode::Image => "image",
         }
     }
 
     /// The visual layout and whether a robot mask is added; `None` for the state modes.
     pub fn visual(self) -> Option<(VisualLayout, bool)> {
         match self {
-            ObsMode::StateDict | ObsMode::State | ObsMode::Particles => None,
+            ObsMode::StateDict | ObsMode::State | ObsMode::Particles | ObsMode::None => None,
+            ObsMode::Image => Some((VisualLayout::Image, false)),
             ObsMode::Rgbd => Some((VisualLayout::Rgbd, false)),
             ObsMode::PointCloud => Some((VisualLayout::PointCloud, false)),
             ObsMode::RgbdRobotSeg => Some((VisualLayout::Rgbd, true)),
@@ -291,8 +318,13 @@ impl RewardMode {
     }
 }
 
-/// Render modes accepted in [`EnvConfig::render_mode`].
-pub const RENDER_MODES: [&str; 1] = ["rgb_array"];
+/// Render modes accepted in [`EnvConfig::render_mode`]: `rgb_array` (the render camera's
+/// view), `cameras` (ManiSkill2's: that view tiled with every observation camera's images; the
+/// runtime renders the parts, [`crate::Env::render`] and [`crate::Env::camera_images`]) and
+/// `human` (a viewer window, which the application opens — crate `ms2-viewer`, Python's
+/// `render_mode="human"` — over [`crate::Env::view_scene`]; [`crate::Env::render`] returns the
+/// `rgb_array` image in it).
+pub const RENDER_MODES: [&str; 3] = ["rgb_array", "cameras", "human"];
 
 #[cfg(test)]
 mod tests {

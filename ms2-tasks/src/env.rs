@@ -87,7 +87,10 @@ impl Env {
     pub fn with_engine(cfg: &EnvConfig, engine: Arc<dyn RigidEngine>) -> Result<Env, EnvError> {
         let registration = registry::registration(&cfg.env_id)?;
         let spec = registration.spec;
-        let obs_mode = ObsMode::parse(&cfg.obs_mode)?;
+        let obs_mode = ObsMode::parse(&cfg.obs_mode).map_err(|_| EnvError::UnknownObsMode {
+            got: cfg.obs_mode.clone(),
+            valid: supported_obs_modes(&spec),
+        })?;
         if !spec.supports_obs_mode(obs_mode) {
             if obs_mode.visual().is_some() {
                 return Err(EnvError::NotRenderable {
@@ -115,6 +118,12 @@ impl Env {
             if !cfg!(feature = "render") {
                 return Err(render_disabled(format!("render_mode {rm:?}")));
             }
+        }
+        if let Some(bg) = &cfg.bg_name {
+            return Err(EnvError::InvalidConfig(format!(
+                "bg_name {bg:?} is not available: ms2 ships no background scenes (ManiSkill2's \
+                 \"minimal_bedroom\" is a separately downloaded asset); use bg_name=None"
+            )));
         }
         cfg.check_bounds()?;
         let robot = match cfg.robot.as_deref() {
@@ -370,7 +379,9 @@ impl Env {
     pub fn observe(&self) -> ObsValue {
         let dict = self.backend.observe_state_dict();
         match self.obs_mode {
-            ObsMode::Rgbd
+            ObsMode::None => ObsValue::Dict(Vec::new()),
+            ObsMode::Image
+            | ObsMode::Rgbd
             | ObsMode::PointCloud
             | ObsMode::RgbdRobotSeg
             | ObsMode::PointCloudRobotSeg => ObsValue::Dict(crate::obs::non_privileged_state(
@@ -513,6 +524,50 @@ impl Env {
         }
         #[cfg(not(feature = "render"))]
         Err(render_disabled("render()".to_owned()))
+    }
+
+    /// Every observation camera's images, whatever the obs mode (for `render_mode =
+    /// "cameras"`): `{uid: {"rgb" u8 [H,W,3], "depth" f32 [H,W,1] (m), and "Segmentation"
+    /// u32 [H,W,4] for cameras with `add_segmentation`}}` in camera order. Without the `render`
+    /// feature: [`EnvError::FeatureDisabled`].
+    pub fn camera_images(&self) -> Result<ObsValue, EnvError> {
+        #[cfg(feature = "render")]
+        {
+            let frame = self.backend.capture_cameras()?;
+            let obs = crate::sensors::visual_obs::assemble(
+                ObsValue::Dict(Vec::new()),
+                &[],
+                frame,
+                crate::sensors::VisualLayout::Rgbd,
+                false,
+            );
+            Ok(obs
+                .get("image")
+                .cloned()
+                .unwrap_or(ObsValue::Dict(Vec::new())))
+        }
+        #[cfg(not(feature = "render"))]
+        Err(render_disabled("camera_images()".to_owned()))
+    }
+
+    /// Calls `f` with the env's render scene as it is now (poses synchronised, the goal marker
+    /// shown as in [`Env::render`]), its observation cameras at their poses and the render
+    /// camera: what a viewer window (crate `ms2-viewer`, `render_mode = "human"`) draws through
+    /// cameras of its own. An error for envs without a 3D scene, and
+    /// [`EnvError::FeatureDisabled`] without the `render` feature.
+    #[cfg(feature = "render")]
+    pub fn view_scene<R>(
+        &self,
+        f: impl FnOnce(&crate::sensors::SceneView<'_>) -> R,
+    ) -> Result<R, EnvError> {
+        let mut f = Some(f);
+        let mut out = None;
+        self.backend.view_scene(self.spec.goal_marker, &mut |view| {
+            if let Some(f) = f.take() {
+                out = Some(f(view));
+            }
+        })?;
+        out.ok_or_else(|| EnvError::Render("the scene view was not drawn".to_owned()))
     }
 
     /// The objects of the segmentation images' channel 1 (actor/link ids) as `(name, id)`

@@ -152,6 +152,10 @@ pub enum EnvError {
         /// The missing feature.
         feature: &'static str,
     },
+    /// A fetched asset (e.g. the real Panda's description) is present but unusable: a file
+    /// is missing, truncated or has a wrong checksum (the message names the file).
+    #[error("asset error: {0}")]
+    Asset(String),
     /// The controller failed (the control crate's error is the source).
     #[error("controller error: {0}")]
     Controller(#[from] ms2_control::ControlError),

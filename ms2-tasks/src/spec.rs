@@ -61,6 +61,8 @@ pub struct TaskSpec {
 pub const RIGID_OBS_MODES: &[ObsMode] = &[
     ObsMode::State,
     ObsMode::StateDict,
+    ObsMode::None,
+    ObsMode::Image,
     ObsMode::Rgbd,
     ObsMode::PointCloud,
     ObsMode::RgbdRobotSeg,

@@ -45,6 +45,12 @@ pub(crate) struct TaskEnv {
     /// The observation cameras (checked when the env is made, in every build).
     #[cfg(feature = "render")]
     camera_cfgs: Vec<CameraConfig>,
+    /// The camera of `render()` (checked when the env is made).
+    #[cfg(feature = "render")]
+    render_camera: CameraConfig,
+    /// Whether the first directional light casts shadows (`enable_shadow`).
+    #[cfg(feature = "render")]
+    enable_shadow: bool,
     /// Cameras and render scene, built on the first render (state-only envs never render).
     #[cfg(feature = "render")]
     sensors: Mutex<Option<Sensors>>,
@@ -117,6 +123,13 @@ impl TaskEnv {
         for cam in &camera_cfgs {
             cam.validate()?;
         }
+        let render_camera = cfg
+            .render_camera
+            .clone()
+            .unwrap_or_else(CameraConfig::render_camera);
+        render_camera.validate()?;
+        #[cfg(not(feature = "render"))]
+        let _ = render_camera;
         Ok(Self {
             task,
             scene,
@@ -130,8 +143,22 @@ impl TaskEnv {
             #[cfg(feature = "render")]
             camera_cfgs,
             #[cfg(feature = "render")]
+            render_camera,
+            #[cfg(feature = "render")]
+            enable_shadow: cfg.enable_shadow,
+            #[cfg(feature = "render")]
             sensors: Mutex::new(None),
         })
+    }
+
+    /// The goal marker's position (m, world): the `extra` entry `goal_key` of the state.
+    #[cfg(feature = "render")]
+    fn goal_position(&self, goal_key: Option<&str>) -> Option<nalgebra::Vector3<f32>> {
+        let state = goal_key.map(|_| self.observe_state_dict());
+        goal_key
+            .zip(state.as_ref())
+            .and_then(|(key, state)| state.get(&format!("extra/{key}")))
+            .and_then(|g| g.as_f32().map(|v| nalgebra::Vector3::new(v[0], v[1], v[2])))
     }
 
     /// Runs `f` on the env's sensors (built on first use) and world.
@@ -161,8 +188,9 @@ impl TaskEnv {
             self.scene.world.as_ref(),
             Some(self.scene.agent.articulation()),
             self.camera_cfgs.clone(),
-            CameraConfig::render_camera(),
+            self.render_camera.clone(),
         )?;
+        sensors.set_shadows(self.enable_shadow);
         for visual in self
             .task
             .soft()
@@ -406,12 +434,18 @@ impl EnvBackend for TaskEnv {
 
     #[cfg(feature = "render")]
     fn render_human(&self, goal_key: Option<&str>) -> Result<ms2_render::CameraOutput, EnvError> {
-        let state = goal_key.map(|_| self.observe_state_dict());
-        let goal = goal_key
-            .zip(state.as_ref())
-            .and_then(|(key, state)| state.get(&format!("extra/{key}")))
-            .and_then(|g| g.as_f32().map(|v| nalgebra::Vector3::new(v[0], v[1], v[2])));
+        let goal = self.goal_position(goal_key);
         self.with_sensors(|sensors, world| sensors.render_human(world, goal))
+    }
+
+    #[cfg(feature = "render")]
+    fn view_scene(
+        &self,
+        goal_key: Option<&str>,
+        f: &mut dyn FnMut(&crate::sensors::SceneView<'_>),
+    ) -> Result<(), EnvError> {
+        let goal = self.goal_position(goal_key);
+        self.with_sensors(|sensors, world| sensors.with_view(world, goal, f))
     }
 
     #[cfg(feature = "render")]

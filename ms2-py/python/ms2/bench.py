@@ -29,6 +29,8 @@ from typing import Any
 
 import numpy as np
 
+from .bench_peer import run_peer
+
 #: ManiSkill2 0.5.3 measured on the same 2-core machine, PickCube-v0, state obs, 500/20 Hz:
 #: single-env steps/s per control mode, and its peak RSS.
 MANISKILL2_SINGLE_STEPS_PER_S = {"pd_ee_delta_pose": 556.0, "pd_joint_delta_pos": 648.0}
@@ -162,26 +164,48 @@ def _run_rows(
     groups: list[dict],
     num_envs_list: list[int],
     format_row: Any,
+    peer_python: str | None = None,
 ) -> list[dict]:
     """Runs, for each group (``control_mode`` and ``obs_mode``), a single env and ``make_vec``
     with each of ``num_envs_list`` envs, each in a fresh process; prints a row per run as
     ``format_row(spec, result, single_env_steps_per_s)`` followed by the load average, and
-    returns the rows (spec, result and load)."""
+    returns the rows (spec, result and load). With ``peer_python``, ManiSkill2 0.5.3's single
+    env runs right after ms2's (kind ``peer``), and later rows compare with it."""
     rows = []
     for group in groups:
         single = None
+        single_rss = None
+        peer = None
         for kind, n in _configs(num_envs_list):
             spec = {"kind": kind, "env_id": env_id, **group, "num_envs": n, "steps": steps}
             load = _load()
             result = _spawn(spec)
             if kind == "single":
                 single = result["steps_per_s"]
+                single_rss = result["peak_rss_mb"]
+                if peer_python:
+                    peer_load = _load()
+                    peer = run_peer(peer_python, spec)
+                    peer["load_1min"] = peer_load
+            elif n > 1 and single_rss is not None:
+                # Peak memory each env beyond the first adds (the single env holds one).
+                result["mb_per_extra_env"] = (result["peak_rss_mb"] - single_rss) / (n - 1)
+            if peer is not None:
+                result["peer_steps_per_s"] = peer["steps_per_s"]
             print(f"{format_row(spec, result, single)} {load:>5.1f}", flush=True)
             rows.append({**spec, **result, "load_1min": load})
+            if kind == "single" and peer is not None:
+                peer_spec = {**spec, "kind": "peer"}
+                peer["peer_steps_per_s"] = peer["steps_per_s"]
+                peer_row = format_row(peer_spec, peer, single)
+                print(f"{peer_row} {peer['load_1min']:>5.1f}", flush=True)
+                rows.append({**peer_spec, **peer})
     return rows
 
 
 def _runner_name(kind: str, n: int) -> str:
+    if kind == "peer":
+        return "ManiSkill2 0.5.3"
     return "gym.make (1 env)" if kind == "single" else f"make_vec({n})"
 
 
@@ -276,37 +300,43 @@ def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
     )
     header = (
         f"{'obs_mode':<11} {'runner':<18} {'steps/s':>9} {'cpu ms/step':>11} "
-        f"{'x our single':>12} {'x MS2 single':>12} {'peak RSS MB':>11} {'triangles/cam':>13} "
-        f"{'load':>5}"
+        f"{'x our single':>12} {'x MS2 single':>12} {'peak RSS MB':>11} {'MB/extra env':>12} "
+        f"{'triangles/cam':>13} {'load':>5}"
     )
     print(header)
     print("-" * len(header))
 
     def visual_row(spec: dict, result: dict, single: float) -> str:
+        # Measured in this run when --peer-python is given, else the recorded figure.
+        reference = result.get("peer_steps_per_s", peer)
+        extra = result.get("mb_per_extra_env")
+        triangles = result["triangles_per_camera"]
         return (
             f"{spec['obs_mode']:<11} {_runner_name(spec['kind'], spec['num_envs']):<18} "
             f"{result['steps_per_s']:>9.1f} {result['cpu_ms_per_step']:>11.1f} "
             f"{result['steps_per_s'] / single:>12.2f} "
-            f"{result['steps_per_s'] / peer:>12.2f} "
-            f"{result['peak_rss_mb']:>11.0f} {result['triangles_per_camera']:>13}"
+            f"{result['steps_per_s'] / reference:>12.2f} "
+            f"{result['peak_rss_mb']:>11.0f} {'-' if extra is None else f'{extra:.0f}':>12} "
+            f"{'-' if triangles is None else triangles:>13}"
         )
 
     specs = [
         {"control_mode": control_mode, "obs_mode": obs_mode, "policy": args.policy}
         for obs_mode in obs_modes
     ]
-    rows = _run_rows(args.env_id, steps, specs, num_envs_list, visual_row)
+    peer_python = args.peer_python or os.environ.get("MS2_PEER_PYTHON")
+    rows = _run_rows(args.env_id, steps, specs, num_envs_list, visual_row, peer_python)
     _print_render_cost(rows)
     if soft:
         print(
             f"ManiSkill2 paper: soft-body envs with rendering ~{peer:.1f} steps/s single env on "
             f"an RTX Titan GPU (MPM on the GPU); ms2 runs MPM and rendering on the CPU cores above"
         )
-    else:
+    elif not peer_python:
         print(
-            f"ManiSkill2 0.5.3 on this machine (single env, lavapipe, same cameras): rgbd and "
-            f"pointcloud ~{peer:.0f} steps/s, peak RSS 336-480 MB; it draws the Panda's full "
-            f"visual meshes, ms2 draws the primitive shapes counted above"
+            f"ManiSkill2 0.5.3 on this machine (single env, lavapipe, same cameras), recorded "
+            f"earlier: rgbd and pointcloud ~{peer:.0f} steps/s, peak RSS 336-480 MB; measure it "
+            f"in the same run with --peer-python (a Python with mani-skill2==0.5.3)"
         )
     _write_json(args.json, rows)
     return 0
@@ -340,13 +370,17 @@ def _write_json(path: str | None, rows: list[dict]) -> None:
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Adds the ``bench`` subcommand to the ``ms2`` command line."""
-    p = sub.add_parser("bench", help="benchmark env steps/s (single env and make_vec) and memory")
-    p.add_argument("--env-id", default="PickCube-v0")
+    p = sub.add_parser(
+        "bench",
+        help="benchmark env steps/s (single env and make_vec) and memory",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    p.add_argument("--env-id", default="PickCube-v0", help="task id")
     p.add_argument(
         "--steps",
         type=int,
         default=None,
-        help="env steps per configuration (default 4000; --visual: 1000, soft-body envs 200)",
+        help="env steps per configuration (None: 4000; --visual: 1000, soft-body envs 200)",
     )
     p.add_argument(
         "--visual",
@@ -358,14 +392,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--control-modes",
         default=None,
-        help="comma-separated (default pd_ee_delta_pose,pd_joint_delta_pos; --visual: the first "
+        help="comma-separated (None: pd_ee_delta_pose,pd_joint_delta_pos; --visual: the first "
         "one given, else pd_joint_delta_pos)",
     )
     p.add_argument(
         "--policy",
         choices=["random", "scripted"],
         default="random",
-        help="actions: uniform random (default) or the task's scripted solution (single envs)",
+        help="actions: uniform random or the task's scripted solution (single envs)",
+    )
+    p.add_argument(
+        "--peer-python",
+        default=None,
+        help="--visual: a Python with mani-skill2==0.5.3 installed; its single env is measured "
+        "after each of ms2's, interleaved (also MS2_PEER_PYTHON)",
     )
     p.add_argument(
         "--soak",

@@ -4,14 +4,21 @@ Subcommands:
 
 * ``ms2 envs`` — list the registered tasks.
 * ``ms2 run PickCube-v0 --policy scripted|random --episodes 20 [--record DIR]`` — run episodes
-  and print the success rate and env steps/s; ``--record`` saves each episode as an MP4 and to
-  ``DIR/<env_id>.h5`` + ``.json`` (ManiSkill2's trajectory layout).
+  (in the task's default control mode unless ``-c`` is given) and print the success rate and
+  env steps/s; ``--record`` saves each episode as an MP4 and to ``DIR/<env_id>.h5`` + ``.json``
+  (ManiSkill2's trajectory layout).
 * ``ms2 bench`` — env steps/s and peak memory of a single env and of ``make_vec`` with 1-16 envs.
-* ``ms2 demos generate PickCube-v0 -n 100 -o demos/PickCube-v0.h5 --workers 2`` — write
+* ``ms2 demos generate PickCube-v0 -n 100 --output demos/PickCube-v0.h5 -w 2`` — write
   successful ``pd_joint_pos`` demonstrations (ManiSkill2's trajectory layout).
 * ``ms2 demos bench PickCube-v0 -n 20`` — seconds per generated demo and per converted episode.
 * ``ms2 replay --traj-path X.h5 [--obs-mode M] [--target-control-mode C] ...`` — replay or
-  convert a trajectory file, writing ``X.<obs_mode>.<control_mode>.h5``.
+  convert a trajectory file (ms2's, or one ManiSkill2 0.5.3 wrote), writing
+  ``X.<obs_mode>.<control_mode>.h5``.
+
+* ``ms2 gallery`` — one picture per task into ``docs/images/tasks/`` (``docs/tasks.md``).
+
+Short flags mean the same in every subcommand: ``-n`` how many episodes, ``-o`` obs mode, ``-c``
+control mode, ``-w`` worker threads, ``-v`` verbose, ``-q`` no progress bar.
 """
 
 from __future__ import annotations
@@ -21,6 +28,17 @@ import sys
 import time
 from collections.abc import Sequence
 from typing import Any
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Shows every option's default: appended as ``(default: X)`` unless the help text
+    already says what the default is."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        if "default" in text.lower():
+            return text
+        return super()._get_help_string(action)
 
 
 def _cmd_envs(_args: argparse.Namespace) -> int:
@@ -33,17 +51,16 @@ def _cmd_envs(_args: argparse.Namespace) -> int:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     import gymnasium as gym
+    from tqdm.auto import tqdm
 
     import ms2
 
-    control_mode = args.control_mode
-    if control_mode is None:
-        supported = ms2.Ms2Env(args.env_id).supported_control_modes
-        control_mode = "pd_ee_delta_pose" if "pd_ee_delta_pose" in supported else None
+    if args.env_id not in ms2.env_ids():
+        raise ValueError(f"unknown env id {args.env_id!r}; valid ids: {ms2.env_ids()}")
     env = gym.make(
         args.env_id,
         obs_mode=args.obs_mode,
-        control_mode=control_mode,
+        control_mode=args.control_mode,  # None: the task's own default
         reward_mode=args.reward_mode,
         render_mode="rgb_array" if args.record is not None else None,
     )
@@ -56,6 +73,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
     successes = 0
     total_steps = 0
     started = time.perf_counter()
+    bar = tqdm(
+        total=args.episodes,
+        desc=f"run {args.env_id}",
+        unit="ep",
+        disable=args.quiet or args.episodes < 2,
+        dynamic_ncols=True,
+    )
     for episode in range(args.episodes):
         _obs, info = env.reset(seed=args.seed + episode)
         if policy is not None:
@@ -71,12 +95,15 @@ def _cmd_run(args: argparse.Namespace) -> int:
             if terminated or truncated:
                 break
         successes += int(success)
+        bar.update(1)
+        bar.set_postfix(success=f"{successes}/{episode + 1}")
         if args.verbose:
-            print(
+            bar.write(
                 f"episode {episode} (seed {args.seed + episode}): "
                 f"{'success' if success else 'failure'} after {info.get('elapsed_steps', '?')} "
                 f"steps, return {episode_return:.3f}"
             )
+    bar.close()
     elapsed = time.perf_counter() - started
     control_mode = env.unwrapped.control_mode
     env.close()
@@ -93,18 +120,27 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _add_run_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("run", help="run episodes of a task with a scripted or random policy")
-    p.add_argument("env_id", nargs="?", default="PickCube-v0", help="task id (default PickCube-v0)")
-    p.add_argument("--policy", choices=["scripted", "random"], default="scripted")
-    p.add_argument("--episodes", type=int, default=20)
-    p.add_argument("--seed", type=int, default=0, help="seed of the first episode (then +1 each)")
-    p.add_argument("--obs-mode", default="state")
+    p = sub.add_parser(
+        "run",
+        help="run episodes of a task with a scripted or random policy",
+        formatter_class=HelpFormatter,
+    )
+    p.add_argument("env_id", nargs="?", default="PickCube-v0", help="task id")
     p.add_argument(
+        "--policy", choices=["scripted", "random"], default="scripted", help="action source"
+    )
+    p.add_argument("-n", "--episodes", type=int, default=20, help="number of episodes")
+    p.add_argument("--seed", type=int, default=0, help="seed of the first episode (then +1 each)")
+    p.add_argument("-o", "--obs-mode", default="state", help="observation mode")
+    p.add_argument(
+        "-c",
         "--control-mode",
         default=None,
-        help="default: pd_ee_delta_pose where the robot has it, else the task's default",
+        help="control mode (None: the task's default, e.g. pd_joint_delta_pos)",
     )
-    p.add_argument("--reward-mode", default=None)
+    p.add_argument(
+        "--reward-mode", default=None, help="reward mode (None: the task's, normalized_dense)"
+    )
     p.add_argument(
         "--record",
         metavar="DIR",
@@ -112,6 +148,7 @@ def _add_run_parser(sub: argparse._SubParsersAction) -> None:
         help="save each episode as DIR/episode_<i>.mp4 and to DIR/<env_id>.h5 + .json",
     )
     p.add_argument("-v", "--verbose", action="store_true", help="print one line per episode")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_run)
 
 
@@ -204,41 +241,55 @@ def _cmd_demos_bench(args: argparse.Namespace) -> int:
 def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("demos", help="generate demonstrations (trajectory files)")
     demos_sub = p.add_subparsers(dest="demos_command", required=True)
-    g = demos_sub.add_parser("generate", help="write successful demonstrations (trajectory files)")
+    fmt = HelpFormatter
+    g = demos_sub.add_parser(
+        "generate", help="write successful demonstrations (trajectory files)", formatter_class=fmt
+    )
     g.add_argument("env_id", help="task id, e.g. PickCube-v0")
-    g.add_argument("-n", "--num-episodes", type=int, default=100)
-    g.add_argument("-o", "--output", required=True, help="output .h5 (its .json is written too)")
-    g.add_argument("--workers", type=int, default=1, help="native worker threads")
+    g.add_argument("-n", "--num-episodes", type=int, default=100, help="demos to keep")
+    g.add_argument("--output", "--out", required=True, help="output .h5 (its .json is written too)")
+    g.add_argument("-w", "--workers", type=int, default=1, help="native worker threads")
     g.add_argument("--seed", type=int, default=0, help="first episode seed (then +1 each)")
-    g.add_argument("--max-seeds", type=int, default=None, help="give up after this many seeds")
+    g.add_argument(
+        "--max-seeds", type=int, default=None, help="give up after this many seeds (None: never)"
+    )
     g.add_argument(
         "--policy",
         choices=["solution", "scripted"],
         default="solution",
-        help="motion-planning solution (default) or the scripted oracle",
+        help="motion-planning solution or the scripted oracle",
     )
     g.add_argument(
         "-c",
         "--control-mode",
         default=None,
-        help="control mode of the demos (default pd_joint_pos, for soft-body envs "
+        help="control mode of the demos (None: pd_joint_pos, for soft-body envs "
         "pd_joint_delta_pos; other modes than pd_joint_pos need --policy scripted)",
     )
     g.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     g.set_defaults(func=_cmd_demos_generate)
-    b = demos_sub.add_parser("bench", help="seconds per generated demo and per converted episode")
-    b.add_argument("env_id", nargs="?", default="PickCube-v0")
-    b.add_argument("-n", "--num-episodes", type=int, default=20)
-    b.add_argument("--workers", type=int, default=1)
-    b.add_argument("--policy", choices=["solution", "scripted"], default="solution")
+    b = demos_sub.add_parser(
+        "bench", help="seconds per generated demo and per converted episode", formatter_class=fmt
+    )
+    b.add_argument("env_id", nargs="?", default="PickCube-v0", help="task id")
+    b.add_argument("-n", "--num-episodes", type=int, default=20, help="demos to generate")
+    b.add_argument("-w", "--workers", type=int, default=1, help="native worker threads")
+    b.add_argument(
+        "--policy", choices=["solution", "scripted"], default="solution", help="demo source"
+    )
     b.add_argument("-c", "--control-mode", default=None, help="control mode of the generated demos")
-    b.add_argument("--max-retry", type=int, default=0)
+    b.add_argument("--max-retry", type=int, default=0, help="retries of a failed conversion")
     b.add_argument(
         "--target-control-modes",
         default="pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos",
         help="comma-separated target modes",
     )
     b.set_defaults(func=_cmd_demos_bench)
+
+
+def run_replay(args: argparse.Namespace) -> int:
+    """Runs ``ms2 replay`` with parsed options (see :func:`add_replay_arguments`)."""
+    return _cmd_replay(args)
 
 
 def _cmd_replay(args: argparse.Namespace) -> int:
@@ -256,6 +307,9 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         allow_failure=args.allow_failure,
         count=args.count,
         progress=not args.quiet,
+        use_first_env_state=args.use_first_env_state,
+        discard_timeout=args.discard_timeout,
+        vis=args.vis,
     )
     print(
         f"replayed {result.num_episodes} episodes: {result.num_succeeded} succeeded "
@@ -273,37 +327,108 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 
 
 def _add_replay_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("replay", help="replay / convert a trajectory file")
-    p.add_argument("--traj-path", required=True, help="the X.h5 to replay (with X.json)")
-    p.add_argument("-o", "--obs-mode", default=None, help="record observations of this mode")
-    p.add_argument(
-        "-c", "--target-control-mode", default=None, help="convert actions to this control mode"
+    p = sub.add_parser(
+        "replay",
+        help="replay / convert a trajectory file (ms2's or ManiSkill2's)",
+        formatter_class=HelpFormatter,
     )
-    p.add_argument("--use-env-states", action="store_true", help="restore the recorded states")
+    add_replay_arguments(p)
+
+
+def add_replay_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of ``ms2 replay`` (ManiSkill2's ``replay_trajectory`` names) on ``p``."""
+    p.add_argument("--traj-path", required=True, help="the X.h5 to replay (with X.json)")
+    p.add_argument(
+        "-o",
+        "--obs-mode",
+        default=None,
+        help="record observations of this mode (default: the file's env_kwargs obs_mode; "
+        "none records none)",
+    )
+    p.add_argument(
+        "-c",
+        "--control-mode",
+        "--target-control-mode",
+        dest="target_control_mode",
+        default=None,
+        help="convert actions to this control mode (default: the recorded one)",
+    )
+    p.add_argument(
+        "--use-env-states", action="store_true", help="restore the recorded state after every step"
+    )
+    p.add_argument(
+        "--use-first-env-state",
+        action="store_true",
+        help="start from the recorded first state instead of the seed's "
+        "(always on for files ManiSkill2 wrote)",
+    )
     p.add_argument("--save-traj", action="store_true", help="write X.<obs_mode>.<control_mode>.h5")
     p.add_argument("--save-video", action="store_true", help="write one MP4 per episode")
-    p.add_argument("--num-workers", type=int, default=1, help="native worker threads")
+    p.add_argument(
+        "--vis", action="store_true", help="show each episode in a viewer window (needs a display)"
+    )
+    p.add_argument(
+        "-w", "--num-workers", "--num-procs", type=int, default=1, help="native worker threads"
+    )
     p.add_argument("--max-retry", type=int, default=0, help="retries of a failed conversion")
+    p.add_argument(
+        "--discard-timeout",
+        action="store_true",
+        help="count episodes that reach the episode limit as failed",
+    )
     p.add_argument(
         "--allow-failure", action="store_true", help="also save episodes that do not succeed"
     )
-    p.add_argument("--count", type=int, default=None, help="replay only the first N episodes")
+    p.add_argument(
+        "-n", "--count", type=int, default=None, help="replay only the first N episodes (all)"
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_replay)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Runs the ``ms2`` command line with ``argv`` (default: ``sys.argv[1:]``)."""
-    from . import bench
+def _cmd_gallery(args: argparse.Namespace) -> int:
+    from .gallery import render_gallery
+
+    for path in render_gallery(args.out, args.env_ids or None, steps=args.steps, seed=args.seed):
+        print(f"wrote {path}")
+    return 0
+
+
+def _add_gallery_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "gallery",
+        help="render one picture per task (the docs/tasks.md gallery)",
+        formatter_class=HelpFormatter,
+    )
+    p.add_argument("env_ids", nargs="*", help="tasks to render (none given: every 3D task)")
+    p.add_argument("--out", default="docs/images/tasks", help="directory of <env_id>.png")
+    p.add_argument("--steps", type=int, default=30, help="scripted steps before the picture")
+    p.add_argument("--seed", type=int, default=0, help="episode seed")
+    p.set_defaults(func=_cmd_gallery)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``ms2`` argument parser with every subcommand."""
+    from . import __version__, assets, bench, teleop
 
     parser = argparse.ArgumentParser(prog="ms2", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"ms2 {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     p_envs = sub.add_parser("envs", help="list the registered tasks")
     p_envs.set_defaults(func=_cmd_envs)
     _add_run_parser(sub)
     bench.add_parser(sub)
+    assets.add_parser(sub)
     _add_demos_parser(sub)
     _add_replay_parser(sub)
+    _add_gallery_parser(sub)
+    teleop.add_parser(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Runs the ``ms2`` command line with ``argv`` (default: ``sys.argv[1:]``)."""
+    parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return int(args.func(args))

@@ -174,6 +174,9 @@ def generate(
     env_kwargs = {"obs_mode": "state", "control_mode": control_mode}
     run = _native.solve_episodes if policy == "solution" else _native.scripted_episodes
     recorded = dict(_native.recorded_env_kwargs(env_id, env_kwargs))
+    # No observations are stored: the file says so, as ManiSkill2's demonstrations do (replays
+    # record the obs mode of env_kwargs unless told another).
+    recorded["obs_mode"] = "none"
     env_info = {
         "env_id": env_id,
         "max_episode_steps": int(recorded.pop("max_episode_steps")),
@@ -279,6 +282,59 @@ def _write_video(env_id: str, env_kwargs: dict[str, Any], episode: dict[str, Any
     return write_video(path, frames, fps=fps)
 
 
+def _state_templates(
+    env_id: str, control_modes: set[str], kwargs: dict[str, Any]
+) -> dict[str, Any]:
+    """A state of an ms2 env of ``env_id`` per control mode (what ManiSkill2 states are mapped
+    into: :func:`ms2.maniskill2_states.map_states`)."""
+    templates = {}
+    for mode in control_modes:
+        env = _native.NativeEnv(env_id, **{**kwargs, "obs_mode": "state", "control_mode": mode})
+        env.reset(seed=0)
+        templates[mode] = env.get_state()
+    return templates
+
+
+def _map_foreign_states(traj: Any, episode: dict[str, Any], templates: dict[str, Any]) -> bool:
+    """Maps ``episode``'s ``env_states`` in place from ManiSkill2 0.5.3's layout into ms2's when
+    their length is not ms2's; whether it did. ``UnmappableStateError`` (a ``ValueError``) names
+    the file, env and lengths of a layout neither knows."""
+    from .maniskill2_states import map_states
+
+    if "env_states" not in episode:
+        return False
+    template = templates[episode["control_mode"]]
+    states = episode["env_states"]
+    if states.shape[1] == template.size:
+        return False
+    source = f"{traj.path} (traj_{episode['episode_id']})"
+    episode["env_states"] = map_states(states, traj.env_id, template, source=source)
+    return True
+
+
+def _show_episode(env_id: str, env_kwargs: dict[str, Any], episode: dict[str, Any]) -> None:
+    """Shows a replayed rigid-body episode state by state in a viewer window
+    (``render_mode="human"``; raises the viewer's error where there is no display)."""
+    from .envs import Ms2Env
+
+    env = Ms2Env(
+        env_id,
+        obs_mode="none",
+        control_mode=episode["control_mode"],
+        render_mode="human",
+        sim_freq=float(env_kwargs.get("sim_freq", 500.0)),
+        control_freq=float(env_kwargs.get("control_freq", 20.0)),
+        mpm_freq=env_kwargs.get("mpm_freq"),
+    )
+    try:
+        env.reset(seed=int(episode["episode_seed"]))
+        for state in episode.get("env_states", [episode.get("env_init_state")]):
+            env.set_state(state)
+            env.render()
+    finally:
+        env.close()
+
+
 def _check_soft_episodes(traj: Any, indices: list[int], use_env_states: bool, kwargs: dict) -> None:
     """Refuses, naming the file and episode, ``use_env_states`` on soft-body episodes and
     ``env_init_state`` vectors whose length is not the env's state length."""
@@ -319,15 +375,29 @@ def replay(
     allow_failure: bool = False,
     count: int | None = None,
     progress: bool = True,
+    use_first_env_state: bool = False,
+    discard_timeout: bool = False,
+    vis: bool = False,
 ) -> ReplayResult:
     """Replays (and optionally converts) the episodes of ``traj_path``.
 
+    Files ManiSkill2 0.5.3 wrote replay too: their env states (another layout) are mapped into
+    ms2's (:mod:`ms2.maniskill2_states`) and, as their seeds do not give the same scenes in
+    ms2, each episode starts from its first recorded state (``use_first_env_state``).
+
     Args:
         traj_path: the ``X.h5`` to replay (with its ``X.json``).
-        obs_mode: record observations of this mode (``None``: none).
+        obs_mode: record observations of this mode; ``None`` = the source's ``env_kwargs``
+            obs mode (as ManiSkill2), none recorded when that is ``"none"`` or absent.
         target_control_mode: convert the actions closed-loop to this mode (``None``: keep).
         use_env_states: restore the recorded state after every step (no conversion; refused
             for soft-body episodes, which store only ``env_init_state``).
+        use_first_env_state: restore the recorded state after reset (``env_states[0]``)
+            instead of relying on the seed, then step the actions (also when converting).
+        discard_timeout: count an episode that reaches the episode limit as failed, even if
+            successful at its last step (ManiSkill2's ``--discard-timeout``).
+        vis: show each replayed episode in a viewer window (``render_mode="human"``), state by
+            state as replayed.
         save_traj: write ``X.<obs_mode>.<control_mode>.h5`` (+ ``.json``).
         save_video: write one MP4 per episode to ``X.<obs_mode>.<control_mode>.videos/``.
         num_workers: native worker threads.
@@ -359,6 +429,10 @@ def replay(
             for key in ("reward_mode", "sim_freq", "control_freq", "mpm_freq")
             if key in env_kwargs
         }
+        if obs_mode is None:
+            obs_mode = env_kwargs.get("obs_mode")
+        if obs_mode == "none":
+            obs_mode = None
         native_kwargs["obs_mode"] = obs_mode or "state"
         native_kwargs["max_episode_steps"] = traj.env_info.get("max_episode_steps")
         try:
@@ -370,6 +444,13 @@ def replay(
                 f"{traj.env_info.get('max_episode_steps')!r}) cannot make an env: {e}"
             ) from e
         _check_soft_episodes(traj, list(range(len(episodes_meta))), use_env_states, native_kwargs)
+        templates = _state_templates(
+            traj.env_id, {ep["control_mode"] for ep in episodes_meta}, native_kwargs
+        )
+        episode_limit = int(
+            traj.env_info.get("max_episode_steps")
+            or _native.recorded_env_kwargs(traj.env_id, native_kwargs)["max_episode_steps"]
+        )
         if any(traj.is_soft(i) for i in range(len(episodes_meta))):
             # Record the resolved MPM frequency (a foreign file may lack it).
             resolved = _native.recorded_env_kwargs(traj.env_id, native_kwargs)
@@ -391,6 +472,7 @@ def replay(
             with _progress(len(indices), f"replay {traj.env_id}", progress) as bar:
                 for chunk in _chunks(indices, 4 * num_workers):
                     sources = [traj.read_episode(i) for i in chunk]
+                    foreign = [_map_foreign_states(traj, ep, templates) for ep in sources]
                     try:
                         replayed = _native.replay_episodes(
                             traj.env_id,
@@ -401,6 +483,7 @@ def replay(
                             obs_mode is not None,
                             max_retry,
                             num_workers,
+                            use_first_env_state=use_first_env_state or any(foreign),
                         )
                     except (ValueError, TypeError) as e:
                         ids = [int(src["episode_id"]) for src in sources]
@@ -411,6 +494,10 @@ def replay(
                         result.num_episodes += 1
                         result.attempts += int(episode["attempts"])
                         ok = _succeeded(episode)
+                        if discard_timeout and len(episode["actions"]) >= episode_limit:
+                            ok = False
+                        if vis:
+                            _show_episode(traj.env_id, env_kwargs, episode)
                         result.num_succeeded += int(ok)
                         if not ok:
                             result.failed_episode_ids.append(int(source["episode_id"]))

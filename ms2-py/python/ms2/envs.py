@@ -15,7 +15,9 @@ import gymnasium as gym
 import numpy as np
 
 from . import _native
+from . import assets as _assets
 from .spaces import to_gym_space
+from .visualization import camera_images_to_tiles, tile_images
 
 #: Native episode limit used when gymnasium's ``TimeLimit`` wrapper enforces the limit instead
 #: (``gymnasium.make`` applies one with the registered or the given ``max_episode_steps``).
@@ -100,12 +102,22 @@ class Ms2Env(gym.Env):
 
     Args:
         env_id: registered task id (``ms2.env_ids()`` lists them).
-        obs_mode: ``"state_dict"`` (nested dict of arrays) or ``"state"`` (one flat float32 array).
+        obs_mode: ``"state"`` (default, ManiSkill2's: one flat float32 array), ``"state_dict"``
+            (nested dict of arrays), ``"none"`` (an empty dict), ``"image"`` (raw camera
+            textures ``Color`` / ``Position``), ``"rgbd"``, ``"pointcloud"``,
+            ``"rgbd_robot_seg"``, ``"pointcloud_robot_seg"``, and ``"particles"`` on the
+            soft-body tasks; ``supported_obs_modes`` lists an env's.
         robot: robot uid, ManiSkill2's keyword (``"panda"``); ``None`` = the task's default.
             A robot the task does not support raises ``ValueError`` listing the valid ones.
         control_mode: e.g. ``"pd_ee_delta_pose"``; ``None`` = ``"pd_joint_delta_pos"``.
         reward_mode: ``"sparse"``, ``"dense"`` or ``"normalized_dense"`` (``None``).
-        render_mode: ``None`` or ``"rgb_array"``.
+        render_mode: ``None``, ``"rgb_array"`` (the render camera's 512×512 view),
+            ``"cameras"`` (that view tiled with every observation camera's images: RGB, depth
+            and, with ``add_segmentation``, the two segmentation channels, as ManiSkill2) or
+            ``"human"`` (``render()`` opens and updates a viewer window: mouse orbit / pan /
+            zoom, ``space`` pause, ``n`` single step, ``c`` sensor views, ``m`` segmentation;
+            see docs/viewer.md). ``"human"`` needs a display: without one ``render()`` raises
+            ``RuntimeError`` naming ``DISPLAY`` / ``WAYLAND_DISPLAY``.
         sim_freq: physics frequency in Hz (500 by default).
         control_freq: env step frequency in Hz (20 by default); ``sim_freq`` must be a multiple.
         max_episode_steps: episode limit in env steps after which ``truncated`` is set;
@@ -114,21 +126,29 @@ class Ms2Env(gym.Env):
             keyword: ``{"width": 64, "height": 64, "fov": 1.2}`` sets fields of every camera,
             ``{"base_camera": {"p": [..], "q": [..]}}`` of one camera (fields: ``width``,
             ``height``, ``fov`` (vertical, radians), ``near``, ``far`` (m), ``p``, ``q`` (pose
-            in the mount's frame, quaternion wxyz)). Unknown keys or bad values raise
-            ``ValueError``.
+            in the mount's frame, quaternion wxyz), ``add_segmentation`` (adds
+            ``Segmentation`` u32 [H, W, 4] to the ``image`` / ``rgbd`` observations)). Unknown
+            keys or bad values raise ``ValueError``.
         mpm_freq: MPM substep frequency in Hz of the soft-body tasks (``Excavate-v0``,
             ``Fill-v0``); ``None`` = the task's default (1000; ManiSkill2 uses 2000). Must be a
             whole multiple of ``sim_freq``; ``ValueError`` on envs without soft bodies.
+        enable_shadow: whether the first directional light casts shadows in every image
+            (ManiSkill2's keyword; off by default).
+        render_camera_cfgs: changes to the camera of ``render()``, as ``camera_cfgs``
+            (``{"width": 256, "height": 256, "fov": 1.2, "p": [..], "q": [..]}``, also under
+            the key ``"render_camera"``).
+        bg_name: ManiSkill2's visual background; only ``None`` (ms2 ships no background
+            scenes: any name raises ``ValueError``).
 
     Unknown ids or modes raise ``ValueError`` listing the valid ones.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+    metadata = {"render_modes": ["rgb_array", "cameras", "human"], "render_fps": 20}
 
     def __init__(
         self,
         env_id: str = "PickCube-v0",
-        obs_mode: str = "state_dict",
+        obs_mode: str = "state",
         robot: str | None = None,
         control_mode: str | None = None,
         reward_mode: str | None = None,
@@ -138,7 +158,11 @@ class Ms2Env(gym.Env):
         max_episode_steps: int | None = None,
         camera_cfgs: dict[str, Any] | None = None,
         mpm_freq: float | None = None,
+        enable_shadow: bool = False,
+        render_camera_cfgs: dict[str, Any] | None = None,
+        bg_name: str | None = None,
     ) -> None:
+        _assets.register_installed_packages()
         self._native = _native.NativeEnv(
             env_id,
             obs_mode=obs_mode,
@@ -151,12 +175,17 @@ class Ms2Env(gym.Env):
             max_episode_steps=max_episode_steps,
             camera_cfgs=camera_cfgs,
             mpm_freq=mpm_freq,
+            enable_shadow=enable_shadow,
+            render_camera_cfgs=render_camera_cfgs,
+            bg_name=bg_name,
         )
         adopt_config(self, self._native.config())
+        _assets.warn_if_primitive_panda()
         self.observation_space = to_gym_space(self._native.observation_space())
         self.action_space = to_gym_space(self._native.action_space())
         self.metadata = {**self.metadata, "render_fps": self.control_freq}
         self._seeded = False
+        self._viewer: Any = None
 
     # --- gymnasium API -------------------------------------------------------------------------
 
@@ -193,16 +222,54 @@ class Ms2Env(gym.Env):
         return native_step(action)
 
     def render(self) -> np.ndarray | None:
-        """An RGB image (uint8 [H, W, 3]) of the scene when ``render_mode="rgb_array"``."""
+        """An RGB image (uint8 [H, W, 3]): with ``render_mode="rgb_array"`` the render
+        camera's view (goal markers shown); with ``"cameras"`` that view tiled with every
+        observation camera's RGB, depth and segmentation images (ManiSkill2's layout). With
+        ``"human"`` it shows the scene in the viewer window (opened on the first call) and
+        returns ``None`` (gymnasium's rule; :meth:`render_human` returns the viewer, as
+        ManiSkill2's does, and :attr:`viewer` holds it)."""
         if self.render_mode is None:
             gym.logger.warn(
                 "render() called without render_mode; make the env with render_mode='rgb_array'"
             )
             return None
-        return self._native.render()
+        if self.render_mode == "human":
+            self.render_human()
+            return None
+        view = self._native.render()
+        if self.render_mode == "cameras":
+            return tile_images([view, *camera_images_to_tiles(self._native.camera_images())])
+        return view
+
+    def get_obs(self) -> Any:
+        """The observation of the current state in the env's obs mode, without stepping
+        (ManiSkill2's ``env.get_obs()``)."""
+        return self._native.get_obs()
+
+    def render_human(self) -> Any:
+        """Opens the viewer window on the first call (``RuntimeError`` without a display),
+        handles its mouse and key events and draws the scene as it is now. While the viewer is
+        paused (``space``) the call keeps the window live and returns only when the user
+        resumes, single-steps (``n``) or closes the window, so a loop that calls ``render()``
+        after each ``step()`` pauses with it. Returns the viewer (``ms2._native.NativeViewer``:
+        ``take_keys()``, ``press_key()``, ``paused``, ``closed``, ``close()``, ...)."""
+        if self._viewer is None:
+            self._viewer = _native.NativeViewer(self._native, title=f"ms2 {self.env_id}")
+        if not self._viewer.closed:
+            self._viewer.show(self._native)
+        return self._viewer
+
+    @property
+    def viewer(self) -> Any:
+        """The viewer window of ``render_mode="human"`` (``None`` before the first render)."""
+        return self._viewer
 
     def close(self) -> None:
-        """Releases the native env; any later call raises ``ValueError`` (the env is closed)."""
+        """Closes the viewer window, if any, and releases the native env; any later call
+        raises ``ValueError`` (the env is closed)."""
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None
         self._native = _Closed("Ms2Env")  # type: ignore[assignment]
 
     # --- ManiSkill2-style extras ----------------------------------------------------------------

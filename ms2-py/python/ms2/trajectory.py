@@ -209,13 +209,19 @@ class TrajectoryWriter:
                 self._file = h5py.File(self._tmp, "w")
         return self._file
 
-    def append(self, episode: Mapping[str, Any], obs: Any = None) -> int:
+    def append(
+        self, episode: Mapping[str, Any], obs: Any = None, episode_id: int | None = None
+    ) -> int:
         """Adds one episode (a dict with ``episode_seed``, ``control_mode``, ``actions``,
         ``env_states`` — or ``env_init_state`` for a soft-body episode —, ``success``,
         ``elapsed_steps``, ``info``; optional ``reset_kwargs``) and its observations
-        ``[T+1, ...]`` (optional). Returns its ``episode_id``."""
+        ``[T+1, ...]`` (optional) as group ``traj_<episode_id>`` (``None``: the next number
+        after the episodes written so far; a used id raises ``ValueError``). Returns the id."""
         actions, success, state_key, states = _check_episode_arrays(episode)
-        episode_id = len(self.episodes)
+        if episode_id is None:
+            episode_id = max((e["episode_id"] + 1 for e in self.episodes), default=0)
+        elif any(e["episode_id"] == episode_id for e in self.episodes):
+            raise ValueError(f"episode_id {episode_id} was already written to {self.path}")
         group = self._working_file().create_group(f"traj_{episode_id}")
         group.create_dataset("actions", data=actions)
         group.create_dataset("success", data=success)

@@ -17,6 +17,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _native
+from . import assets as _assets
 from .envs import MAX_SEED, _Closed, _seed_from, adopt_config, check_options, check_seed, real_array
 from .spaces import to_gym_space
 
@@ -39,7 +40,9 @@ class Ms2VectorEnv(VectorEnv):
             raise TypeError(f"num_envs must be an int, got {type(num_envs).__name__} {num_envs!r}")
         if not 1 <= num_envs <= MAX_NUM_ENVS:
             raise ValueError(f"num_envs must be in 1..={MAX_NUM_ENVS}, got {num_envs}")
+        _assets.register_installed_packages()
         self._native = _native.NativeVecEnv(env_id, int(num_envs), **kwargs)
+        _assets.warn_if_primitive_panda()
         adopt_config(self, self._native.config())
         self.num_envs = int(num_envs)
         self.single_observation_space = to_gym_space(self._native.single_observation_space())

@@ -21,8 +21,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use ms2_physics::{ArticulationId, BodyId, BodyKind, Pose3, ShapeDesc};
 use ms2_render::{
-    Instance, InstanceId, Material, MeshData, MeshHandle, ParticleSet, ParticleSetId, Renderer,
-    RendererConfig, Scene, SegmentationIds,
+    DirectionalLight, Instance, InstanceId, Lighting, Material, MeshData, MeshHandle, ParticleSet,
+    ParticleSetId, Renderer, RendererConfig, Scene, SegmentationIds,
 };
 use nalgebra::Vector3;
 
@@ -34,10 +34,36 @@ use crate::rigid_world::RigidWorld;
 const ROUND_SEGMENTS: u32 = 24;
 /// Latitude rings of procedural spheres (capsules use half per cap).
 const SPHERE_RINGS: u32 = 12;
-/// Half side (m) of the drawn ground square (the physics ground is an infinite plane).
-pub const GROUND_HALF_SIZE_M: f32 = 2.0;
-/// Linear RGB colour of the drawn ground.
-pub const GROUND_COLOR: [f32; 3] = [0.45, 0.42, 0.38];
+/// Half side (m) of the drawn ground square (the physics ground is an infinite plane): SAPIEN's
+/// ground of 20 × 20 m, so the ground reaches every camera's 10 m far plane and no camera
+/// looking down sees past its edge.
+pub const GROUND_HALF_SIZE_M: f32 = 10.0;
+/// Linear RGB colour of the drawn ground (ManiSkill2's dark blue-grey ground).
+pub const GROUND_COLOR: [f32; 3] = [0.06, 0.08, 0.12];
+
+/// ManiSkill2's scene lighting (its `_setup_lighting`): ambient 0.3, a white directional
+/// light travelling along (1, 1, −1) (the one that casts shadows when they are on) and one
+/// straight down, no shadows. ms2 shades Lambert (albedo · cos) where SAPIEN's PBR diffuse term
+/// is albedo · cos / π, so the directional colours are 1/π to give ManiSkill2's brightness
+/// (its red cube's top face: sRGB 230 in both).
+pub fn maniskill2_lighting() -> Lighting {
+    let white = [std::f32::consts::FRAC_1_PI; 3];
+    Lighting {
+        ambient: [0.3, 0.3, 0.3],
+        directional: vec![
+            DirectionalLight {
+                direction_world: Vector3::new(1.0, 1.0, -1.0),
+                color: white,
+            },
+            DirectionalLight {
+                direction_world: Vector3::new(0.0, 0.0, -1.0),
+                color: white,
+            },
+        ],
+        background: [0.0, 0.0, 0.0],
+        shadow: None,
+    }
+}
 
 /// Wraps a render error.
 pub(crate) fn render_err(e: ms2_render::RenderError) -> EnvError {
@@ -67,8 +93,17 @@ enum MeshKey {
     UnitBox,
     UnitSphere,
     UnitCylinder,
-    Capsule { radius: u32, half_length: u32 },
+    Capsule {
+        radius: u32,
+        half_length: u32,
+    },
     Plane,
+    /// A triangle mesh, by a hash of its vertex and index data and its sizes.
+    TriMesh {
+        hash: u64,
+        vertices: usize,
+        triangles: usize,
+    },
 }
 
 static SHARED_CONTEXT: OnceLock<Result<Arc<RenderContext>, String>> = OnceLock::new();
@@ -128,14 +163,50 @@ impl RenderContext {
                 SPHERE_RINGS / 2,
             ),
             MeshKey::Plane => MeshData::plane(GROUND_HALF_SIZE_M, GROUND_HALF_SIZE_M),
+            MeshKey::TriMesh { .. } => {
+                return Err(EnvError::Render(
+                    "triangle meshes are uploaded by trimesh_mesh".to_owned(),
+                ))
+            }
         };
         let handle = self.renderer.add_mesh(&data).map_err(render_err)?;
         cache.insert(key, handle);
         Ok(handle)
     }
 
-    /// Meshes drawing `shape`: `(mesh, scale, pose_shape_from_mesh)` per part. Triangle meshes
-    /// and convex hulls are uploaded per call (they are not shared); primitives are cached.
+    /// The uploaded mesh of a triangle mesh: uploaded on first use, then shared by content
+    /// (every env's real-Panda link meshes are one copy on the device).
+    fn trimesh_mesh(
+        &self,
+        vertices: &[nalgebra::Point3<f32>],
+        indices: &[[u32; 3]],
+    ) -> Result<MeshHandle, EnvError> {
+        use std::hash::{Hash, Hasher};
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        for p in vertices {
+            p.coords.iter().for_each(|v| v.to_bits().hash(&mut hasher));
+        }
+        indices.hash(&mut hasher);
+        let key = MeshKey::TriMesh {
+            hash: hasher.finish(),
+            vertices: vertices.len(),
+            triangles: indices.len(),
+        };
+        let mut cache = self
+            .meshes
+            .lock()
+            .map_err(|_| EnvError::Render("mesh cache lock poisoned".to_owned()))?;
+        if let Some(&handle) = cache.get(&key) {
+            return Ok(handle);
+        }
+        let data = flat_shaded_mesh(vertices, indices);
+        let handle = self.renderer.add_mesh(&data).map_err(render_err)?;
+        cache.insert(key, handle);
+        Ok(handle)
+    }
+
+    /// Meshes drawing `shape`: `(mesh, scale, pose_shape_from_mesh)` per part. Primitives and
+    /// triangle meshes are cached (triangle meshes by content).
     fn meshes_for(
         &self,
         shape: &ShapeDesc,
@@ -172,11 +243,11 @@ impl RenderContext {
                 }
                 Ok(out)
             }
-            ShapeDesc::TriMesh { vertices, indices } => {
-                let data = flat_shaded_mesh(vertices, indices);
-                let handle = self.renderer.add_mesh(&data).map_err(render_err)?;
-                Ok(vec![(handle, Vector3::repeat(1.0), Pose3::identity())])
-            }
+            ShapeDesc::TriMesh { vertices, indices } => Ok(vec![(
+                self.trimesh_mesh(vertices, indices)?,
+                Vector3::repeat(1.0),
+                Pose3::identity(),
+            )]),
             ShapeDesc::ConvexHull { points } => Err(EnvError::Render(format!(
                 "convex-hull visual shapes ({} points) cannot be drawn yet; give the actor a \
                  triangle-mesh or primitive visual",
@@ -252,8 +323,10 @@ impl WorldRenderScene {
         ctx: &RenderContext,
         world: &dyn RigidWorld,
     ) -> Result<WorldRenderScene, EnvError> {
+        let mut scene = Scene::new();
+        scene.lighting = maniskill2_lighting();
         let mut out = WorldRenderScene {
-            scene: Scene::new(),
+            scene,
             bindings: Vec::new(),
             objects: Vec::new(),
             visual_count: 0,

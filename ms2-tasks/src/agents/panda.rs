@@ -4,7 +4,9 @@
 use std::sync::OnceLock;
 
 use ms2_control::{CombinedController, ControlMode, ControlTiming, RobotConfig};
-use ms2_physics::{parse_urdf_str, ArticulationId, BodyId, PandaOptions, UrdfLoadOptions};
+use ms2_physics::{
+    parse_urdf_str, ArticulationDesc, ArticulationId, BodyId, PandaOptions, UrdfLoadOptions,
+};
 use nalgebra::Vector3;
 use rand_distr::{Distribution, Normal};
 
@@ -18,10 +20,12 @@ use crate::seeding::EpisodeRng;
 /// The `panda` robot: ManiSkill2's Panda with its two-finger gripper.
 pub const PANDA: RobotSpec = RobotSpec {
     name: "panda",
-    description: "Franka Emika Panda with its two-finger gripper (ms2_assets::PANDA_URDF)",
+    description: "Franka Emika Panda with its two-finger gripper (the real meshes of the asset \
+                  group franka_description when fetched, else ms2_assets::PANDA_URDF)",
     control_modes: panda_control_modes,
     build: |world, mode, timing| {
-        let agent = PandaAgent::build_from_urdf(world, mode, timing, ms2_assets::PANDA_URDF)?;
+        let model = super::panda_model::panda_model()?;
+        let agent = PandaAgent::build_from_desc(world, mode, timing, &model.desc)?;
         Ok(Box::new(agent.named("panda")))
     },
 };
@@ -111,10 +115,27 @@ impl PandaAgent {
         timing: ControlTiming,
         urdf: &str,
     ) -> Result<Self, EnvError> {
+        let desc = parse_urdf_str(
+            urdf,
+            std::path::Path::new("."),
+            "robot URDF of the task",
+            &UrdfLoadOptions::default(),
+        )?;
+        Self::build_from_desc(world, mode, timing, &desc)
+    }
+
+    /// [`PandaAgent::build_from_urdf`] from a parsed description (e.g. the real Panda of
+    /// [`super::panda_model::panda_model`], parsed once per process).
+    pub fn build_from_desc(
+        world: &mut dyn RigidWorld,
+        mode: ControlMode,
+        timing: ControlTiming,
+        desc: &ArticulationDesc,
+    ) -> Result<Self, EnvError> {
         let robot = panda_robot_config()?;
         let options = PandaOptions::default();
         let base_pose = options.base_pose;
-        let art = add_panda(world, &options, urdf)?;
+        let art = add_panda(world, &options, desc)?;
         let controller = {
             let view = PhysicsArticulation::new(world, art);
             robot
@@ -173,20 +194,14 @@ impl PandaAgent {
     }
 }
 
-/// Adds the Panda of `urdf` as [`ms2_physics::add_panda_from_urdf`] does, through the port:
-/// the same articulation options, drives and drive targets, in the same order.
+/// Adds the Panda described by `desc` as [`ms2_physics::add_panda_from_urdf`] does, through
+/// the port: the same articulation options, drives and drive targets, in the same order.
 fn add_panda(
     world: &mut dyn RigidWorld,
     options: &PandaOptions,
-    urdf: &str,
+    desc: &ArticulationDesc,
 ) -> Result<ArticulationId, EnvError> {
-    let desc = parse_urdf_str(
-        urdf,
-        std::path::Path::new("."),
-        "robot URDF of the task",
-        &UrdfLoadOptions::default(),
-    )?;
-    let art = world.add_articulation(&desc, &options.articulation_options())?;
+    let art = world.add_articulation(desc, &options.articulation_options())?;
     for i in 0..ARM_DOF {
         world.set_drive(art, i, options.arm_drive)?;
     }

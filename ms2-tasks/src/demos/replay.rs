@@ -32,6 +32,10 @@ pub struct ReplayOptions {
     /// with [`StateRecording::EveryStep`] only): the output's states are then exactly the
     /// recorded ones.
     pub use_env_states: bool,
+    /// Restore the recorded state after reset (`env_states[0]`) before stepping the actions
+    /// (ManiSkill2's `--use-first-env-state`), also when converting: for episodes whose seed
+    /// does not reproduce their scene in ms2 (files ManiSkill2 wrote, their states mapped).
+    pub use_first_env_state: bool,
     /// Collect the observations (in `cfg.obs_mode`) after reset and after every step.
     pub record_obs: bool,
     /// Further attempts after the conversion of a successful source episode fails. Retry `k`
@@ -128,13 +132,7 @@ pub fn replay_episode(
     let mut attempt = 0;
     loop {
         let trailing_tolerance = (attempt > 0).then(|| TRAILING_TOLERANCE_M / attempt as f32);
-        let (episode, obs) = convert_once(
-            &env_cfg,
-            &mut env,
-            source,
-            opts.record_obs,
-            trailing_tolerance,
-        )?;
+        let (episode, obs) = convert_once(&env_cfg, &mut env, source, opts, trailing_tolerance)?;
         attempt += 1;
         if episode.succeeded() || !source.succeeded() || attempt > opts.max_retry {
             return Ok(ReplayedEpisode {
@@ -172,7 +170,10 @@ fn replay_same_mode(
     opts: &ReplayOptions,
 ) -> Result<(DemoEpisode, Option<Vec<ObsValue>>), DemoError> {
     let (mut recorder, mut first_obs) = EpisodeRecorder::reset(env, source.episode_seed)?;
-    if opts.use_env_states || source.state_recording == StateRecording::InitialOnly {
+    if opts.use_env_states
+        || opts.use_first_env_state
+        || source.state_recording == StateRecording::InitialOnly
+    {
         restore_init_state(env, source)?;
         recorder.restart_from_state(env.get_state());
         if opts.record_obs {
@@ -203,9 +204,9 @@ pub(crate) fn restore_init_state(env: &mut Env, source: &DemoEpisode) -> Result<
         return Err(DemoError::InvalidEpisode {
             seed: source.episode_seed,
             reason: format!(
-                "env_init_state has {} values but a {} state in ms2 has {expected}; ms2's state \
-                 layout differs from ManiSkill2's, so trajectories recorded by ManiSkill2 (or by \
-                 another ms2 version) open but cannot be replayed in ms2 envs",
+                "env_init_state has {} values but a {} state in ms2 has {expected}; the episode \
+                 was recorded in another state layout (ManiSkill2's rigid-body layout is mapped \
+                 by the Python replay, ms2.maniskill2_states; other layouts cannot be replayed)",
                 init.len(),
                 source.env_id
             ),
@@ -222,11 +223,12 @@ fn convert_once(
     cfg: &EnvConfig,
     env: &mut Env,
     source: &DemoEpisode,
-    record_obs: bool,
+    opts: &ReplayOptions,
     trailing_tolerance: Option<f32>,
 ) -> Result<(DemoEpisode, Option<Vec<ObsValue>>), DemoError> {
+    let record_obs = opts.record_obs;
     let (mut recorder, mut first_obs) = EpisodeRecorder::reset(env, source.episode_seed)?;
-    if source.state_recording == StateRecording::InitialOnly {
+    if opts.use_first_env_state || source.state_recording == StateRecording::InitialOnly {
         restore_init_state(env, source)?;
         recorder.restart_from_state(env.get_state());
         if record_obs {

@@ -52,7 +52,7 @@ pub fn submit_batch(items: &[BatchItem<'_>]) -> Result<PendingBatch, EnvError> {
             .iter()
             .map(|&k| (items[k].0.scene(), items[k].1))
             .collect();
-        let pending = ctx.renderer().submit(&views).map_err(render_err)?;
+        let pending = ctx.renderer().submit_sensors(&views).map_err(render_err)?;
         let frames = group
             .iter()
             .map(|&k| {

@@ -50,6 +50,10 @@ pub struct CameraConfig {
     pub far: f32,
     /// Where the camera is.
     pub mount: CameraMount,
+    /// Whether the `image` / `rgbd` observations of this camera include its `Segmentation`
+    /// image (u32 [H, W, 4]; ManiSkill2's `camera_cfgs={"add_segmentation": True}`). Off by
+    /// default, as in ManiSkill2.
+    pub segmentation: bool,
 }
 
 /// Pose (robotics convention: x forward, z up) of a camera at `eye` looking at `target`.
@@ -86,6 +90,7 @@ impl CameraConfig {
             mount: CameraMount::World {
                 pose_world_from_camera: look_at_robotics([0.3, 0.0, 0.6], [-0.1, 0.0, 0.1]),
             },
+            segmentation: false,
         }
     }
 
@@ -111,11 +116,13 @@ impl CameraConfig {
                     )),
                 ),
             },
+            segmentation: false,
         }
     }
 
-    /// The camera of `render_mode = "rgb_array"` (ManiSkill2's `render_camera`): 512×512,
-    /// fov 1 rad, at (1, 1, 0.8) looking at (0, 0, 0.35).
+    /// The camera of `render_mode = "rgb_array"` (ManiSkill2 0.5.3's `render_camera` of its
+    /// Panda pick-and-place tasks): 512×512, fov 1 rad, near 0.01 m, far 10 m, at
+    /// (0.4, 0.4, 0.8) looking at (0, 0, 0.4).
     pub fn render_camera() -> CameraConfig {
         CameraConfig {
             uid: "render_camera".to_owned(),
@@ -125,8 +132,9 @@ impl CameraConfig {
             near: 0.01,
             far: 10.0,
             mount: CameraMount::World {
-                pose_world_from_camera: look_at_robotics([1.0, 1.0, 0.8], [0.0, 0.0, 0.35]),
+                pose_world_from_camera: look_at_robotics([0.4, 0.4, 0.8], [0.0, 0.0, 0.4]),
             },
+            segmentation: false,
         }
     }
 

@@ -7,7 +7,16 @@ use super::camera::{CameraConfig, CameraMount};
 use crate::error::EnvError;
 
 /// The camera fields a `camera_cfgs` entry may set (ManiSkill2's `CameraConfig` names).
-pub const CAMERA_UPDATE_KEYS: [&str; 7] = ["width", "height", "fov", "near", "far", "p", "q"];
+pub const CAMERA_UPDATE_KEYS: [&str; 8] = [
+    "width",
+    "height",
+    "fov",
+    "near",
+    "far",
+    "p",
+    "q",
+    "add_segmentation",
+];
 
 /// New values for some fields of a camera; `None` keeps the current value.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -27,6 +36,9 @@ pub struct CameraUpdate {
     /// Orientation (quaternion w, x, y, z; normalised here) in its mount's frame, robotics
     /// convention (x forward, z up).
     pub q: Option<[f32; 4]>,
+    /// Adds (`true`) or removes the camera's `Segmentation` image in the `image` / `rgbd`
+    /// observations (ManiSkill2's `add_segmentation`).
+    pub add_segmentation: Option<bool>,
 }
 
 impl CameraUpdate {
@@ -46,6 +58,9 @@ impl CameraUpdate {
         }
         if let Some(far) = self.far {
             camera.far = far;
+        }
+        if let Some(seg) = self.add_segmentation {
+            camera.segmentation = seg;
         }
         if self.p.is_none() && self.q.is_none() {
             return Ok(());

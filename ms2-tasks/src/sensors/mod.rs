@@ -28,7 +28,7 @@ pub use batch::capture_batch;
 pub use camera::{look_at_robotics, CameraConfig, CameraMount};
 pub use camera_update::{CameraCfgUpdates, CameraUpdate, CAMERA_UPDATE_KEYS};
 #[cfg(feature = "render")]
-pub use sensor_scene::Sensors;
+pub use sensor_scene::{SceneView, Sensors};
 #[cfg(feature = "render")]
 pub use visual_obs::CameraFrame;
 pub use visual_obs::VisualLayout;

@@ -4,7 +4,8 @@ use std::sync::Arc;
 
 use ms2_physics::ArticulationId;
 use ms2_render::{
-    Camera, CameraOutput, Instance, InstanceId, Material, ParticleSetId, Scene, SegmentationIds,
+    Camera, CameraOutput, Instance, InstanceId, Material, ParticleSetId, Renderer, Scene,
+    SegmentationIds,
 };
 use nalgebra::{Isometry3, Vector3};
 
@@ -25,6 +26,28 @@ pub struct Sensors {
     robot_ids: Vec<u32>,
     goal_marker: InstanceId,
     particle_sets: Vec<SensorParticleSet>,
+}
+
+/// An env's scene as of now, for drawing it through cameras of one's own (a viewer window):
+/// poses synchronised with the world, the goal marker shown as in human renders.
+pub struct SceneView<'a> {
+    /// The renderer the scene's meshes live in.
+    pub renderer: &'a Renderer,
+    /// The render scene.
+    pub scene: &'a Scene,
+    /// The observation cameras at their current poses, with their uids, in config order.
+    pub cameras: Vec<(String, Camera)>,
+    /// The camera of `render_mode = "rgb_array"` (a good initial view).
+    pub render_camera: Camera,
+}
+
+impl std::fmt::Debug for SceneView<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneView")
+            .field("cameras", &self.cameras)
+            .field("render_camera", &self.render_camera)
+            .finish_non_exhaustive()
+    }
 }
 
 /// A particle set of the render scene and how its positions are filtered.
@@ -97,6 +120,16 @@ impl Sensors {
         Ok(self.particle_sets.len() - 1)
     }
 
+    /// Turns the shadows of the scene's first directional light on (a 1.5 m sphere around the
+    /// table, 2048² texels, as ManiSkill2's `enable_shadow`) or off.
+    pub fn set_shadows(&mut self, on: bool) {
+        self.scene.scene_mut().lighting.shadow = on.then_some(ms2_render::Shadow {
+            center_world: Vector3::new(0.0, 0.0, 0.3),
+            radius_m: 1.5,
+            resolution: 2048,
+        });
+    }
+
     /// Number of particle sets.
     pub fn particle_set_count(&self) -> usize {
         self.particle_sets.len()
@@ -144,7 +177,7 @@ impl Sensors {
         let outputs = self
             .ctx
             .renderer()
-            .render(&[(self.scene.scene(), &cams[..])])
+            .render_sensors(&[(self.scene.scene(), &cams[..])])
             .map_err(render_err)?;
         Ok(self.frame(outputs))
     }
@@ -176,6 +209,7 @@ impl Sensors {
             uids: self.cameras.iter().map(|c| c.uid.clone()).collect(),
             outputs,
             robot_ids: self.robot_ids.clone(),
+            segmentation: self.cameras.iter().map(|c| c.segmentation).collect(),
         }
     }
 
@@ -212,6 +246,47 @@ impl Sensors {
         outputs
             .pop()
             .ok_or_else(|| EnvError::Render("the renderer returned no image".to_owned()))
+    }
+
+    /// Calls `f` with the scene synchronised with `world`, the goal marker shown at
+    /// `goal_world` (m) when given (hidden again afterwards), and the cameras at their poses.
+    pub fn with_view<R>(
+        &mut self,
+        world: &dyn RigidWorld,
+        goal_world: Option<Vector3<f32>>,
+        f: impl FnOnce(&SceneView<'_>) -> R,
+    ) -> Result<R, EnvError> {
+        let cams = self.prepare(world)?;
+        let render_camera = self.render_camera.camera_at(world, self.robot)?;
+        if let Some(goal) = goal_world {
+            let scene = self.scene.scene_mut();
+            scene
+                .set_pose(
+                    self.goal_marker,
+                    Isometry3::translation(goal.x, goal.y, goal.z),
+                )
+                .map_err(render_err)?;
+            scene
+                .set_visible(self.goal_marker, true)
+                .map_err(render_err)?;
+        }
+        let view = SceneView {
+            renderer: self.ctx.renderer(),
+            scene: self.scene.scene(),
+            cameras: self
+                .cameras
+                .iter()
+                .map(|c| c.uid.clone())
+                .zip(cams)
+                .collect(),
+            render_camera,
+        };
+        let out = f(&view);
+        self.scene
+            .scene_mut()
+            .set_visible(self.goal_marker, false)
+            .map_err(render_err)?;
+        Ok(out)
     }
 
     /// Triangles drawn per observation camera (the scene's visible triangles).

@@ -4,7 +4,14 @@
 //! - `rgbd`: `{"agent", "extra", "camera_param": {cam: {"extrinsic_cv" [3,4],
 //!   "cam2world_gl" [4,4], "intrinsic_cv" [3,3]}}, "image": {cam: {"rgb" u8 [H,W,3],
 //!   "depth" f32 [H,W,1] (metres, 0 = nothing seen)}}}`; `rgbd_robot_seg` adds
-//!   `image[cam]["robot_seg"]` bool [H,W,1].
+//!   `image[cam]["robot_seg"]` bool [H,W,1]; a camera with `add_segmentation` adds
+//!   `image[cam]["Segmentation"]` u32 [H,W,4].
+//! - `image` (ManiSkill2's raw textures, from which its `rgbd` and `pointcloud` are derived):
+//!   as `rgbd` but `image[cam]` = `{"Color" f32 [H,W,4] (RGBA in [0, 1], alpha 1),
+//!   "Position" f32 [H,W,4] (x, y, z in the camera's OpenGL frame: x right, y up, looking
+//!   down -z, metres; w = depth / far in [0, 1) on surfaces, all (0, 0, 0, 1) where nothing is
+//!   seen, so `-Position[..., 2]` is the depth and `Position[..., 3] < 1` the valid mask)}`,
+//!   plus `"Segmentation"` with `add_segmentation`.
 //! - `pointcloud`: `{"agent", "extra", "pointcloud": {"xyzw" f32 [N,4] (world frame; w = 1 for
 //!   points on a surface, all zeros for background), "rgb" u8 [N,3], "Segmentation" u32 [N,4]}}`,
 //!   N = the sum of H·W over cameras (camera order, then row-major); `pointcloud_robot_seg`
@@ -29,6 +36,8 @@ pub enum VisualLayout {
     Rgbd,
     /// One world-frame point cloud fused over the cameras.
     PointCloud,
+    /// Raw per-camera textures (`Color`, `Position`) plus camera parameters.
+    Image,
 }
 
 /// One frame of an env's observation cameras (feature `render`).
@@ -41,6 +50,8 @@ pub struct CameraFrame {
     pub outputs: Vec<CameraOutput>,
     /// Channel-1 (actor/link) ids of the robot's links.
     pub robot_ids: Vec<u32>,
+    /// Per camera (same order): whether its `Segmentation` image is observed.
+    pub segmentation: Vec<bool>,
 }
 
 #[cfg(feature = "render")]
@@ -54,6 +65,55 @@ fn matrix_rows<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f32, R, C>)
         .flat_map(|r| (0..C).map(move |c| m[(r, c)]))
         .collect();
     array(vec![R, C], ArrayData::F32(data))
+}
+
+/// ManiSkill2's `Segmentation` texture of one camera: per pixel (visual-shape id, actor/link
+/// id, 0, 0).
+#[cfg(feature = "render")]
+fn segmentation_image(out: &CameraOutput) -> Vec<u32> {
+    out.segmentation_actor
+        .iter()
+        .zip(&out.segmentation_link)
+        .flat_map(|(&visual, &link)| [visual, link, 0, 0])
+        .collect()
+}
+
+/// ManiSkill2's raw `Color` and `Position` textures of one camera (see the module docs).
+#[cfg(feature = "render")]
+fn raw_textures(out: CameraOutput) -> Vec<(String, ObsValue)> {
+    let (h, w) = (out.height() as usize, out.width() as usize);
+    let color = out
+        .rgb
+        .chunks_exact(3)
+        .flat_map(|p| {
+            [p[0], p[1], p[2]]
+                .map(|c| f32::from(c) / 255.0)
+                .into_iter()
+                .chain([1.0])
+        })
+        .collect();
+    let far = out.camera.far.max(f32::MIN_POSITIVE);
+    let position = out
+        .point_cloud_camera_cv()
+        .into_iter()
+        .flat_map(|p| {
+            if p[3] > 0.0 {
+                [p[0], -p[1], -p[2], (p[2] / far).min(1.0 - f32::EPSILON)]
+            } else {
+                [0.0, 0.0, 0.0, 1.0]
+            }
+        })
+        .collect();
+    vec![
+        (
+            "Color".to_owned(),
+            array(vec![h, w, 4], ArrayData::F32(color)),
+        ),
+        (
+            "Position".to_owned(),
+            array(vec![h, w, 4], ArrayData::F32(position)),
+        ),
+    ]
 }
 
 /// The full visual observation: `state_dict`'s non-privileged part (`extra` filtered to
@@ -71,10 +131,15 @@ pub fn assemble(
     let mut root = non_privileged_state(state_dict, non_privileged_extra_keys);
     let is_robot = |link_id: &u32| frame.robot_ids.contains(link_id);
     match layout {
-        VisualLayout::Rgbd => {
+        VisualLayout::Rgbd | VisualLayout::Image => {
             let mut params = Vec::with_capacity(frame.outputs.len());
             let mut images = Vec::with_capacity(frame.outputs.len());
-            for (uid, out) in frame.uids.iter().zip(frame.outputs) {
+            let seg_flags = frame
+                .segmentation
+                .iter()
+                .copied()
+                .chain(std::iter::repeat(false));
+            for ((uid, out), with_seg) in frame.uids.iter().zip(frame.outputs).zip(seg_flags) {
                 let (h, w) = (out.height() as usize, out.width() as usize);
                 params.push((
                     uid.clone(),
@@ -85,16 +150,26 @@ pub fn assemble(
                     ]),
                 ));
                 let mask = robot_seg.then(|| out.segmentation_link.iter().map(is_robot).collect());
-                let mut image = vec![
-                    (
-                        "rgb".to_owned(),
-                        array(vec![h, w, 3], ArrayData::U8(out.rgb)),
-                    ),
-                    (
-                        "depth".to_owned(),
-                        array(vec![h, w, 1], ArrayData::F32(out.depth_m)),
-                    ),
-                ];
+                let segmentation = with_seg.then(|| segmentation_image(&out));
+                let mut image = match layout {
+                    VisualLayout::Image => raw_textures(out),
+                    _ => vec![
+                        (
+                            "rgb".to_owned(),
+                            array(vec![h, w, 3], ArrayData::U8(out.rgb)),
+                        ),
+                        (
+                            "depth".to_owned(),
+                            array(vec![h, w, 1], ArrayData::F32(out.depth_m)),
+                        ),
+                    ],
+                };
+                if let Some(seg) = segmentation {
+                    image.push((
+                        "Segmentation".to_owned(),
+                        array(vec![h, w, 4], ArrayData::U32(seg)),
+                    ));
+                }
                 if let Some(mask) = mask {
                     image.push((
                         "robot_seg".to_owned(),

@@ -38,6 +38,7 @@ pub const DUMMY: TaskSpec = TaskSpec {
     obs_modes: &[
         crate::config::ObsMode::State,
         crate::config::ObsMode::StateDict,
+        crate::config::ObsMode::None,
     ],
     non_privileged_extra_keys: &["tcp_pose", "goal_pos"],
     goal_marker: None,
