@@ -562,11 +562,12 @@ impl Env {
     ) -> Result<R, EnvError> {
         let mut f = Some(f);
         let mut out = None;
-        self.backend.view_scene(self.spec.goal_marker, &mut |view| {
-            if let Some(f) = f.take() {
-                out = Some(f(view));
-            }
-        })?;
+        self.backend
+            .view_scene(self.spec.goal_marker, &mut |view| {
+                if let Some(f) = f.take() {
+                    out = Some(f(view));
+                }
+            })?;
         out.ok_or_else(|| EnvError::Render("the scene view was not drawn".to_owned()))
     }
 
