@@ -149,9 +149,7 @@ mod tests {
         let layout = world.state_layout();
         assert_eq!(layout.len(), world.state_len());
         assert_eq!(layout[0].name, "position x of actor cube");
-        assert!(layout
-            .iter()
-            .any(|f| f.name == "qpos of panda_joint1"
-                && matches!(f.quantity, super::StateQuantity::JointPosition { .. })));
+        assert!(layout.iter().any(|f| f.name == "qpos of panda_joint1"
+            && matches!(f.quantity, super::StateQuantity::JointPosition { .. })));
     }
 }

@@ -3,9 +3,7 @@
 
 use std::sync::atomic::Ordering;
 
-use ms2_tasks::demos::{
-    replay_episode, DemoEpisode, DemoError, ReplayOptions, ReplayedEpisode,
-};
+use ms2_tasks::demos::{replay_episode, DemoEpisode, DemoError, ReplayOptions, ReplayedEpisode};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;

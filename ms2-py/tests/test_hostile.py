@@ -381,3 +381,53 @@ def test_inputs_that_used_to_abort_or_hang_are_refused_in_a_child_process():
     assert "sim_freq must be in [10, 10000] Hz, got 1000000000" in out
     assert "state[20] = 10 (qpos of panda_joint1)" in out
     assert out.strip().endswith("ok")
+
+
+# ---- restoring states ----
+
+#: Largest difference (any state element) between an original run and its continuation from a
+#: state restored into a fresh env, over 20 steps (docs/tasks.md, "State vector layout").
+FRESH_ENV_BOUND = 1e-4
+
+
+def test_recorded_fixture_states_are_accepted():
+    """Every state recorded by real episodes (the prev_main fixtures) passes the bounds."""
+    from ms2.trajectory import open_trajectory
+
+    fixtures = Path(__file__).parent / "fixtures" / "prev_main"
+    for h5 in sorted(fixtures.glob("*Cube-v0.h5")):
+        with open_trajectory(h5) as traj:
+            env = ms2.Ms2Env(traj.env_id, obs_mode="state")
+            env.reset(seed=0)
+            for i in range(len(traj)):
+                for state in traj.read_episode(i)["env_states"]:
+                    env.set_state(state)
+
+
+def test_fresh_env_divergence_is_bounded():
+    env_id, mode = "StackCube-v0", "pd_ee_delta_pose"
+    original = ms2.Ms2Env(env_id, obs_mode="state", control_mode=mode)
+    original.reset(seed=5)
+    policy = ms2.ScriptedPolicy(original)
+    policy.reset()
+    actions, states = [], [original.get_state()]
+    for _ in range(50):
+        actions.append(policy.act())
+        original.step(actions[-1])
+        states.append(original.get_state())
+    worst = 0.0
+    for start in (10, 30):
+        runs = []
+        for _ in range(2):
+            fresh = ms2.Ms2Env(env_id, obs_mode="state", control_mode=mode)
+            fresh.reset(seed=5)
+            fresh.set_state(states[start])
+            run = []
+            for t in range(start, start + 20):
+                fresh.step(actions[t])
+                run.append(fresh.get_state())
+            runs.append(np.stack(run))
+        np.testing.assert_array_equal(runs[0], runs[1])  # a fresh env reproduces itself
+        worst = max(worst, float(np.abs(runs[0] - np.stack(states[start + 1 : start + 21])).max()))
+    assert worst <= FRESH_ENV_BOUND, worst
+    print(f"fresh-env divergence over 20 steps: {worst:.3g}")

@@ -168,7 +168,12 @@ pub const MAX_MPM_SUBSTEPS: u32 = 2000;
 pub const MAX_EPISODE_STEPS: u32 = i32::MAX as u32;
 
 /// Refuses `value` (named `name`, in `unit`) outside the inclusive `(low, high)`, or NaN.
-fn check_range(name: &str, value: f64, (low, high): (f64, f64), unit: &str) -> Result<(), EnvError> {
+fn check_range(
+    name: &str,
+    value: f64,
+    (low, high): (f64, f64),
+    unit: &str,
+) -> Result<(), EnvError> {
     if !(value >= low && value <= high) {
         return Err(EnvError::InvalidConfig(format!(
             "{name} must be in [{low}, {high}] {unit}, got {value}"
@@ -371,12 +376,20 @@ mod tests {
             max_episode_steps: Some(0),
             ..EnvConfig::default()
         };
-        assert!(cfg.check_bounds().unwrap_err().to_string().contains("max_episode_steps"));
+        assert!(cfg
+            .check_bounds()
+            .unwrap_err()
+            .to_string()
+            .contains("max_episode_steps"));
         let cfg = EnvConfig {
             mpm_freq: Some(1e7),
             ..EnvConfig::new("Excavate-v0")
         };
-        assert!(cfg.check_bounds().unwrap_err().to_string().contains("mpm_freq"));
+        assert!(cfg
+            .check_bounds()
+            .unwrap_err()
+            .to_string()
+            .contains("mpm_freq"));
         assert!(EnvConfig::default().check_bounds().is_ok());
     }
 

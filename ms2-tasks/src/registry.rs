@@ -179,7 +179,12 @@ pub fn register_family(register: fn(&mut Registrar)) -> Result<(), EnvError> {
 /// assert!(ms2_tasks::task_spec("Dummy-v0").is_ok());
 /// ```
 pub fn env_ids() -> Vec<&'static str> {
-    read(|r| r.iter().filter(|t| t.public).map(|t| t.spec.env_id).collect())
+    read(|r| {
+        r.iter()
+            .filter(|t| t.public)
+            .map(|t| t.spec.env_id)
+            .collect()
+    })
 }
 
 /// Every public task's spec, in registration order.

@@ -152,8 +152,7 @@ impl StateLayout {
                         limits[0], limits[1]
                     ),
                 )?,
-                StateQuantity::JointVelocity { .. }
-                | StateQuantity::DriveVelocityTarget { .. } => {
+                StateQuantity::JointVelocity { .. } | StateQuantity::DriveVelocityTarget { .. } => {
                     out(-max_speed, max_speed, speed_unit, "")?
                 }
             }

@@ -73,11 +73,11 @@ def check_options(options: Any, valid: tuple[str, ...]) -> dict[str, Any]:
 
 
 def real_array(value: Any, what: str) -> np.ndarray:
-    """``value`` as a contiguous float32 array; ``TypeError`` for complex, string, bytes or
-    object data (which a float32 cast would silently mangle)."""
+    """``value`` as a contiguous float32 array; ``ValueError`` for complex, string, bytes or
+    object data (which a float32 cast would silently mangle or fail on obscurely)."""
     array = np.asarray(value)
     if array.dtype.kind not in "biuf":
-        raise TypeError(f"{what} must hold real numbers, got dtype {array.dtype}")
+        raise ValueError(f"{what} must hold real numbers, got dtype {array.dtype}")
     with np.errstate(over="ignore"):  # values beyond float32 become inf, refused natively
         return np.ascontiguousarray(array, dtype=np.float32)
 
