@@ -98,7 +98,8 @@ impl NativeViewer {
                 return Ok(true);
             }
             py.check_signals()?;
-            std::thread::sleep(std::time::Duration::from_secs_f64(PAUSED_REDRAW_S));
+            // Other Python threads (and signal handlers) run while we wait.
+            py.detach(|| std::thread::sleep(std::time::Duration::from_secs_f64(PAUSED_REDRAW_S)));
         }
     }
 

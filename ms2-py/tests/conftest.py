@@ -6,6 +6,14 @@ import gymnasium as gym
 import ms2
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
+
+# Property-based tests (test_hostile.py): few examples in CI (the default profile "ci");
+# `pytest --hypothesis-profile heavy` for a long local run.
+_SLOW_OK = [HealthCheck.too_slow, HealthCheck.function_scoped_fixture]
+settings.register_profile("ci", max_examples=25, deadline=None, suppress_health_check=_SLOW_OK)
+settings.register_profile("heavy", max_examples=500, deadline=None, suppress_health_check=_SLOW_OK)
+settings.load_profile("ci")
 
 ENV_IDS = ms2.env_ids()
 #: The task single-env tests use.

@@ -185,3 +185,54 @@ def test_gymnasium_env_checker_is_clean(env_id, obs_mode):
     messages = [str(w.message) for w in caught]
     assert [m for m in messages if not any(u in m for u in unbounded)] == [], messages
     env.close()
+
+
+@pytest.mark.parametrize("env_id", [RIGID, SOFT])
+@pytest.mark.parametrize("obs_mode", ["state_dict", "rgbd", "pointcloud"])
+def test_record_episode_with_cameras_across_obs_modes(tmp_path, env_id, obs_mode):
+    from ms2.wrappers import RecordEpisode
+
+    env = gym.make(env_id, obs_mode=obs_mode, render_mode="cameras", max_episode_steps=4)
+    env = RecordEpisode(env, tmp_path, info_on_video=True)
+    env.reset(seed=0)
+    for _ in range(9):
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()
+    env.close()
+    assert len(list(tmp_path.glob("*.mp4"))) == 3  # two full episodes and the last one
+    from ms2.trajectory import open_trajectory
+
+    with open_trajectory(tmp_path / "trajectory.h5") as traj:
+        assert len(traj) == 3
+        assert traj.read_episode(0, with_obs=True)["obs"] is not None
+
+
+@pytest.mark.parametrize("env_id", [RIGID, SOFT])
+@pytest.mark.parametrize("obs_mode", ["image", "rgbd", "pointcloud_robot_seg"])
+def test_native_vector_env_matches_gymnasium_vector_env(env_id, obs_mode):
+    from ms2.wrappers import FlattenObservationWrapper, flatten_dict_keys
+
+    kwargs = {"obs_mode": obs_mode, "camera_cfgs": {"width": 32, "height": 32}}
+    reference = gym.make_vec(
+        env_id, 2, vectorization_mode="sync", wrappers=[FlattenObservationWrapper], **kwargs
+    )
+    native = ms2.make_vec(env_id, 2, **kwargs)
+    ref_obs, _ = reference.reset(seed=2022)
+    obs, _ = native.reset(seed=2022)
+    for step in range(4):
+        flat = flatten_dict_keys(obs)
+        assert sorted(flat) == sorted(ref_obs), step
+        for key, value in ref_obs.items():
+            if value.dtype == np.uint8:
+                np.testing.assert_allclose(flat[key], value, atol=1, err_msg=key)
+            else:
+                np.testing.assert_allclose(flat[key], value, atol=1e-4, err_msg=key)
+        actions = reference.action_space.sample()
+        ref_obs, ref_rew, ref_term, ref_trunc, _ = reference.step(actions)
+        obs, rew, term, trunc, _ = native.step(actions)
+        np.testing.assert_allclose(rew, ref_rew, rtol=1e-5)
+        np.testing.assert_array_equal(term, ref_term)
+        np.testing.assert_array_equal(trunc, ref_trunc)
+    reference.close()
+    native.close()

@@ -226,3 +226,15 @@ def test_maniskill2_state_mapping_and_unmappable_layouts():
         map_states(np.zeros((2, 70), np.float32), RIGID, template, source="x.h5")
     with pytest.raises(UnmappableStateError, match="Dummy-v0"):
         map_states(np.zeros(5, np.float32), "Dummy-v0", np.zeros(3, np.float32))
+
+
+def test_flushing_by_hand_then_resetting_writes_the_episode_once(tmp_path):
+    env = RecordEpisode(gym.make(RIGID, render_mode="rgb_array"), tmp_path)
+    _run(env, 3)
+    env.flush_trajectory()
+    env.flush_video()
+    _run(env, 2, seed=1)  # save_on_reset: episode 0 is already written as it is
+    env.close()
+    with open_trajectory(tmp_path / "trajectory.h5") as traj:
+        assert [e["episode_seed"] for e in traj.episodes] == [0, 1]
+    assert env.video_paths == [tmp_path / "episode_0.mp4", tmp_path / "episode_1.mp4"]

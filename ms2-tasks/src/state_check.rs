@@ -15,15 +15,17 @@
 //! | joint position | joint limits widened by [`JOINT_LIMIT_TOLERANCE_RAD`] rad / [`JOINT_LIMIT_TOLERANCE_M`] m |
 //! | joint velocity, drive velocity target | within ±[`MAX_JOINT_SPEED_RAD`] rad/s / ±[`MAX_JOINT_SPEED_M`] m/s |
 //! | drive position target | joint limits widened by [`DRIVE_TARGET_TOLERANCE_RAD`] rad / [`DRIVE_TARGET_TOLERANCE_M`] m (accumulating controllers may aim past a limit) |
-//! | controller state (accumulated targets), task state (goals) | within ±[`MAX_POSITION_M`] |
+//! | controller state (accumulated targets), task state (goals, soft-body state) | within ±[`MAX_EXTRA_STATE`] |
 
 use ms2_physics::{StateField, StateQuantity};
 
 use crate::error::EnvError;
 
-/// Largest accepted position coordinate (m) of a body, and magnitude of any controller or task
-/// state value.
+/// Largest accepted position coordinate (m) of a body.
 pub const MAX_POSITION_M: f32 = 100.0;
+/// Largest accepted magnitude of a controller or task state value (their meanings vary by task:
+/// targets, goals, particle counts).
+pub const MAX_EXTRA_STATE: f32 = 1e6;
 /// Accepted deviation of a pose quaternion's norm from 1.
 pub const QUATERNION_NORM_TOLERANCE: f32 = 1e-3;
 /// Largest accepted linear velocity component (m/s).
@@ -118,10 +120,10 @@ impl StateLayout {
                 )
             };
             match field.quantity {
-                StateQuantity::Position => {
-                    let unit = if index < self.world_len { "m" } else { "" };
-                    out(-MAX_POSITION_M, MAX_POSITION_M, unit, "")?
+                StateQuantity::Position if index < self.world_len => {
+                    out(-MAX_POSITION_M, MAX_POSITION_M, "m", "")?
                 }
+                StateQuantity::Position => out(-MAX_EXTRA_STATE, MAX_EXTRA_STATE, "", "")?,
                 StateQuantity::Quaternion { index: 0 } => {
                     check_quaternion(state, index, &field.name)?
                 }
@@ -234,7 +236,7 @@ mod tests {
             (8, 1e4, "qvel of panda_joint1"),
             (0, 1e10, "position x of actor cube"),
             (3, 2.0, "quaternion"),
-            (9, -500.0, "goal x"),
+            (9, -5e6, "goal x"),
         ];
         for (index, value, meaning) in cases {
             let mut bad = good;

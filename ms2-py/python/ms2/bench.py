@@ -209,9 +209,30 @@ def _runner_name(kind: str, n: int) -> str:
     return "gym.make (1 env)" if kind == "single" else f"make_vec({n})"
 
 
+def _soak(args: argparse.Namespace) -> int:
+    """``ms2 bench --soak``: see :mod:`ms2.soak`."""
+    from .soak import run_soak
+
+    steps = 1_000_000 if args.steps is None else args.steps
+    if steps < 1:
+        raise ValueError(f"--steps must be at least 1, got {steps}")
+    print(
+        f"ms2 bench --soak: {steps} env steps over every task and obs mode, load average "
+        f"{os.getloadavg()[0]:.1f}",
+        flush=True,
+    )
+    total = run_soak(steps)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(total, f, indent=2)
+    return 0 if total["non_finite"] == 0 and total["errors"] == 0 else 1
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     if args.worker:
         return _worker(args)
+    if args.soak:
+        return _soak(args)
     num_envs_list = [int(n) for n in args.num_envs.split(",") if n]
     if args.visual:
         return _bench_visual(args, num_envs_list)
@@ -385,6 +406,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="--visual: a Python with mani-skill2==0.5.3 installed; its single env is measured "
         "after each of ms2's, interleaved (also MS2_PEER_PYTHON)",
+    )
+    p.add_argument(
+        "--soak",
+        action="store_true",
+        help="robustness soak instead: --steps (default 1,000,000) env steps over every task and "
+        "obs mode with resets and set_state of recorded states; reports RSS, NaN and errors",
     )
     p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     p.add_argument("--worker", default=None, help=argparse.SUPPRESS)

@@ -409,7 +409,7 @@ def _add_gallery_parser(sub: argparse._SubParsersAction) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``ms2`` argument parser with every subcommand."""
-    from . import __version__, assets, bench
+    from . import __version__, assets, bench, teleop
 
     parser = argparse.ArgumentParser(prog="ms2", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"ms2 {__version__}")
@@ -422,6 +422,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_demos_parser(sub)
     _add_replay_parser(sub)
     _add_gallery_parser(sub)
+    teleop.add_parser(sub)
     return parser
 
 

@@ -65,9 +65,7 @@ def check_options(options: Any, valid: tuple[str, ...]) -> dict[str, Any]:
     if options is None:
         return {}
     if not isinstance(options, Mapping):
-        raise TypeError(
-            f"options must be a dict or None, got {type(options).__name__} {options!r}"
-        )
+        raise TypeError(f"options must be a dict or None, got {type(options).__name__} {options!r}")
     unknown = [k for k in options if k not in valid]
     if unknown:
         raise ValueError(f"unknown reset option(s) {unknown}; valid options: {list(valid)}")
@@ -80,7 +78,8 @@ def real_array(value: Any, what: str) -> np.ndarray:
     array = np.asarray(value)
     if array.dtype.kind not in "biuf":
         raise TypeError(f"{what} must hold real numbers, got dtype {array.dtype}")
-    return np.ascontiguousarray(array, dtype=np.float32)
+    with np.errstate(over="ignore"):  # values beyond float32 become inf, refused natively
+        return np.ascontiguousarray(array, dtype=np.float32)
 
 
 class _Closed:
@@ -112,9 +111,13 @@ class Ms2Env(gym.Env):
             A robot the task does not support raises ``ValueError`` listing the valid ones.
         control_mode: e.g. ``"pd_ee_delta_pose"``; ``None`` = ``"pd_joint_delta_pos"``.
         reward_mode: ``"sparse"``, ``"dense"`` or ``"normalized_dense"`` (``None``).
-        render_mode: ``None``, ``"rgb_array"`` (the render camera's 512×512 view) or
+        render_mode: ``None``, ``"rgb_array"`` (the render camera's 512×512 view),
             ``"cameras"`` (that view tiled with every observation camera's images: RGB, depth
-            and, with ``add_segmentation``, the two segmentation channels, as ManiSkill2).
+            and, with ``add_segmentation``, the two segmentation channels, as ManiSkill2) or
+            ``"human"`` (``render()`` opens and updates a viewer window: mouse orbit / pan /
+            zoom, ``space`` pause, ``n`` single step, ``c`` sensor views, ``m`` segmentation;
+            see docs/viewer.md). ``"human"`` needs a display: without one ``render()`` raises
+            ``RuntimeError`` naming ``DISPLAY`` / ``WAYLAND_DISPLAY``.
         sim_freq: physics frequency in Hz (500 by default).
         control_freq: env step frequency in Hz (20 by default); ``sim_freq`` must be a multiple.
         max_episode_steps: episode limit in env steps after which ``truncated`` is set;
@@ -140,7 +143,7 @@ class Ms2Env(gym.Env):
     Unknown ids or modes raise ``ValueError`` listing the valid ones.
     """
 
-    metadata = {"render_modes": ["rgb_array", "cameras"], "render_fps": 20}
+    metadata = {"render_modes": ["rgb_array", "cameras", "human"], "render_fps": 20}
 
     def __init__(
         self,
@@ -182,6 +185,7 @@ class Ms2Env(gym.Env):
         self.action_space = to_gym_space(self._native.action_space())
         self.metadata = {**self.metadata, "render_fps": self.control_freq}
         self._seeded = False
+        self._viewer: Any = None
 
     # --- gymnasium API -------------------------------------------------------------------------
 
@@ -196,34 +200,41 @@ class Ms2Env(gym.Env):
         reconfigure = options.get("reconfigure", False)
         if not isinstance(reconfigure, (bool, np.bool_)):
             raise TypeError(f"options['reconfigure'] must be a bool, got {reconfigure!r}")
-        self._native.config  # a closed env raises here, before gymnasium's seeding
+        native_reset = self._native.reset  # a closed env raises here
         super().reset(seed=seed)
         if seed is None and not self._seeded:
             seed = _seed_from(self.np_random)
         if seed is not None:
             self._seeded = True
         reconfigure = bool(reconfigure)
-        return self._native.reset(seed=seed, reconfigure=reconfigure)
+        return native_reset(seed=seed, reconfigure=reconfigure)
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """One control step (``sim_freq / control_freq`` physics steps). ``action`` must have the
         action space's shape and be finite (``ValueError`` otherwise)."""
+        native_step = self._native.step  # a closed env raises here
         action = real_array(action, "action")
         if action.shape != self.action_space.shape:
             raise ValueError(
                 f"action for control_mode {self.control_mode!r} must have shape "
                 f"{self.action_space.shape}, got {action.shape}"
             )
-        return self._native.step(action)
+        return native_step(action)
 
     def render(self) -> np.ndarray | None:
         """An RGB image (uint8 [H, W, 3]): with ``render_mode="rgb_array"`` the render
         camera's view (goal markers shown); with ``"cameras"`` that view tiled with every
-        observation camera's RGB, depth and segmentation images (ManiSkill2's layout)."""
+        observation camera's RGB, depth and segmentation images (ManiSkill2's layout). With
+        ``"human"`` it shows the scene in the viewer window (opened on the first call) and
+        returns ``None`` (gymnasium's rule; :meth:`render_human` returns the viewer, as
+        ManiSkill2's does, and :attr:`viewer` holds it)."""
         if self.render_mode is None:
             gym.logger.warn(
                 "render() called without render_mode; make the env with render_mode='rgb_array'"
             )
+            return None
+        if self.render_mode == "human":
+            self.render_human()
             return None
         view = self._native.render()
         if self.render_mode == "cameras":
@@ -235,8 +246,30 @@ class Ms2Env(gym.Env):
         (ManiSkill2's ``env.get_obs()``)."""
         return self._native.get_obs()
 
+    def render_human(self) -> Any:
+        """Opens the viewer window on the first call (``RuntimeError`` without a display),
+        handles its mouse and key events and draws the scene as it is now. While the viewer is
+        paused (``space``) the call keeps the window live and returns only when the user
+        resumes, single-steps (``n``) or closes the window, so a loop that calls ``render()``
+        after each ``step()`` pauses with it. Returns the viewer (``ms2._native.NativeViewer``:
+        ``take_keys()``, ``press_key()``, ``paused``, ``closed``, ``close()``, ...)."""
+        if self._viewer is None:
+            self._viewer = _native.NativeViewer(self._native, title=f"ms2 {self.env_id}")
+        if not self._viewer.closed:
+            self._viewer.show(self._native)
+        return self._viewer
+
+    @property
+    def viewer(self) -> Any:
+        """The viewer window of ``render_mode="human"`` (``None`` before the first render)."""
+        return self._viewer
+
     def close(self) -> None:
-        """Releases the native env; any later call raises ``ValueError`` (the env is closed)."""
+        """Closes the viewer window, if any, and releases the native env; any later call
+        raises ``ValueError`` (the env is closed)."""
+        if self._viewer is not None:
+            self._viewer.close()
+            self._viewer = None
         self._native = _Closed("Ms2Env")  # type: ignore[assignment]
 
     # --- ManiSkill2-style extras ----------------------------------------------------------------

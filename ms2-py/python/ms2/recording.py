@@ -227,6 +227,9 @@ class RecordEpisode(gym.Wrapper):
         self._elapsed_steps = 0
         self._log: _EpisodeLog | None = None
         self._writer: Any = None
+        # Steps / frames of the current episode already written by a flush (None: not yet).
+        self._flushed_steps: int | None = None
+        self._flushed_frames: int | None = None
 
     def _capture(self, frame_text: tuple[dict[str, Any], list[str]] | None = None) -> None:
         if not self.save_video:
@@ -262,7 +265,10 @@ class RecordEpisode(gym.Wrapper):
             return
         if ignore_empty_transition and not log.actions:
             return
+        if self._flushed_steps == len(log.actions):
+            return  # already written as it is (e.g. flushed by hand, then reset)
         self._write_trajectory(log)
+        self._flushed_steps = len(log.actions)
         if verbose:
             print(f"Recorded episode {log.episode_id} to {self.trajectory_path}")
 
@@ -276,11 +282,15 @@ class RecordEpisode(gym.Wrapper):
             return None
         if ignore_empty_transition and len(self._frames) == 1:
             return None
+        if self._flushed_frames == len(self._frames):
+            return None  # already written as it is
         name = f"{self.name_prefix}_{max(self._episode_id, 0)}"
         if suffix:
             name += f"_{suffix}"
         path = write_video(self.output_dir / f"{name}.mp4", self._frames, self.fps)
-        self.video_paths.append(path)
+        self._flushed_frames = len(self._frames)
+        if path not in self.video_paths:
+            self.video_paths.append(path)
         if verbose:
             print(f"Video written: {path}")
         return path
@@ -300,6 +310,7 @@ class RecordEpisode(gym.Wrapper):
         self._elapsed_steps = 0
         self._frames = []
         self._log = None
+        self._flushed_steps = self._flushed_frames = None
         obs, info = self.env.reset(**kwargs)
         self._capture()
         if self.save_trajectory:

@@ -389,8 +389,7 @@ def _check_json_int(json_file: Path, i: int, key: str, value: Any, high: int) ->
     """Refuses a JSON episode entry that is not an int in ``[0, high]``, naming the file."""
     if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= high:
         raise TrajectoryFileError(
-            f"{json_file}: episodes[{i}]['{key}'] must be an integer in [0, {high}], got "
-            f"{value!r}"
+            f"{json_file}: episodes[{i}]['{key}'] must be an integer in [0, {high}], got {value!r}"
         )
 
 

@@ -37,9 +37,7 @@ class Ms2VectorEnv(VectorEnv):
 
     def __init__(self, env_id: str = "PickCube-v0", num_envs: int = 1, **kwargs: Any) -> None:
         if isinstance(num_envs, (bool, np.bool_)) or not isinstance(num_envs, (int, np.integer)):
-            raise TypeError(
-                f"num_envs must be an int, got {type(num_envs).__name__} {num_envs!r}"
-            )
+            raise TypeError(f"num_envs must be an int, got {type(num_envs).__name__} {num_envs!r}")
         if not 1 <= num_envs <= MAX_NUM_ENVS:
             raise ValueError(f"num_envs must be in 1..={MAX_NUM_ENVS}, got {num_envs}")
         _assets.register_installed_packages()
@@ -62,7 +60,7 @@ class Ms2VectorEnv(VectorEnv):
         """Resets all envs (or those in ``options["reset_mask"]``): ``(batched obs, info)``."""
         n = self.num_envs
         options = check_options(options, ("reset_mask",))
-        self._native.config  # a closed env raises here
+        native_reset = self._native.reset  # a closed env raises here
         if seed is None or isinstance(seed, (int, np.integer, bool, np.bool_, float)):
             first = check_seed(seed)
             if first is not None and first + n - 1 > MAX_SEED:
@@ -100,17 +98,18 @@ class Ms2VectorEnv(VectorEnv):
             mask = mask_array.tolist()
         if any(s is not None for s in seeds):
             self._seeded = True
-        return self._native.reset(seeds, mask)
+        return native_reset(seeds, mask)
 
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """Steps all envs with ``actions`` of shape ``(num_envs, *single_action_space.shape)``."""
+        native_step = self._native.step  # a closed env raises here
         actions = real_array(actions, "actions")
         if actions.shape != self.action_space.shape:
             raise ValueError(
                 f"actions for control_mode {self.control_mode!r} must have shape "
                 f"{self.action_space.shape}, got {actions.shape}"
             )
-        return self._native.step(actions.reshape(self.num_envs, -1))
+        return native_step(actions.reshape(self.num_envs, -1))
 
     def get_state(self, index: int) -> np.ndarray:
         """Env ``index``'s simulation state (see :meth:`ms2.envs.Ms2Env.get_state`)."""
