@@ -160,10 +160,10 @@ def test_use_first_env_state_starts_from_the_recorded_state(state_demo, tmp_path
 
 
 def test_discard_timeout_counts_episodes_at_the_limit_as_failed(tmp_path):
-    env = RecordEpisode(gym.make("Dummy-v0", max_episode_steps=4), tmp_path, save_video=False)
-    policy_env = env.unwrapped
     import ms2
 
+    env = RecordEpisode(ms2.Ms2Env("Dummy-v0", max_episode_steps=4), tmp_path, save_video=False)
+    policy_env = env.unwrapped
     policy = ms2.ScriptedPolicy(env)
     for seed in range(6):
         env.reset(seed=seed)
