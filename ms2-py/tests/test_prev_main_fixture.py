@@ -1,14 +1,19 @@
 """Trajectories written by the previous main (before the task-runtime reorganisation) replay bit
 for bit on this build: from their seeds, and (rigid tasks) from their recorded env states.
 
-The fixture and how it was made: ``fixtures/prev_main/README.md``.
+The fixture and how it was made: ``fixtures/prev_main/README.md``. It was recorded with ms2's
+primitive Panda, so each check runs in a child process with ``MS2_PANDA_DESCRIPTION=primitive``
+(the Panda description is chosen once per process, and setup fetches the real one).
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import os
 import pathlib
+import subprocess
+import sys
 
 import h5py
 import ms2
@@ -39,8 +44,31 @@ def _digest(state: np.ndarray) -> np.ndarray:
     return np.frombuffer(hashlib.sha256(raw).digest(), dtype=np.uint8)
 
 
+def _in_primitive_panda_process(check: str, env_id: str, episode_id: int) -> None:
+    env = {**os.environ, "MS2_PANDA_DESCRIPTION": "primitive"}
+    out = subprocess.run(
+        [sys.executable, __file__, check, env_id, str(episode_id)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert out.returncode == 0, out.stdout + out.stderr
+
+
 @pytest.mark.parametrize(("env_id", "episode_id"), EPISODES)
 def test_replay_from_seed_is_bit_identical(env_id, episode_id):
+    _in_primitive_panda_process("seed", env_id, episode_id)
+
+
+@pytest.mark.parametrize(
+    ("env_id", "episode_id"), [e for e in EPISODES if _load(*e)[3] is not None]
+)
+def test_replay_with_env_states_is_bit_identical(env_id, episode_id):
+    _in_primitive_panda_process("env_states", env_id, episode_id)
+
+
+def _check_replay_from_seed(env_id, episode_id):
     kwargs, episode, actions, _ = _load(env_id, episode_id)
     digests = EXPECTED[f"{env_id}/traj_{episode_id}/sha256"]
     assert len(digests) == len(actions) + 1
@@ -59,10 +87,7 @@ def test_replay_from_seed_is_bit_identical(env_id, episode_id):
     assert info["success"] == episode["info"]["success"]
 
 
-@pytest.mark.parametrize(
-    ("env_id", "episode_id"), [e for e in EPISODES if _load(*e)[3] is not None]
-)
-def test_replay_with_env_states_is_bit_identical(env_id, episode_id):
+def _check_replay_with_env_states(env_id, episode_id):
     kwargs, _, actions, env_states = _load(env_id, episode_id)
     env = ms2.Ms2Env(env_id, **kwargs)
     env.reset(seed=0)
@@ -73,3 +98,13 @@ def test_replay_with_env_states_is_bit_identical(env_id, episode_id):
             env.unwrapped.get_state(), env_states[t + 1], err_msg=f"{env_id} step {t}"
         )
     env.close()
+
+
+if __name__ == "__main__":
+    check, env_id, episode_id = sys.argv[1], sys.argv[2], int(sys.argv[3])
+    from ms2.assets import panda_description
+
+    assert panda_description()["real"] is False, "the fixture needs the primitive Panda"
+    {"seed": _check_replay_from_seed, "env_states": _check_replay_with_env_states}[check](
+        env_id, episode_id
+    )
