@@ -96,7 +96,9 @@ def test_keys_are_documented():
     out = subprocess.run(
         [sys.executable, "-m", "ms2", "teleop", "--help"], capture_output=True, text=True
     )
-    assert out.returncode == 0 and "save the episode" in out.stdout and "(default: 0.1)" in out.stdout
+    assert (
+        out.returncode == 0 and "save the episode" in out.stdout and "(default: 0.1)" in out.stdout
+    )
 
 
 def test_bad_arguments_are_value_errors(tmp_path):

@@ -246,4 +246,4 @@ def test_no_display_is_a_clear_runtime_error():
 def test_unreachable_display_is_a_clear_runtime_error():
     out = _render_in_subprocess({**os.environ, "DISPLAY": ":4242"})
     assert out.returncode == 0, out.stderr
-    assert "RuntimeError:" in out.stdout and "DISPLAY=\":4242\"" in out.stdout, out.stdout
+    assert "RuntimeError:" in out.stdout and 'DISPLAY=":4242"' in out.stdout, out.stdout
