@@ -250,6 +250,9 @@ fn resolve_mesh_path(filename: &str, base_dir: &Path) -> PathBuf {
     }
 }
 
+/// Shapes of one visual, each with the RGBA colour of its material in the mesh file (if any).
+type VisualParts = Vec<(ShapeDesc, Option<[f32; 4]>)>;
+
 /// A visual's geometry: one shape for primitives, one triangle mesh per part (with the part's
 /// material colour from the file) for meshes.
 fn visual_geometry(
@@ -257,7 +260,7 @@ fn visual_geometry(
     base_dir: &Path,
     file: &str,
     link: &str,
-) -> std::result::Result<Vec<(ShapeDesc, Option<[f32; 4]>)>, UrdfError> {
+) -> std::result::Result<VisualParts, UrdfError> {
     let urdf_rs::Geometry::Mesh { filename, scale } = g else {
         return Ok(vec![(
             geometry(g, base_dir, file, link, "visual", None)?,

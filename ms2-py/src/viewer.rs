@@ -122,7 +122,9 @@ impl NativeViewer {
     /// Handles `key` (a name as `take_keys` returns them) exactly as a key press in the window.
     fn press_key(&mut self, key: &str) -> PyResult<()> {
         if key.is_empty() {
-            return Err(PyValueError::new_err("key must be a non-empty key name, got ''"));
+            return Err(PyValueError::new_err(
+                "key must be a non-empty key name, got ''",
+            ));
         }
         self.viewer()?.press_key(key);
         Ok(())

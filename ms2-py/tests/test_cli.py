@@ -76,6 +76,9 @@ def test_bench_visual_smoke():
     rows = [line for line in out.splitlines() if line.startswith("rgbd")]
     assert len(rows) == 2 and "make_vec(2)" in rows[1], out
     for row in rows:
-        # ... steps/s, x our single, x MS2 single, peak RSS MB, triangles/cam, load
+        # ... steps/s, cpu ms/step, x our single, x MS2 single, peak RSS MB, MB/extra env,
+        # triangles/cam, load
         fields = row.split()
-        assert float(fields[-6]) > 0 and float(fields[-3]) > 10 and int(fields[-2]) > 100
+        assert float(fields[-8]) > 0 and float(fields[-4]) > 10 and int(fields[-2]) > 100
+    # MB per extra env: only for the vector env (the single env is the baseline).
+    assert rows[0].split()[-3] == "-" and float(rows[1].split()[-3]) > -1000, out

@@ -74,13 +74,14 @@ def project(point, eye, target, fov_y, width, height):
 
 def robot_grey_share(patch):
     """Share of pixels with the robot's paint: grey/white (channels within 8 of each other,
-    brighter than 60). The floor is beige (R > B by ~20) and the sky black."""
+    brighter than 60). The floor is slate blue (B > R by ~25)."""
     patch = patch.reshape(-1, 3).astype(int)
     spread = patch.max(axis=1) - patch.min(axis=1)
     return float(np.mean((spread <= 8) & (patch.mean(axis=1) > 60)))
 
 
 def window_image(xserver, window):
+    time.sleep(0.2)  # the X server draws the last frame asynchronously
     x, y, w, h = xserver.geometry(window)
     shot = xserver.screenshot()
     return shot[y : y + h, x : x + w]
@@ -105,10 +106,9 @@ def test_window_shows_the_robot_where_it_projects(xserver, viewed):
         shares[name] = robot_grey_share(image[r - 3 : r + 4, c - 3 : c + 4])
     assert shares["hand"] > 0.5 and shares["base"] > 0.5, shares
     assert shares["floor"] < 0.1, shares
-    # The window is not just the robot: floor (beige) and background (black) are there too.
+    # The window is not just the robot: most of it is the floor, blue-grey.
     flat = image.reshape(-1, 3).astype(int)
-    assert np.mean(flat.sum(axis=1) == 0) > 0.05
-    assert np.mean((flat[:, 0] - flat[:, 2]) > 10) > 0.2
+    assert np.mean((flat[:, 2] - flat[:, 0]) > 10) > 0.3
 
 
 def test_window_follows_the_simulation(xserver, viewed):

@@ -2,7 +2,7 @@
 
 use crate::error::INSTALL_ADVICE;
 use crate::particle_gpu::ParticleGpu;
-use crate::raycast::{CpuMesh, CpuTexture};
+use crate::raycast::{CpuMesh, CpuTexture, MergedMeshes};
 use crate::sensor_backend::SensorBackend;
 use crate::shadow::{shadow_bind_group_layout, ShadowGpu};
 use crate::targets::FramePool;
@@ -124,6 +124,8 @@ pub(crate) struct RendererInner {
     pub(crate) store: RwLock<ResourceStore>,
     pub(crate) triangle_counts: RwLock<Vec<usize>>,
     pub(crate) pool: Mutex<FramePool>,
+    /// Ray casting's merged meshes of instances that share a pose (see `raycast`).
+    pub(crate) merged_meshes: MergedMeshes,
     pub(crate) adapter: AdapterSummary,
     /// The resolved sensor path (never `Auto`).
     pub(crate) sensor_backend: SensorBackend,
@@ -300,6 +302,7 @@ impl Renderer {
                 store: RwLock::new(ResourceStore::default()),
                 triangle_counts: RwLock::new(Vec::new()),
                 pool: Mutex::new(FramePool::default()),
+                merged_meshes: MergedMeshes::default(),
                 adapter: summary,
                 sensor_backend,
             }),

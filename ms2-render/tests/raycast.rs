@@ -16,7 +16,8 @@ fn ids(actor: u32, link: u32) -> SegmentationIds {
 }
 
 /// A tabletop: ground, a rotated box, a scaled unit box, a fine sphere, a non-uniformly
-/// scaled capsule, a textured quad and a small particle slab.
+/// scaled capsule, a rod through the sphere in the sphere's frame, a textured quad and a small
+/// particle slab.
 fn table_scene() -> Scene {
     let r = renderer();
     let ground = r.add_mesh(&MeshData::plane(3.0, 3.0)).unwrap();
@@ -24,6 +25,7 @@ fn table_scene() -> Scene {
     let unit_box = r.add_mesh(&MeshData::cuboid([0.5, 0.5, 0.5])).unwrap();
     let sphere = r.add_mesh(&MeshData::icosphere(0.06, 4)).unwrap();
     let capsule = r.add_mesh(&MeshData::capsule(0.03, 0.06, 24, 8)).unwrap();
+    let rod = r.add_mesh(&MeshData::cylinder(0.015, 0.11, 16)).unwrap();
     let quad = r.add_mesh(&MeshData::cuboid([0.06, 0.06, 0.005])).unwrap();
     let texture = r
         .add_texture(&TextureData {
@@ -54,11 +56,23 @@ fn table_scene() -> Scene {
         )
         .with_scale(Vector3::new(0.06, 0.06, 0.06)),
     );
+    let sphere_pose = Isometry3::from_parts(
+        Vector3::new(-0.2, 0.15, 0.06).into(),
+        UnitQuaternion::from_euler_angles(0.0, 1.5, 0.3),
+    );
     scene.add_instance(Instance::new(
         sphere,
         Material::color(0.2, 0.7, 0.2),
-        Isometry3::translation(-0.2, 0.15, 0.06),
+        sphere_pose,
         ids(4, 40),
+    ));
+    // A rod through the sphere in the same frame (as two material parts of one robot link):
+    // the ray caster merges them into one mesh, keeping each part's colour and ids.
+    scene.add_instance(Instance::new(
+        rod,
+        Material::color(0.9, 0.8, 0.1),
+        sphere_pose,
+        ids(8, 80),
     ));
     scene.add_instance(
         Instance::new(
@@ -190,7 +204,7 @@ fn raycast_agrees_with_the_rasterizer() {
     }
     // The base camera sees every object of the scene.
     let seen: std::collections::BTreeSet<u32> = rays[0].segmentation_link.iter().copied().collect();
-    for id in [1, 20, 30, 40, 50, 60, 70] {
+    for id in [1, 20, 30, 40, 50, 60, 70, 80] {
         assert!(seen.contains(&id), "object {id} missing from {seen:?}");
     }
 }

@@ -146,10 +146,14 @@ fn bad_inputs_give_typed_errors() {
         obs_mode: "rgbz".into(),
         ..EnvConfig::new("Dummy-v0")
     };
-    assert!(matches!(
-        make_env(&bad_obs),
-        Err(EnvError::UnknownObsMode { .. })
-    ));
+    // The error lists only the modes this env supports (Dummy-v0 has no 3D scene, no particles).
+    match make_env(&bad_obs) {
+        Err(EnvError::UnknownObsMode { got, valid }) => {
+            assert_eq!(got, "rgbz");
+            assert_eq!(valid, ["state", "state_dict", "none"]);
+        }
+        other => panic!("unexpected {other:?}"),
+    }
     let bad_ctrl = EnvConfig {
         control_mode: Some("pd_teleport".into()),
         ..EnvConfig::new("Dummy-v0")

@@ -134,7 +134,10 @@ mod tests {
     fn pause_and_single_step() {
         let mut c = Controls::default();
         assert!(!c.paused());
-        assert!(c.press("n", 2) && !c.take_step(), "n does nothing while running");
+        assert!(
+            c.press("n", 2) && !c.take_step(),
+            "n does nothing while running"
+        );
         assert!(c.press("space", 2) && c.paused());
         c.press("n", 2);
         c.press("n", 2);
@@ -170,7 +173,11 @@ mod tests {
         c.press("c", 2);
         assert_eq!(c.view(2), View::Free);
         c.press("c", 0);
-        assert_eq!(c.view(0), View::Free, "no sensors: stays on the free camera");
+        assert_eq!(
+            c.view(0),
+            View::Free,
+            "no sensors: stays on the free camera"
+        );
     }
 
     #[test]

@@ -128,7 +128,10 @@ mod tests {
         cam.orbit(100.0, -40.0);
         assert_relative_eq!((cam.eye() - cam.target).norm(), d, epsilon = 1e-5);
         assert_eq!(cam.target, Point3::origin());
-        assert!(cam.yaw < 0.0, "dragging right turns the eye clockwise seen from above");
+        assert!(
+            cam.yaw < 0.0,
+            "dragging right turns the eye clockwise seen from above"
+        );
         cam.orbit(0.0, 1e6);
         assert!(cam.pitch <= MAX_PITCH_RAD);
     }

@@ -29,7 +29,14 @@ pub fn segmentation_rgb(ids: &[u32]) -> Vec<u8> {
 /// # Panics
 /// Never for consistent sizes; `rgb` shorter than `width * height * 3` or `dst` shorter than
 /// `dst_width * dst_height` draws what fits (callers pass matching sizes).
-pub fn blit_fit(rgb: &[u8], width: u32, height: u32, dst: &mut [u32], dst_width: u32, dst_height: u32) {
+pub fn blit_fit(
+    rgb: &[u8],
+    width: u32,
+    height: u32,
+    dst: &mut [u32],
+    dst_width: u32,
+    dst_height: u32,
+) {
     dst.fill(LETTERBOX);
     if width == 0 || height == 0 || dst_width == 0 || dst_height == 0 {
         return;
@@ -76,7 +83,10 @@ mod tests {
         let mut dst = [0u32; 8];
         blit_fit(&[255, 0, 0], 1, 1, &mut dst, 4, 2);
         let red = 0xff0000;
-        assert_eq!(dst, [LETTERBOX, red, red, LETTERBOX, LETTERBOX, red, red, LETTERBOX]);
+        assert_eq!(
+            dst,
+            [LETTERBOX, red, red, LETTERBOX, LETTERBOX, red, red, LETTERBOX]
+        );
     }
 
     #[test]

@@ -130,26 +130,27 @@ fn with_shared<R>(f: impl FnOnce(&mut Shared) -> R) -> Result<R, ViewerError> {
                     wayland: env_var("WAYLAND_DISPLAY").unwrap_or_else(|| "not set".to_owned()),
                 });
             };
-            let event_loop = EventLoop::builder()
-                .with_any_thread(true)
-                .build()
-                .map_err(|e| match e {
-                    winit::error::EventLoopError::RecreationAttempt => {
-                        ViewerError::WrongThread(e.to_string())
-                    }
-                    other => ViewerError::Display {
-                        display,
-                        reason: other.to_string(),
-                    },
-                })?;
+            let event_loop =
+                EventLoop::builder()
+                    .with_any_thread(true)
+                    .build()
+                    .map_err(|e| match e {
+                        winit::error::EventLoopError::RecreationAttempt => {
+                            ViewerError::WrongThread(e.to_string())
+                        }
+                        other => ViewerError::Display {
+                            display,
+                            reason: other.to_string(),
+                        },
+                    })?;
             *slot = Some(Shared {
                 event_loop,
                 hub: Hub::default(),
             });
         }
-        let shared = slot.as_mut().ok_or_else(|| {
-            ViewerError::Window("the viewer's event loop is missing".to_owned())
-        })?;
+        let shared = slot
+            .as_mut()
+            .ok_or_else(|| ViewerError::Window("the viewer's event loop is missing".to_owned()))?;
         Ok(f(shared))
     })
 }
@@ -201,8 +202,7 @@ impl Viewer {
     /// Opens a window. Without a display: [`ViewerError::NoDisplay`] (names `DISPLAY` and
     /// `WAYLAND_DISPLAY`); with an unreachable one: [`ViewerError::Display`].
     pub fn open(config: &ViewerConfig) -> Result<Viewer, ViewerError> {
-        if config.width == 0 || config.height == 0 || config.width > 8192 || config.height > 8192
-        {
+        if config.width == 0 || config.height == 0 || config.width > 8192 || config.height > 8192 {
             return Err(ViewerError::InvalidArgument(format!(
                 "viewer window size must be 1..=8192 px each, got {}x{}",
                 config.width, config.height
@@ -298,7 +298,8 @@ impl Viewer {
                 let now = (position.x, position.y);
                 if let Some((x0, y0)) = self.mouse.cursor {
                     let (dx, dy) = ((now.0 - x0) as f32, (now.1 - y0) as f32);
-                    let pan = self.mouse.pan_button || (self.mouse.left && self.modifiers.shift_key());
+                    let pan =
+                        self.mouse.pan_button || (self.mouse.left && self.modifiers.shift_key());
                     if pan {
                         let height = self.window.inner_size().height as f32;
                         self.orbit.pan(dx, dy, height);
@@ -390,7 +391,11 @@ impl Viewer {
             } => format!(
                 "{} ({})",
                 sensors[index].name,
-                if segmentation { "segmentation" } else { "colour" }
+                if segmentation {
+                    "segmentation"
+                } else {
+                    "colour"
+                }
             ),
         };
         let mut text = format!("{} | {view}", self.title);
@@ -413,11 +418,7 @@ impl Viewer {
         sensors: &[SensorCamera],
     ) -> Result<(), ViewerError> {
         self.sensor_count = sensors.len();
-        let title = self.describe(sensors);
-        if title != self.shown_title {
-            self.window.set_title(&title);
-            self.shown_title = title;
-        }
+        self.shown_title = self.describe(sensors);
         let (width, height) = self.size();
         let (Some(w), Some(h)) = (NonZeroU32::new(width), NonZeroU32::new(height)) else {
             return Ok(()); // minimised
@@ -452,6 +453,10 @@ impl Viewer {
         buffer
             .present()
             .map_err(|e| ViewerError::Window(format!("present: {e}")))?;
+        // softbuffer queues the image on the X connection without flushing it, so the window
+        // would show the previous frame until the next request. Setting the title (winit
+        // flushes the shared connection after it) sends the frame now.
+        self.window.set_title(&self.shown_title);
         Ok(())
     }
 }

@@ -423,7 +423,18 @@ def build_parser() -> argparse.ArgumentParser:
     _add_replay_parser(sub)
     _add_gallery_parser(sub)
     teleop.add_parser(sub)
+    _show_defaults_everywhere(parser)
     return parser
+
+
+def _show_defaults_everywhere(parser: argparse.ArgumentParser) -> None:
+    """Gives every (sub)command's help the :class:`HelpFormatter`, so each option shows its
+    default whichever module added it."""
+    parser.formatter_class = HelpFormatter
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                _show_defaults_everywhere(sub)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

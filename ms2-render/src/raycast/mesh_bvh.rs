@@ -14,6 +14,8 @@ pub(crate) struct CpuMesh {
     normals: Vec<Vec3>,
     uvs: Option<Vec<[f32; 2]>>,
     triangles: Vec<[u32; 3]>,
+    /// For a merged mesh: which member mesh each triangle came from.
+    parts: Option<Vec<u32>>,
     bvh: Bvh,
     /// Bounds of all vertices, local frame.
     pub(crate) aabb: Aabb,
@@ -36,6 +38,8 @@ pub(crate) struct SurfacePoint {
     /// Geometric normal of the triangle (counter-clockwise winding = front).
     pub(crate) face_normal: Vec3,
     pub(crate) uv: Option<[f32; 2]>,
+    /// For a merged mesh, the member the triangle belongs to (0 otherwise).
+    pub(crate) part: u32,
 }
 
 impl CpuMesh {
@@ -48,6 +52,40 @@ impl CpuMesh {
             .chunks_exact(3)
             .map(|t| [t[0], t[1], t[2]])
             .collect();
+        Self::build(positions, normals, mesh.uvs.clone(), triangles, None)
+    }
+
+    /// One mesh of several placed in the same frame (e.g. the parts of one robot link, one
+    /// per material): one hierarchy over all their triangles, each remembering its member.
+    pub(crate) fn merged(members: &[&CpuMesh]) -> CpuMesh {
+        let any_uvs = members.iter().any(|m| m.uvs.is_some());
+        let (mut positions, mut normals, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+        let mut uvs = Vec::new();
+        let mut parts = Vec::new();
+        for (k, m) in members.iter().enumerate() {
+            let offset = positions.len() as u32;
+            positions.extend_from_slice(&m.positions);
+            normals.extend_from_slice(&m.normals);
+            if any_uvs {
+                match &m.uvs {
+                    Some(u) => uvs.extend_from_slice(u),
+                    None => uvs.extend(std::iter::repeat_n([0.0, 0.0], m.positions.len())),
+                }
+            }
+            triangles.extend(m.triangles.iter().map(|t| t.map(|i| i + offset)));
+            parts.extend(std::iter::repeat_n(k as u32, m.triangles.len()));
+        }
+        let uvs = any_uvs.then_some(uvs);
+        Self::build(positions, normals, uvs, triangles, Some(parts))
+    }
+
+    fn build(
+        positions: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        uvs: Option<Vec<[f32; 2]>>,
+        triangles: Vec<[u32; 3]>,
+        parts: Option<Vec<u32>>,
+    ) -> CpuMesh {
         let leaves: Vec<Aabb> = triangles
             .iter()
             .map(|t| {
@@ -63,8 +101,9 @@ impl CpuMesh {
         CpuMesh {
             positions,
             normals,
-            uvs: mesh.uvs.clone(),
+            uvs,
             triangles,
+            parts,
             bvh,
             aabb,
         }
@@ -130,6 +169,7 @@ impl CpuMesh {
             normal,
             face_normal: (b - a).cross(c - a),
             uv,
+            part: self.parts.as_ref().map_or(0, |p| p[hit.triangle as usize]),
         }
     }
 }

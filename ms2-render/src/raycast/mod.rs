@@ -10,6 +10,7 @@ mod scene_bvh;
 mod texture;
 
 pub(crate) use mesh_bvh::CpuMesh;
+pub(crate) use scene_bvh::MergedMeshes;
 pub(crate) use texture::CpuTexture;
 
 use crate::camera::Camera;
@@ -60,7 +61,7 @@ impl Renderer {
                 .expect("resource store lock poisoned");
             views
                 .par_iter()
-                .map(|(scene, _)| SceneRays::new(scene, &store))
+                .map(|(scene, _)| SceneRays::new(scene, &store, &self.inner.merged_meshes))
                 .collect::<Result<_, _>>()?
         };
         let mut outputs = Vec::new();

@@ -12,9 +12,21 @@ use parry3d::math::{Mat3, Vec3};
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
 use parry3d::query::Ray;
 use std::cell::Cell;
-use std::sync::Arc;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 
-/// A visible instance with its mesh and the transforms a ray needs.
+/// Appearance and ids of one member of a placed mesh.
+struct Look {
+    material: Material,
+    texture: Option<Arc<CpuTexture>>,
+    ids: SegmentationIds,
+}
+
+/// Merged meshes by the handles of their members, shared by every frame and scene.
+pub(crate) type MergedMeshes = Mutex<HashMap<Vec<u32>, Arc<CpuMesh>>>;
+
+/// The visible instances that share one pose and scale (e.g. the parts of one robot link),
+/// as one mesh with the transforms a ray needs.
 struct PlacedMesh {
     mesh: Arc<CpuMesh>,
     /// World-from-mesh rotation and translation (scale applied first, along mesh axes).
@@ -23,9 +35,8 @@ struct PlacedMesh {
     inv_scale: Vec3,
     /// −1 when the scale mirrors the mesh (flips its winding), else 1.
     mirror: f32,
-    material: Material,
-    texture: Option<Arc<CpuTexture>>,
-    ids: SegmentationIds,
+    /// Per member, in merge order (one entry for a single instance).
+    looks: Vec<Look>,
 }
 
 /// A particle drawn as a sphere.
@@ -71,29 +82,82 @@ fn rotation(pose: &Isometry3<f32>) -> Mat3 {
 }
 
 impl SceneRays {
-    /// Places the visible instances and particles of `scene` (already validated).
-    pub(crate) fn new(scene: &Scene, store: &ResourceStore) -> Result<SceneRays, RenderError> {
+    /// Places the visible instances and particles of `scene` (already validated). Instances
+    /// with bit-identical poses and scales are cast against as one merged mesh (from `merged`,
+    /// built on first use), so a ray entering a robot link walks one hierarchy, not one per
+    /// material part.
+    pub(crate) fn new(
+        scene: &Scene,
+        store: &ResourceStore,
+        merged: &MergedMeshes,
+    ) -> Result<SceneRays, RenderError> {
+        // Group visible instances by pose and scale bits, in scene order.
+        let mut groups: Vec<(Vec<u32>, Vec<&crate::Instance>)> = Vec::new();
+        let mut index: HashMap<Vec<u32>, usize> = HashMap::new();
+        for instance in scene.instances().iter().filter(|i| i.visible) {
+            let pose = &instance.pose_world_from_mesh;
+            let key: Vec<u32> = pose
+                .translation
+                .vector
+                .iter()
+                .chain(pose.rotation.coords.iter())
+                .chain(instance.scale.iter())
+                .map(|v| v.to_bits())
+                .collect();
+            match index.get(&key) {
+                Some(&g) => groups[g].1.push(instance),
+                None => {
+                    index.insert(key.clone(), groups.len());
+                    groups.push((key, vec![instance]));
+                }
+            }
+        }
         let mut meshes = Vec::new();
         let mut leaves = Vec::new();
-        for instance in scene.instances().iter().filter(|i| i.visible) {
-            let mesh = store
-                .cpu_meshes
-                .get(instance.mesh.0 as usize)
-                .ok_or(RenderError::UnknownMesh(
-                    instance.mesh.0,
-                    store.cpu_meshes.len(),
-                ))?
-                .clone();
-            let texture = match instance.material.texture {
-                Some(t) => Some(
+        for (_, members) in groups {
+            let mut member_meshes = Vec::with_capacity(members.len());
+            let mut looks = Vec::with_capacity(members.len());
+            for instance in &members {
+                member_meshes.push(
                     store
-                        .cpu_textures
-                        .get(t.0 as usize)
-                        .ok_or(RenderError::UnknownTexture(t.0, store.cpu_textures.len()))?
+                        .cpu_meshes
+                        .get(instance.mesh.0 as usize)
+                        .ok_or(RenderError::UnknownMesh(
+                            instance.mesh.0,
+                            store.cpu_meshes.len(),
+                        ))?
                         .clone(),
-                ),
-                None => None,
+                );
+                let texture = match instance.material.texture {
+                    Some(t) => Some(
+                        store
+                            .cpu_textures
+                            .get(t.0 as usize)
+                            .ok_or(RenderError::UnknownTexture(t.0, store.cpu_textures.len()))?
+                            .clone(),
+                    ),
+                    None => None,
+                };
+                looks.push(Look {
+                    material: instance.material,
+                    texture,
+                    ids: instance.segmentation,
+                });
+            }
+            let mesh = if member_meshes.len() == 1 {
+                member_meshes.pop().expect("one member")
+            } else {
+                let handles: Vec<u32> = members.iter().map(|i| i.mesh.0).collect();
+                let mut cache = merged.lock().expect("merged mesh cache lock poisoned");
+                cache
+                    .entry(handles)
+                    .or_insert_with(|| {
+                        let refs: Vec<&CpuMesh> = member_meshes.iter().map(|m| &**m).collect();
+                        Arc::new(CpuMesh::merged(&refs))
+                    })
+                    .clone()
             };
+            let instance = members[0];
             let rotation = rotation(&instance.pose_world_from_mesh);
             let translation = vec3(&instance.pose_world_from_mesh.translation.vector);
             let scale = vec3(&instance.scale);
@@ -115,9 +179,7 @@ impl SceneRays {
                 translation,
                 inv_scale: scale.recip(),
                 mirror: (scale.x * scale.y * scale.z).signum(),
-                material: instance.material,
-                texture,
-                ids: instance.segmentation,
+                looks,
             });
         }
         let mut spheres = Vec::new();
@@ -214,9 +276,10 @@ impl SceneRays {
         if face.dot(ray.dir) > 0.0 {
             normal = -normal;
         }
-        let c = placed.material.base_color;
+        let look = &placed.looks[surface.part as usize];
+        let c = look.material.base_color;
         let mut albedo = Vec3::new(c[0], c[1], c[2]);
-        if let Some(texture) = &placed.texture {
+        if let Some(texture) = &look.texture {
             // Meshes without uvs sample texel (0, 0), as their vertices carry uv (0, 0).
             albedo *= texture.sample_linear(surface.uv.unwrap_or([0.0, 0.0]));
         }
@@ -224,7 +287,7 @@ impl SceneRays {
             t: tri.t,
             normal,
             albedo,
-            ids: placed.ids,
+            ids: look.ids,
         }
     }
 }
