@@ -426,7 +426,7 @@ impl Viewer {
         let view = self.controls.view(sensors.len());
         let camera = match view {
             View::Free => self.orbit.camera(width, height),
-            View::Sensor { index, .. } => sensors[index].camera.clone(),
+            View::Sensor { index, .. } => sensors[index].camera,
         };
         let mut outputs = renderer.render(&[(scene, &[camera][..])])?;
         let out = outputs
