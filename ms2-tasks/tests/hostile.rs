@@ -106,13 +106,18 @@ fn vec_env_sizes_are_bounded() {
     let cfg = EnvConfig::new("Dummy-v0");
     for n in [0, ms2_tasks::MAX_NUM_ENVS + 1, 1 << 40] {
         let msg = ms2_tasks::VecEnv::new(&cfg, n).unwrap_err().to_string();
-        assert!(msg.contains(&n.to_string()) && msg.contains("4096"), "{msg}");
+        assert!(
+            msg.contains(&n.to_string()) && msg.contains("4096"),
+            "{msg}"
+        );
     }
 }
 
 #[test]
 fn test_envs_are_not_listed_but_can_be_made() {
     assert!(!ms2_tasks::env_ids().contains(&"Dummy-v0"));
-    assert!(ms2_tasks::task_specs().iter().all(|s| s.env_id != "Dummy-v0"));
+    assert!(ms2_tasks::task_specs()
+        .iter()
+        .all(|s| s.env_id != "Dummy-v0"));
     make_env(&EnvConfig::new("Dummy-v0")).unwrap();
 }
