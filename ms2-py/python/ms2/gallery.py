@@ -2,9 +2,9 @@
 ``docs/tasks.md``.
 
 Each task is reset with seed 0 and driven by its scripted policy for a few steps (so the robot is
-seen at work), then rendered at 512x512 from a camera closer to the table than the default view
-(``render_camera_cfgs``) and written as ``<out_dir>/<env_id>.png`` (temporary
-file, then rename). Tasks without a 3D scene (``Dummy-v0``) are skipped.
+seen at work), then rendered at 512x512 through the env's ``render()`` camera (ManiSkill2's
+pose and field of view) and written as ``<out_dir>/<env_id>.png`` (temporary file, then
+rename). Tasks without a 3D scene (``Dummy-v0``) are skipped.
 """
 
 from __future__ import annotations
@@ -17,25 +17,6 @@ import numpy as np
 
 #: Scripted steps taken before the picture (mid-reach for the rigid tasks).
 DEFAULT_STEPS = 30
-#: The gallery's camera (m, world): closer to the table than ``render()``'s default view.
-EYE = (0.8, 0.65, 0.6)
-TARGET = (-0.2, 0.0, 0.2)
-
-
-def look_at_quaternion(eye: Sequence[float], target: Sequence[float]) -> list[float]:
-    """Orientation (w, x, y, z) of a camera at ``eye`` looking at ``target`` in ManiSkill2's
-    camera convention (x forward, y left, z up), world z up."""
-    forward = np.subtract(target, eye, dtype=np.float64)
-    forward /= np.linalg.norm(forward)
-    left = np.cross([0.0, 0.0, 1.0], forward)
-    left /= np.linalg.norm(left)
-    up = np.cross(forward, left)
-    m = np.stack([forward, left, up], axis=1)  # columns: the camera axes in the world
-    w = np.sqrt(max(1e-12, 1.0 + m[0, 0] + m[1, 1] + m[2, 2])) / 2.0
-    x = (m[2, 1] - m[1, 2]) / (4.0 * w)
-    y = (m[0, 2] - m[2, 0]) / (4.0 * w)
-    z = (m[1, 0] - m[0, 1]) / (4.0 * w)
-    return [float(w), float(x), float(y), float(z)]
 
 
 def save_png(path: Path, image: np.ndarray) -> Path:
@@ -55,8 +36,7 @@ def render_task(env_id: str, steps: int = DEFAULT_STEPS, seed: int = 0) -> np.nd
 
     from .envs import ScriptedPolicy
 
-    camera = {"p": list(EYE), "q": look_at_quaternion(EYE, TARGET)}
-    env = gym.make(env_id, obs_mode="none", render_mode="rgb_array", render_camera_cfgs=camera)
+    env = gym.make(env_id, obs_mode="none", render_mode="rgb_array")
     try:
         env.reset(seed=seed)
         policy = ScriptedPolicy(env)
