@@ -234,6 +234,7 @@ def test_missing_truncated_and_foreign_files_give_clear_errors(demo_file, tmp_pa
         f.create_dataset("traj_0/env_init_state", data=np.zeros(5, np.float32))
     soft_meta = json.loads(text_json)
     soft_meta["episodes"] = soft_meta["episodes"][:1]
+    soft_meta["episodes"][0]["elapsed_steps"] = 2
     soft.with_suffix(".json").write_text(json.dumps(soft_meta))
     # The soft-body layout opens; a state of another length than the env's cannot replay.
     with open_trajectory(soft) as traj:
@@ -317,7 +318,7 @@ def test_generate_with_the_motion_planning_solution(tmp_path):
 
 
 def test_bad_arguments_are_refused(demo_file, tmp_path):
-    with pytest.raises(ValueError, match="num_episodes must be at least 1"):
+    with pytest.raises(ValueError, match=r"num_episodes must be in \[1, 10000000\], got 0"):
         generate(ENV_ID, 0, tmp_path / "x.h5", policy="scripted")
     with pytest.raises(ValueError, match="unknown policy"):
         generate(ENV_ID, 1, tmp_path / "x.h5", policy="teleop")
