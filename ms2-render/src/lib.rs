@@ -61,7 +61,7 @@ pub use camera::Camera;
 pub use error::{RenderError, INSTALL_ADVICE};
 pub use frame::PendingFrame;
 pub use mesh::MeshData;
-pub use output::{CameraOutput, FusedPointCloud};
+pub use output::{segmentation_color, CameraOutput, FusedPointCloud};
 pub use particles::{ParticleSet, ParticleSetId};
 pub use renderer::{
     AdapterSummary, BackendChoice, MeshHandle, Renderer, RendererConfig, TextureData,

@@ -128,7 +128,7 @@ impl CameraOutput {
         let rgb: Vec<u8> = self
             .segmentation_link
             .iter()
-            .flat_map(|&id| id_color(id))
+            .flat_map(|&id| segmentation_color(id))
             .collect();
         save_png(
             path,
@@ -140,8 +140,15 @@ impl CameraOutput {
     }
 }
 
-/// A distinct colour per id (0 = black).
-fn id_color(id: u32) -> [u8; 3] {
+/// A distinct, bright RGB colour per segmentation id, for showing segmentation images to people
+/// (id 0, the background, is black). The same id always gets the same colour.
+///
+/// ```
+/// assert_eq!(ms2_render::segmentation_color(0), [0, 0, 0]);
+/// assert_eq!(ms2_render::segmentation_color(7), ms2_render::segmentation_color(7));
+/// assert_ne!(ms2_render::segmentation_color(1), ms2_render::segmentation_color(2));
+/// ```
+pub fn segmentation_color(id: u32) -> [u8; 3] {
     if id == 0 {
         return [0, 0, 0];
     }

@@ -1,25 +1,15 @@
 //! Turning rendered images into window pixels: aspect-preserving scaling into the window's
-//! `0x00RRGGBB` framebuffer, and segmentation ids as colours.
+//! `0x00RRGGBB` framebuffer, and segmentation ids as colours (ms2-render's
+//! [`ms2_render::segmentation_color`]).
 
 /// Colour of the window outside the image (letterbox bars), `0x00RRGGBB`.
 pub const LETTERBOX: u32 = 0x0020_2020;
 
-/// A distinct, bright colour per segmentation id (0, the background, is black).
-pub fn id_color(id: u32) -> [u8; 3] {
-    if id == 0 {
-        return [0, 0, 0];
-    }
-    let h = id.wrapping_mul(2_654_435_761);
-    [
-        (h >> 24) as u8 | 0x40,
-        (h >> 16) as u8 | 0x40,
-        (h >> 8) as u8 | 0x40,
-    ]
-}
-
 /// RGB (3 bytes per pixel, row-major) of a segmentation image.
 pub fn segmentation_rgb(ids: &[u32]) -> Vec<u8> {
-    ids.iter().flat_map(|&id| id_color(id)).collect()
+    ids.iter()
+        .flat_map(|&id| ms2_render::segmentation_color(id))
+        .collect()
 }
 
 /// Draws the RGB image `rgb` (`width`×`height`, 3 bytes per pixel, row-major) into `dst`

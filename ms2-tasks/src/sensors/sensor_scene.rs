@@ -213,6 +213,24 @@ impl Sensors {
         }
     }
 
+    /// Shows the goal marker at `goal_world` (m, world frame) when given; callers hide it again
+    /// after drawing, so observation cameras never see it.
+    fn show_goal_marker(&mut self, goal_world: Option<Vector3<f32>>) -> Result<(), EnvError> {
+        let Some(goal) = goal_world else {
+            return Ok(());
+        };
+        let scene = self.scene.scene_mut();
+        scene
+            .set_pose(
+                self.goal_marker,
+                Isometry3::translation(goal.x, goal.y, goal.z),
+            )
+            .map_err(render_err)?;
+        scene
+            .set_visible(self.goal_marker, true)
+            .map_err(render_err)
+    }
+
     /// Renders the human view (render camera) with the goal marker at `goal_world` (m) when
     /// given; the marker is hidden again afterwards, so observation cameras never see it.
     pub fn render_human(
@@ -222,18 +240,7 @@ impl Sensors {
     ) -> Result<CameraOutput, EnvError> {
         self.scene.sync_poses(world)?;
         let camera = self.render_camera.camera_at(world, self.robot)?;
-        if let Some(goal) = goal_world {
-            let scene = self.scene.scene_mut();
-            scene
-                .set_pose(
-                    self.goal_marker,
-                    Isometry3::translation(goal.x, goal.y, goal.z),
-                )
-                .map_err(render_err)?;
-            scene
-                .set_visible(self.goal_marker, true)
-                .map_err(render_err)?;
-        }
+        self.show_goal_marker(goal_world)?;
         let result = self
             .ctx
             .renderer()
@@ -258,18 +265,7 @@ impl Sensors {
     ) -> Result<R, EnvError> {
         let cams = self.prepare(world)?;
         let render_camera = self.render_camera.camera_at(world, self.robot)?;
-        if let Some(goal) = goal_world {
-            let scene = self.scene.scene_mut();
-            scene
-                .set_pose(
-                    self.goal_marker,
-                    Isometry3::translation(goal.x, goal.y, goal.z),
-                )
-                .map_err(render_err)?;
-            scene
-                .set_visible(self.goal_marker, true)
-                .map_err(render_err)?;
-        }
+        self.show_goal_marker(goal_world)?;
         let view = SceneView {
             renderer: self.ctx.renderer(),
             scene: self.scene.scene(),
