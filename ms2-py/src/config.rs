@@ -6,7 +6,7 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat};
 
-use crate::cameras::{cameras_from_py, render_camera_from_py};
+use crate::cameras::camera_updates_from_py;
 
 /// The keyword arguments every native env constructor and demonstration binding accepts, with
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
@@ -120,13 +120,13 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                 let dict = value.cast::<PyDict>().map_err(|_| {
                     PyTypeError::new_err(format!("camera_cfgs must be a dict, got {value}"))
                 })?;
-                cfg.camera_cfgs = cameras_from_py(Some(dict))?;
+                cfg.camera_updates = Some(camera_updates_from_py(dict)?);
             }
             "render_camera_cfgs" => {
                 let dict = value.cast::<PyDict>().map_err(|_| {
                     PyTypeError::new_err(format!("render_camera_cfgs must be a dict, got {value}"))
                 })?;
-                cfg.render_camera = Some(render_camera_from_py(dict)?);
+                cfg.render_camera_updates = Some(camera_updates_from_py(dict)?);
             }
             "enable_shadow" => {
                 if !value.is_instance_of::<pyo3::types::PyBool>() {

@@ -118,17 +118,23 @@ impl TaskEnv {
             ctrl.action_low().iter().map(|&v| v as f32).collect(),
             ctrl.action_high().iter().map(|&v| v as f32).collect(),
         );
-        let camera_cfgs = cfg
+        let mut camera_cfgs = cfg
             .camera_cfgs
             .clone()
-            .unwrap_or_else(CameraConfig::panda_defaults);
+            .unwrap_or_else(|| task.sensor_cameras());
+        if let Some(updates) = &cfg.camera_updates {
+            camera_cfgs = updates.applied_to(camera_cfgs)?;
+        }
         for cam in &camera_cfgs {
             cam.validate()?;
         }
-        let render_camera = cfg
+        let mut render_camera = cfg
             .render_camera
             .clone()
-            .unwrap_or_else(CameraConfig::render_camera);
+            .unwrap_or_else(|| task.render_camera());
+        if let Some(updates) = &cfg.render_camera_updates {
+            render_camera = updates.applied_to(vec![render_camera])?.remove(0);
+        }
         render_camera.validate()?;
         #[cfg(not(feature = "render"))]
         let _ = render_camera;
