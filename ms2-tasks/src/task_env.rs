@@ -10,7 +10,7 @@ use ms2_physics::WorldConfig;
 
 #[cfg(feature = "render")]
 use crate::adapters::RenderContext;
-use crate::agents::{robot_spec, RobotSpec};
+use crate::agents::{robot_spec, RobotSpec, CONTROL_MODE_ALIASES};
 use crate::backend::EnvBackend;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
@@ -81,14 +81,25 @@ impl TaskEnv {
             .filter(|m| spec.control_modes.is_empty() || spec.control_modes.contains(&m.name()))
             .collect();
         let control_modes: Vec<String> = supported.iter().map(|m| m.name().to_owned()).collect();
-        let mode_name = cfg
-            .control_mode
-            .as_deref()
-            .unwrap_or(spec.default_control_mode);
+        // The task's default for its default robot, else the robot's own first mode
+        // (ManiSkill2: the agent's first mode; `xmate3_robotiq` starts with `pd_joint_pos`).
+        let default_mode = if robot_uid == Some(spec.default_robot()) {
+            spec.default_control_mode
+        } else {
+            control_modes
+                .first()
+                .map_or(spec.default_control_mode, String::as_str)
+        };
+        let mode_name = cfg.control_mode.as_deref().unwrap_or(default_mode);
         let mode = supported
             .iter()
             .copied()
-            .find(|m| m.name() == mode_name)
+            .find(|m| {
+                m.name() == mode_name
+                    || CONTROL_MODE_ALIASES
+                        .iter()
+                        .any(|(alias, aliased)| *alias == mode_name && aliased == m)
+            })
             .ok_or_else(|| EnvError::UnknownControlMode {
                 got: mode_name.to_owned(),
                 valid: control_modes.clone(),
@@ -116,17 +127,14 @@ impl TaskEnv {
             ctrl.action_low().iter().map(|&v| v as f32).collect(),
             ctrl.action_high().iter().map(|&v| v as f32).collect(),
         );
-        let camera_cfgs = cfg
-            .camera_cfgs
-            .clone()
-            .unwrap_or_else(CameraConfig::panda_defaults);
+        let camera_cfgs = cfg.camera_cfgs.clone().unwrap_or_else(robot.cameras);
         for cam in &camera_cfgs {
             cam.validate()?;
         }
         let render_camera = cfg
             .render_camera
             .clone()
-            .unwrap_or_else(CameraConfig::render_camera);
+            .unwrap_or_else(robot.render_camera);
         render_camera.validate()?;
         #[cfg(not(feature = "render"))]
         let _ = render_camera;
