@@ -6,7 +6,8 @@
 //! | when | hook |
 //! |---|---|
 //! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
-//! | every reset, in this order | [`Task::initialize_actors`], robot reset (rest qpos + noise), [`Task::initialize_task`] |
+//! | every reset, in this order | [`Task::initialize_actors`], robot reset (rest qpos + noise), [`Task::initialize_agent`], [`Task::initialize_task`] |
+//! | every reset, first, when [`Task::rebuild_every_episode`] | [`Task::build_scene`] on a fresh world, with the episode's RNG (per-episode layouts) |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
@@ -59,6 +60,23 @@ pub trait Task: Any + Send {
         scene: &mut TaskScene,
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError>;
+
+    /// Adjusts the robot after its reset (e.g. an episode's own start configuration:
+    /// `scene.agent.set_joint_state`). Default: nothing.
+    fn initialize_agent(
+        &mut self,
+        _scene: &mut TaskScene,
+        _rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
+        Ok(())
+    }
+
+    /// Whether every episode builds a fresh world ([`Task::build_scene`] with the episode's
+    /// RNG), for tasks whose actors differ per episode (ManiSkill2 reconfigures on a new
+    /// episode layout). Default: `false` (the world is built at make and on `reconfigure`).
+    fn rebuild_every_episode(&self) -> bool {
+        false
+    }
 
     /// Samples task data (e.g. the goal) after actors and robot are placed.
     fn initialize_task(

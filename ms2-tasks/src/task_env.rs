@@ -272,6 +272,10 @@ impl EnvBackend for TaskEnv {
         self.task.max_dense_reward()
     }
 
+    fn rebuild_every_episode(&self) -> bool {
+        self.task.rebuild_every_episode()
+    }
+
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let mode = self.scene.agent.control_mode();
         self.scene = build_scene(
@@ -295,6 +299,7 @@ impl EnvBackend for TaskEnv {
         self.task.initialize_actors(&mut self.scene, rng)?;
         let TaskScene { world, agent } = &mut self.scene;
         agent.initialize(world.as_mut(), rng)?;
+        self.task.initialize_agent(&mut self.scene, rng)?;
         self.task.initialize_task(&self.scene, rng)?;
         // The previous episode's contact caches must not leak into this one: an episode is
         // determined by its seed alone.

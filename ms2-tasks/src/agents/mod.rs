@@ -10,6 +10,7 @@
 //! |---|---|---|
 //! | `panda` | Franka Panda, two-finger gripper, ManiSkill2's base pose | every mode of [`ms2_control::RobotConfig::panda`] |
 //! | `panda_bucket` | the Panda with a bucket fixed to its hand (soft-body tasks) | the same |
+//! | `panda_avoid_obstacles` | the Panda at the world origin with PandaAvoidObstacles' cameras (ManiSkill2's `PandaRealSensed435Config`) | the same as `panda` |
 //! | `xmate3_robotiq` | ROKAE xMate3 arm with a Robotiq two-finger gripper (ManiSkill2's second robot) | `pd_joint_pos` (default), `pd_joint_delta_pos` (also by ManiSkill2's name `arm_pd_joint_delta_pos`), `pd_ee_delta_pos`, `pd_ee_delta_pose` |
 //!
 //! Both robots are [`GripperArmAgent`]s: one agent type over the data of a
@@ -120,7 +121,12 @@ pub struct RobotSpec {
 }
 
 /// The registered robots.
-pub const ROBOTS: &[RobotSpec] = &[panda::PANDA, panda::PANDA_BUCKET, xmate3::XMATE3_ROBOTIQ];
+pub const ROBOTS: &[RobotSpec] = &[
+    panda::PANDA,
+    panda::PANDA_BUCKET,
+    panda::PANDA_AVOID_OBSTACLES,
+    xmate3::XMATE3_ROBOTIQ,
+];
 
 /// ManiSkill2's other names of control modes: `xmate3_robotiq` registers its joint-delta mode
 /// as `arm_pd_joint_delta_pos`.

@@ -47,9 +47,40 @@ pub const PANDA_BUCKET: RobotSpec = RobotSpec {
     },
 };
 
+/// The `panda_avoid_obstacles` robot: ManiSkill2's Panda of `PandaAvoidObstacles-v0`
+/// (`PandaRealSensed435Config`): the same Panda with its base at the world origin and that
+/// task's cameras.
+pub const PANDA_AVOID_OBSTACLES: RobotSpec = RobotSpec {
+    name: "panda_avoid_obstacles",
+    description: "the Panda at the world origin with the cameras of PandaAvoidObstacles-v0",
+    control_modes: panda_control_modes,
+    cameras: crate::sensors::CameraConfig::avoid_obstacles_defaults,
+    render_camera: crate::sensors::CameraConfig::avoid_obstacles_render_camera,
+    build: |world, mode, timing| {
+        let model = super::panda_model::panda_model()?;
+        let agent = GripperArmAgent::build(
+            world,
+            mode,
+            timing,
+            &model.desc,
+            &PANDA_AT_ORIGIN_MODEL,
+            "panda_avoid_obstacles",
+        )?;
+        Ok(Box::new(agent))
+    },
+};
+
+/// [`PANDA_MODEL`] with the base at the world origin.
+pub static PANDA_AT_ORIGIN_MODEL: GripperArmModel = GripperArmModel {
+    base_position: [0.0, 0.0, 0.0],
+    ..PANDA_MODEL_DATA
+};
+
 /// The Panda's facts: base at (-0.615, 0, 0), ManiSkill2's rest qpos, 7 arm joints, TCP
 /// `panda_hand_tcp`, fingers opening with +qpos, drives 1e3/1e2/100, finger friction 2.
-pub static PANDA_MODEL: GripperArmModel = GripperArmModel {
+pub static PANDA_MODEL: GripperArmModel = PANDA_MODEL_DATA;
+
+const PANDA_MODEL_DATA: GripperArmModel = GripperArmModel {
     robot_config: panda_robot_config,
     base_position: [-0.615, 0.0, 0.0],
     rest_qpos: &ms2_assets::PANDA_REST_QPOS,

@@ -178,6 +178,30 @@ impl CameraConfig {
         }
     }
 
+    /// The observation cameras of `PandaAvoidObstacles-v0` (ManiSkill2's): `base_camera` at
+    /// (-0.25, 0, 1.2) looking at (0.6, 0, 0.6) (128×128, fov π/2), and the Panda's
+    /// `hand_camera`.
+    pub fn avoid_obstacles_defaults() -> Vec<CameraConfig> {
+        let base = CameraConfig {
+            mount: CameraMount::World {
+                pose_world_from_camera: look_at_robotics([-0.25, 0.0, 1.2], [0.6, 0.0, 0.6]),
+            },
+            ..Self::base_camera()
+        };
+        vec![base, Self::hand_camera()]
+    }
+
+    /// The human render camera of `PandaAvoidObstacles-v0`: at (1.5, 0, 1.5) looking at
+    /// (0, 0, 0.5), facing the robot over the wall.
+    pub fn avoid_obstacles_render_camera() -> CameraConfig {
+        CameraConfig {
+            mount: CameraMount::World {
+                pose_world_from_camera: look_at_robotics([1.5, 0.0, 1.5], [0.0, 0.0, 0.5]),
+            },
+            ..Self::render_camera()
+        }
+    }
+
     /// Checks the size, field of view and clipping distances (the mount is checked when the
     /// camera is attached to a scene).
     pub fn validate(&self) -> Result<(), EnvError> {
