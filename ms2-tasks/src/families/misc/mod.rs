@@ -1,11 +1,13 @@
 //! Miscellaneous tasks: `PandaAvoidObstacles-v0`.
 //!
 //! [`obstacle_layout`] holds the episode layouts (ManiSkill2's file or ms2's generator);
-//! [`avoid_obstacles`] the task's hooks; [`solutions`] its motion-planning solution (feature
-//! `demos`).
+//! [`avoid_obstacles`] the task's hooks; [`solutions`] its motion-planning solution and
+//! [`scripted`] the scripted policy that plays it in any control mode (feature `demos`).
 
 pub mod avoid_obstacles;
 pub mod obstacle_layout;
+#[cfg(feature = "demos")]
+pub mod scripted;
 #[cfg(feature = "demos")]
 pub mod solutions;
 
@@ -42,7 +44,9 @@ pub fn register(r: &mut Registrar) {
         Ok(Box::new(AvoidObstacles::new(layout_source()?)))
     });
     #[cfg(feature = "demos")]
-    let registration = registration.solution(&solutions::AVOID_OBSTACLES);
+    let registration = registration
+        .solution(&solutions::AVOID_OBSTACLES)
+        .scripted(scripted::policy);
     r.add(registration);
 }
 

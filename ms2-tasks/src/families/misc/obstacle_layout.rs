@@ -8,7 +8,8 @@
 //!   origin). Used when present; a file that is there but unreadable is an error naming it.
 //! - **The procedural generator** otherwise ([`generate_layout`]): ms2's own distribution of the
 //!   same kind of scene (ManiSkill2 does not document the file's sampler): a goal configuration
-//!   reaching forward with the gripper pointing at a wall 9-15 cm behind the goal, and 6-10
+//!   reaching forward with the gripper pointing at a wall 9-15 cm behind the goal (0.8 m
+//!   high, 1.2 m wide, 4 cm thick), and 6-10
 //!   boxes (2-9 cm half sizes, random orientations) between the start and goal TCPs, each kept
 //!   off the arm's start and goal configurations (10 cm around every link origin and the
 //!   midpoints between them) so both ends are collision-free; whether a path exists between
@@ -200,8 +201,8 @@ pub fn generate_layout(rng: &mut EpisodeRng) -> ObstacleLayout {
     };
     let wall_x = goal_tcp.translation.vector.x + rng.random_range(0.09..0.15);
     let wall = BoxObstacle {
-        half_size: Vector3::new(0.02, 0.6, 0.5),
-        pose: Pose3::translation(wall_x + 0.02, 0.0, 0.5),
+        half_size: Vector3::new(0.02, 0.6, 0.4),
+        pose: Pose3::translation(wall_x + 0.02, 0.0, 0.4),
     };
     let count = rng.random_range(6..=10);
     let mut obstacles = Vec::with_capacity(count);
@@ -247,7 +248,7 @@ pub fn generate_layout(rng: &mut EpisodeRng) -> ObstacleLayout {
 }
 
 /// Draws goal configurations around [`GOAL_QPOS`] until the TCP is in the goal region (x in
-/// [0.45, 0.7] m, |y| ≤ 0.3 m, z in [0.25, 0.75] m) with the gripper pointing at +x within
+/// [0.45, 0.7] m, |y| ≤ 0.3 m, z in [0.25, 0.65] m) with the gripper pointing at +x within
 /// 45°; after 200 draws the nominal configuration.
 fn sample_goal_configuration(kin: &PandaKinematics, rng: &mut EpisodeRng) -> ([f64; 9], Pose3) {
     for _ in 0..200 {
@@ -260,7 +261,7 @@ fn sample_goal_configuration(kin: &PandaKinematics, rng: &mut EpisodeRng) -> ([f
         let approach = tcp.rotation * Vector3::z();
         if (0.45..=0.7).contains(&p.x)
             && p.y.abs() <= 0.3
-            && (0.25..=0.75).contains(&p.z)
+            && (0.25..=0.65).contains(&p.z)
             && approach.x >= std::f32::consts::FRAC_1_SQRT_2
         {
             return (q, tcp);

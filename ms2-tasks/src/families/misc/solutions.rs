@@ -6,19 +6,22 @@
 //!
 //! The planner keeps a [`SAFETY_MARGIN`] from every obstacle, so the executed motion (which
 //! tracks the plan with a small lag) does not brush them; a failed query is retried with other
-//! seeds ([`ATTEMPTS`]).
+//! seeds ([`ATTEMPTS`]), the last ones without the margin (goals closer than it to an
+//! obstacle).
 
 use std::time::Instant;
 
 use ms2_plan::parry3d::shape::SharedShape;
 use ms2_plan::{
-    CheckerOptions, CollisionScene, KinematicRobot, MotionPlanner, PlanError, PlannerConfig,
+    CheckerOptions, CollisionScene, KinematicRobot, MotionPlanner, PlanError, PlannedMotion,
+    PlannerConfig,
 };
 use nalgebra::Isometry3;
 
 use super::avoid_obstacles::AvoidObstacles;
 use crate::demos::solutions::driver::{Gripper, JointTargetDriver};
 use crate::demos::solutions::{Solution, SolveError, SolveTimings};
+use crate::env::Env;
 
 /// Clearance (m) the planned motion keeps from the obstacles, the wall and the ground.
 pub const SAFETY_MARGIN: f64 = 0.01;
@@ -62,6 +65,70 @@ fn collision_scene(task: &AvoidObstacles) -> Result<CollisionScene, PlanError> {
     Ok(scene)
 }
 
+/// Plans the reach of `env`'s current episode from the arm configuration `start` (rad): the
+/// goal pose through IK, RRT-Connect, shortcutting and TOPP-RA at the env's control frequency,
+/// retried with other seeds ([`ATTEMPTS`]). Counts queries and planning time in `timings`.
+///
+/// # Errors
+/// [`SolveError::Sensing`] for another env; [`SolveError::Plan`] when every attempt fails.
+pub fn plan_reach(
+    env: &Env,
+    panda: &KinematicRobot,
+    start: &[f64],
+    seed: u64,
+    timings: &mut SolveTimings,
+) -> Result<PlannedMotion, SolveError> {
+    let task = env
+        .task()
+        .and_then(|t| t.downcast_ref::<AvoidObstacles>())
+        .ok_or_else(|| SolveError::Sensing("not a PandaAvoidObstacles-v0 env".to_owned()))?;
+    let base = env
+        .task_scene()
+        .map(|s| s.agent.base_pose())
+        .ok_or_else(|| SolveError::Sensing("no robot".to_owned()))?;
+    let goal: Isometry3<f64> = nalgebra::convert(base.inverse() * task.goal());
+    let scene = collision_scene(task).map_err(|source| SolveError::Plan {
+        phase: "scene",
+        source,
+    })?;
+    let control_frequency = env.config().control_freq;
+    let t0 = Instant::now();
+    let mut last_error = PlanError::NoPathFound { iterations: 0 };
+    let mut motion = None;
+    for attempt in 0..ATTEMPTS {
+        let config = PlannerConfig {
+            seed: seed.wrapping_mul(16).wrapping_add(attempt),
+            control_frequency,
+            velocity_scale: SPEED_SCALE,
+            acceleration_scale: SPEED_SCALE,
+            checker: CheckerOptions {
+                margin: if attempt + 2 < ATTEMPTS {
+                    SAFETY_MARGIN
+                } else {
+                    0.0
+                },
+                self_collision: true,
+            },
+            ..PlannerConfig::default()
+        };
+        timings.planning_queries += 1;
+        match MotionPlanner::new(panda, config)
+            .and_then(|mut planner| planner.plan_to_pose(&scene, start, &goal))
+        {
+            Ok(m) => {
+                motion = Some(m);
+                break;
+            }
+            Err(e) => last_error = e,
+        }
+    }
+    timings.planning_seconds += t0.elapsed().as_secs_f64();
+    motion.ok_or(SolveError::Plan {
+        phase: "reach",
+        source: last_error,
+    })
+}
+
 impl Solution for AvoidObstaclesSolution {
     fn run(
         &self,
@@ -70,59 +137,8 @@ impl Solution for AvoidObstaclesSolution {
         seed: u64,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
-        let task = driver
-            .env()
-            .task()
-            .and_then(|t| t.downcast_ref::<AvoidObstacles>())
-            .ok_or_else(|| SolveError::Sensing("not a PandaAvoidObstacles-v0 env".to_owned()))?;
-        let base = driver
-            .env()
-            .task_scene()
-            .map(|s| s.agent.base_pose())
-            .ok_or_else(|| SolveError::Sensing("no robot".to_owned()))?;
-        let goal: Isometry3<f64> = nalgebra::convert(base.inverse() * task.goal());
-        let scene = collision_scene(task).map_err(|source| SolveError::Plan {
-            phase: "scene",
-            source,
-        })?;
         let start = driver.arm_target().to_vec();
-        let control_frequency = driver.env().config().control_freq;
-        let t0 = Instant::now();
-        let mut last_error = None;
-        let mut motion = None;
-        for attempt in 0..ATTEMPTS {
-            let config = PlannerConfig {
-                seed: seed.wrapping_mul(16).wrapping_add(attempt),
-                control_frequency,
-                velocity_scale: SPEED_SCALE,
-                acceleration_scale: SPEED_SCALE,
-                checker: CheckerOptions {
-                    margin: SAFETY_MARGIN,
-                    self_collision: true,
-                },
-                ..PlannerConfig::default()
-            };
-            timings.planning_queries += 1;
-            let planned = MotionPlanner::new(panda, config)
-                .and_then(|mut planner| planner.plan_to_pose(&scene, &start, &goal));
-            match planned {
-                Ok(m) => {
-                    motion = Some(m);
-                    break;
-                }
-                Err(e) => last_error = Some(e),
-            }
-        }
-        timings.planning_seconds += t0.elapsed().as_secs_f64();
-        let motion = match motion {
-            Some(m) => m,
-            None => {
-                return Err(SolveError::Plan {
-                    phase: "reach",
-                    source: last_error.unwrap_or(PlanError::NoPathFound { iterations: 0 }),
-                })
-            }
-        };
+        let motion = plan_reach(driver.env(), panda, &start, seed, timings)?;
         driver.follow(&motion.trajectory, Gripper::Open)?;
         driver.hold_until_success(SUCCESS_STEPS, Gripper::Open)
     }
