@@ -50,6 +50,17 @@ pub struct EnvConfig {
     /// `None` = the default scene. ms2 ships no background scenes, so any name is refused with
     /// [`EnvError::InvalidConfig`].
     pub bg_name: Option<String>,
+    /// Whether every env step starts from the flat state alone (default `false`).
+    ///
+    /// rapier carries solver history from one substep to the next (warm-start impulses and
+    /// the order of contact pairs). With `exact_restore`, each env step first drops that history
+    /// (as a reset does), so [`crate::Env::set_state`] into *any* env of the same build continues
+    /// bit for bit like the run the state was recorded from. It costs about 20 % of the state
+    /// step rate (PickCube / StackCube, 2026-11-24). Without it a restore into the *same* env is
+    /// still exact (recent states are snapshotted), an episode replayed from its first state is
+    /// exact, and a restore mid-episode into a fresh env drifts once objects touch (see
+    /// docs/trajectory_format.md, "Restoring states").
+    pub exact_restore: bool,
 }
 
 impl Default for EnvConfig {
@@ -69,6 +80,7 @@ impl Default for EnvConfig {
             enable_shadow: false,
             render_camera: None,
             bg_name: None,
+            exact_restore: false,
         }
     }
 }

@@ -51,6 +51,8 @@ pub(crate) struct TaskEnv {
     /// Whether the first directional light casts shadows (`enable_shadow`).
     #[cfg(feature = "render")]
     enable_shadow: bool,
+    /// [`crate::EnvConfig::exact_restore`].
+    exact_restore: bool,
     /// Cameras and render scene, built on the first render (state-only envs never render).
     #[cfg(feature = "render")]
     sensors: Mutex<Option<Sensors>>,
@@ -154,6 +156,7 @@ impl TaskEnv {
             render_camera,
             #[cfg(feature = "render")]
             enable_shadow: cfg.enable_shadow,
+            exact_restore: cfg.exact_restore,
             #[cfg(feature = "render")]
             sensors: Mutex::new(None),
         })
@@ -310,6 +313,12 @@ impl EnvBackend for TaskEnv {
     fn apply_action(&mut self, action: &[f32]) -> Result<(), EnvError> {
         let TaskScene { world, agent } = &mut self.scene;
         let world = world.as_mut();
+        // With `exact_restore`, every env step starts from the flat state alone (no warm-start
+        // impulses or contact pairs carried over from the previous step), so a state restored
+        // into any env of the same build continues exactly as the run it was recorded from.
+        if self.exact_restore {
+            world.forget_solver_history()?;
+        }
         agent.set_action(world, action)?;
         let mut soft = self.task.soft_mut();
         for _ in 0..self.substeps {
