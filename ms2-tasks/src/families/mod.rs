@@ -8,9 +8,11 @@
 //! |---|---|---|
 //! | [`rigid`] | `PickCube-v0`, `LiftCube-v0`, `StackCube-v0` | — |
 //! | [`soft`] | `Excavate-v0`, `Fill-v0` | `soft` |
+//! | [`misc`] | `PandaAvoidObstacles-v0` | — |
 //! | [`dummy`] | `Dummy-v0` (physics-free test env) | — |
 
 pub mod dummy;
+pub mod misc;
 pub mod rigid;
 #[cfg(feature = "soft")]
 pub mod soft;
@@ -22,5 +24,6 @@ pub(crate) fn register_builtin(r: &mut Registrar) {
     rigid::register(r);
     #[cfg(feature = "soft")]
     soft::register(r);
+    misc::register(r);
     dummy::register(r);
 }

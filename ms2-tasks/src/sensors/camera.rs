@@ -176,6 +176,65 @@ impl CameraConfig {
         vec![Self::base_camera(), Self::hand_camera()]
     }
 
+    /// The observation cameras of `xmate3_robotiq` (ManiSkill2's, mounted on the robot):
+    /// `base_camera` on `camera_base_link` (fixed in front of the robot, looking back down at
+    /// it) and `hand_camera` on `camera_hand_link` (the wrist), both 128×128, fov 1.5707,
+    /// near 0.01, far 10, at the link frame.
+    pub fn xmate3_defaults() -> Vec<CameraConfig> {
+        let on_link = |uid: &str, link: &str| CameraConfig {
+            uid: uid.to_owned(),
+            width: 128,
+            height: 128,
+            fov_y: 1.5707,
+            near: 0.01,
+            far: 10.0,
+            mount: CameraMount::RobotLink {
+                link: link.to_owned(),
+                pose_link_from_camera: Pose3::identity(),
+            },
+            segmentation: false,
+        };
+        vec![
+            on_link("base_camera", "camera_base_link"),
+            on_link("hand_camera", "camera_hand_link"),
+        ]
+    }
+
+    /// The human render camera of the `xmate3_robotiq` tasks: as [`Self::render_camera`] but
+    /// at (0.5, 0.5, 1.0) looking at (0, 0, 0.5) (ManiSkill2's, for the taller robot).
+    pub fn xmate3_render_camera() -> CameraConfig {
+        CameraConfig {
+            mount: CameraMount::World {
+                pose_world_from_camera: look_at_robotics([0.5, 0.5, 1.0], [0.0, 0.0, 0.5]),
+            },
+            ..Self::render_camera()
+        }
+    }
+
+    /// The observation cameras of `PandaAvoidObstacles-v0` (ManiSkill2's): `base_camera` at
+    /// (-0.25, 0, 1.2) looking at (0.6, 0, 0.6) (128×128, fov π/2), and the Panda's
+    /// `hand_camera`.
+    pub fn avoid_obstacles_defaults() -> Vec<CameraConfig> {
+        let base = CameraConfig {
+            mount: CameraMount::World {
+                pose_world_from_camera: look_at_robotics([-0.25, 0.0, 1.2], [0.6, 0.0, 0.6]),
+            },
+            ..Self::base_camera()
+        };
+        vec![base, Self::hand_camera()]
+    }
+
+    /// The human render camera of `PandaAvoidObstacles-v0`: at (1.5, 0, 1.5) looking at
+    /// (0, 0, 0.5), facing the robot over the wall.
+    pub fn avoid_obstacles_render_camera() -> CameraConfig {
+        CameraConfig {
+            mount: CameraMount::World {
+                pose_world_from_camera: look_at_robotics([1.5, 0.0, 1.5], [0.0, 0.0, 0.5]),
+            },
+            ..Self::render_camera()
+        }
+    }
+
     /// Checks the size, field of view and clipping distances (the mount is checked when the
     /// camera is attached to a scene).
     pub fn validate(&self) -> Result<(), EnvError> {
