@@ -6,7 +6,8 @@
 //! | when | hook |
 //! |---|---|
 //! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
-//! | every reset, in this order | [`Task::initialize_actors`], robot reset (rest qpos + noise), [`Task::initialize_task`] |
+//! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_agent`] (default: rest qpos + noise), [`Task::initialize_task`] |
+//! | every reset, when [`Task::reconfigure_every_reset`] | [`Task::build_scene`] first |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
@@ -59,6 +60,25 @@ pub trait Task: Any + Send {
         scene: &mut TaskScene,
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError>;
+
+    /// Puts the robot at its episode start (after [`Task::initialize_actors`]). The default is
+    /// the agent's own reset (rest qpos plus noise); a task with another start posture (e.g.
+    /// PegInsertionSide's turned hand) overrides it.
+    fn initialize_agent(
+        &mut self,
+        scene: &mut TaskScene,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
+        let TaskScene { world, agent } = scene;
+        agent.initialize(world.as_mut(), rng)
+    }
+
+    /// Whether every reset rebuilds the scene ([`Task::build_scene`] with the episode's RNG),
+    /// as ManiSkill2 does for tasks whose geometry is drawn per episode (PegInsertionSide's
+    /// peg and hole sizes). Default: only when the caller asks for it.
+    fn reconfigure_every_reset(&self) -> bool {
+        false
+    }
 
     /// Samples task data (e.g. the goal) after actors and robot are placed.
     fn initialize_task(

@@ -264,6 +264,10 @@ impl EnvBackend for TaskEnv {
         self.task.max_dense_reward()
     }
 
+    fn reconfigures_every_reset(&self) -> bool {
+        self.task.reconfigure_every_reset()
+    }
+
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let mode = self.scene.agent.control_mode();
         self.scene = build_scene(
@@ -285,8 +289,7 @@ impl EnvBackend for TaskEnv {
 
     fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         self.task.initialize_actors(&mut self.scene, rng)?;
-        let TaskScene { world, agent } = &mut self.scene;
-        agent.initialize(world.as_mut(), rng)?;
+        self.task.initialize_agent(&mut self.scene, rng)?;
         self.task.initialize_task(&self.scene, rng)?;
         // The previous episode's contact caches must not leak into this one: an episode is
         // determined by its seed alone.

@@ -1,0 +1,54 @@
+//! Assembly with real clearances: `PegInsertionSide-v0` (so far; PlugCharger-v0 and
+//! AssemblingKits-v0 are to follow in this folder).
+//!
+//! [`common`] holds what the assembly tasks share (box actors whose collision shapes are their
+//! visual shapes, walls around an opening built from convex boxes, the turned-hand Panda start,
+//! grasp-orientation measures); each task is its geometry, hooks and spec; [`scripted`] is the
+//! family's oracle policy.
+
+pub mod common;
+pub mod peg_insertion_side;
+pub mod scripted;
+
+pub use peg_insertion_side::PegInsertionSide;
+
+use crate::registry::{Registrar, TaskRegistration};
+use crate::spec::{RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE, RIGID_OBS_MODES};
+
+/// The assembly tasks' robots: the Panda.
+const PANDA_ONLY: &[RobotChoice] = &[RobotChoice::same("panda")];
+
+/// The spec shared by the assembly tasks (ManiSkill2's: 200 steps, the Panda,
+/// `pd_joint_delta_pos` by default, only the TCP pose known in visual modes).
+const fn assembly_spec(env_id: &'static str, summary: &'static str) -> TaskSpec {
+    TaskSpec {
+        env_id,
+        family: "assembly",
+        summary,
+        max_episode_steps: 200,
+        robots: PANDA_ONLY,
+        control_modes: &[],
+        default_control_mode: DEFAULT_CONTROL_MODE,
+        obs_modes: RIGID_OBS_MODES,
+        non_privileged_extra_keys: &["tcp_pose"],
+        goal_marker: None,
+        soft_bodies: false,
+        assets: &[],
+    }
+}
+
+/// `PegInsertionSide-v0`'s spec.
+pub const PEG_INSERTION_SIDE: TaskSpec = assembly_spec(
+    "PegInsertionSide-v0",
+    "insert a peg into the hole in the side of a box (3 mm clearance)",
+);
+
+/// Registers the family.
+pub fn register(r: &mut Registrar) {
+    r.add(
+        TaskRegistration::new(PEG_INSERTION_SIDE, |_| {
+            Ok(Box::<PegInsertionSide>::default())
+        })
+        .scripted(scripted::peg_insertion_policy),
+    );
+}
