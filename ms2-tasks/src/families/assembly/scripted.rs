@@ -28,6 +28,11 @@ const LIFT_HEIGHT: f32 = 0.1;
 const CLOSE_STEPS: u32 = 8;
 /// Distance (m) in front of the opening from which the part is pushed in.
 const PRE_INSERT_GAP: f32 = 0.04;
+/// Fraction of the part's remaining sideways error (across the opening's axis) added to the
+/// hand's target per control step: an integral term that removes the sag of the loaded arm.
+const SAG_GAIN: f32 = 0.3;
+/// Largest sag correction (m).
+const MAX_SAG_CORRECTION: f32 = 0.02;
 /// Alignment (m, rad) needed before pushing in.
 const ALIGN_TOLERANCE: (f32, f32) = (0.002, 0.02);
 
@@ -91,6 +96,8 @@ pub struct InsertionPolicy {
     /// The grasp's rotation of the TCP in the part's frame, chosen once per episode.
     grasp_rotation: Option<UnitQuaternion<f32>>,
     lift_from: Option<Pose3>,
+    /// Integrated correction (m, world) of the hand's target across the opening's axis.
+    sag_correction: Vector3<f32>,
 }
 
 impl InsertionPolicy {
@@ -103,12 +110,26 @@ impl InsertionPolicy {
             steps_in_phase: 0,
             grasp_rotation: None,
             lift_from: None,
+            sag_correction: Vector3::zeros(),
         }
     }
 
     fn goto(&mut self, phase: Phase) {
         self.phase = phase;
         self.steps_in_phase = 0;
+    }
+
+    /// Integrates the part's sideways error from `wanted` (its pose, world) across the axis of
+    /// `goal` into [`InsertionPolicy::sag_correction`].
+    fn correct_sag(&mut self, goal: &InsertionGoal, wanted: &Pose3) {
+        let axis = goal.inserted.rotation * Vector3::x();
+        let error = wanted.translation.vector - goal.part.translation.vector;
+        let sideways = error - axis * axis.dot(&error);
+        self.sag_correction += SAG_GAIN * sideways;
+        let n = self.sag_correction.norm();
+        if n > MAX_SAG_CORRECTION {
+            self.sag_correction *= MAX_SAG_CORRECTION / n;
+        }
     }
 }
 
@@ -154,6 +175,7 @@ impl ScriptedPolicy for InsertionPolicy {
         self.goto(Phase::Approach);
         self.grasp_rotation = None;
         self.lift_from = None;
+        self.sag_correction = Vector3::zeros();
     }
 
     fn act(&mut self, env: &Env) -> Vec<f32> {
@@ -219,6 +241,9 @@ impl ScriptedPolicy for InsertionPolicy {
                 if aligned {
                     self.goto(Phase::Insert);
                 }
+                if off.translation.x.abs() < 0.02 {
+                    self.correct_sag(&goal, &before);
+                }
                 (target, GRIPPER_CLOSED, MAX_STEP)
             }
             Phase::Insert => {
@@ -226,10 +251,25 @@ impl ScriptedPolicy for InsertionPolicy {
                 let off = goal.inserted.inverse() * part;
                 let along = (off.translation.x + INSERT_STEP).min(0.0);
                 let next = goal.inserted * Translation3::new(along, 0.0, 0.0);
+                self.correct_sag(&goal, &next);
                 (next * part_from_tcp, GRIPPER_CLOSED, INSERT_STEP)
             }
         };
-        let target = limited(&tcp, &target, step);
+        if std::env::var("MS2_DEBUG_POLICY").is_ok() {
+            let off = goal.inserted.inverse() * part;
+            eprintln!(
+                "{:?} {} off {:.4?} ang {:.3} part_from_tcp {:.4?}",
+                self.phase,
+                self.steps_in_phase,
+                off.translation.vector.as_slice(),
+                off.rotation.angle(),
+                part_from_tcp.translation.vector.as_slice()
+            );
+        }
+        let mut target = limited(&tcp, &target, step);
+        if matches!(self.phase, Phase::Align | Phase::Insert) {
+            target.translation.vector += self.sag_correction;
+        }
         self.oracle.action(env, &target, fingers)
     }
 }
