@@ -4,11 +4,13 @@
 //! [`common`] holds what the assembly tasks share (box actors whose collision shapes are their
 //! visual shapes, walls around an opening built from convex boxes, the turned-hand Panda start,
 //! grasp-orientation measures); each task is its geometry, hooks and spec; [`scripted`] is the
-//! family's oracle policy.
+//! family's oracle policy and [`solutions`] its motion-planning solutions (feature `demos`).
 
 pub mod common;
 pub mod peg_insertion_side;
 pub mod scripted;
+#[cfg(feature = "demos")]
+pub mod solutions;
 
 pub use peg_insertion_side::PegInsertionSide;
 
@@ -45,10 +47,11 @@ pub const PEG_INSERTION_SIDE: TaskSpec = assembly_spec(
 
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
-    r.add(
-        TaskRegistration::new(PEG_INSERTION_SIDE, |_| {
-            Ok(Box::<PegInsertionSide>::default())
-        })
-        .scripted(scripted::peg_insertion_policy),
-    );
+    let registration = TaskRegistration::new(PEG_INSERTION_SIDE, |_| {
+        Ok(Box::<PegInsertionSide>::default())
+    })
+    .scripted(scripted::peg_insertion_policy);
+    #[cfg(feature = "demos")]
+    let registration = registration.solution(&solutions::PEG_INSERTION_SIDE);
+    r.add(registration);
 }

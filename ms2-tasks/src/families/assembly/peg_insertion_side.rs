@@ -123,8 +123,8 @@ impl PegGeometry {
         Ok((peg, block))
     }
 
-    /// The block's walls around the hole.
-    fn block_parts(&self) -> Vec<BoxPart> {
+    /// The block's walls around the hole (block frame).
+    pub fn block_parts(&self) -> Vec<BoxPart> {
         let l = self.length();
         walls_around_opening(
             l,
