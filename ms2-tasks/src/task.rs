@@ -15,6 +15,8 @@
 
 use std::any::Any;
 
+use ms2_physics::SolverConfig;
+
 use crate::agents::Agent;
 use crate::error::EnvError;
 use crate::info::Evaluation;
@@ -78,6 +80,13 @@ pub trait Task: Any + Send {
     /// peg and hole sizes). Default: only when the caller asks for it.
     fn reconfigure_every_reset(&self) -> bool {
         false
+    }
+
+    /// The physics solver settings of the task's worlds, given ms2's defaults (a task whose
+    /// contacts need other settings, e.g. PlugCharger's 0.5 mm clearance a shorter contact
+    /// prediction distance, changes them here). Read once when the env is made.
+    fn solver_config(&self, defaults: SolverConfig) -> SolverConfig {
+        defaults
     }
 
     /// Samples task data (e.g. the goal) after actors and robot are placed.

@@ -97,9 +97,11 @@ impl TaskEnv {
             control_freq_hz: cfg.control_freq,
             sim_freq_hz: cfg.sim_freq,
         };
+        let defaults = WorldConfig::default();
         let world_config = WorldConfig {
             timestep: (1.0 / cfg.sim_freq) as f32,
-            ..WorldConfig::default()
+            solver: task.solver_config(defaults.solver),
+            ..defaults
         };
         let mut rng = episode_rng(BUILD_SEED);
         let scene = build_scene(

@@ -11,6 +11,7 @@
 
 use ms2_physics::{BodyId, WorldConfig};
 use ms2_tasks::families::assembly::peg_insertion_side::PegGeometry;
+use ms2_tasks::families::assembly::plug_charger::{self, add_plug_and_socket};
 use ms2_tasks::geometry::{pose_xyz_yaw, Pose3};
 use ms2_tasks::rigid_world::rapier::RapierEngine;
 use ms2_tasks::{RigidEngine, RigidWorld};
@@ -43,6 +44,11 @@ impl Hand {
         Self {
             mass: 1000.0 * 8.0 * h.x * h.y * h.z,
         }
+    }
+
+    /// A grip on a body of `mass` (kg).
+    fn with_mass(mass: f32) -> Self {
+        Self { mass }
     }
 
     fn drive(&self, world: &mut dyn RigidWorld, body: BodyId, target: &Pose3) {
@@ -304,6 +310,72 @@ fn a_peg_resting_in_the_hole_does_not_jitter() {
         assert!(
             head.x > -0.01,
             "{g:?}: the peg slid out of the hole ({head:?})"
+        );
+    }
+}
+
+/// The charger's pose (receptacle frame) with its prongs' tips at `x` along the slots' axis
+/// (−x of the receptacle; 0 = the receptacle's face, fully plugged in when the charger's frame
+/// is at the face), shifted by `lateral` (y, z).
+fn charger_at(receptacle: &Pose3, depth: f32, lateral: [f32; 2]) -> Pose3 {
+    let turn = nalgebra::UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f32::consts::PI);
+    let tip = 2.0 * plug_charger::PRONG_HALF_SIZE[0];
+    receptacle * Pose3::from_parts(Translation3::new(tip - depth, lateral[0], lateral[1]), turn)
+}
+
+/// Pushes the charger from `start` to `end` (depth of the prong tips past the receptacle's
+/// face, m) at `speed` for `seconds`; returns the depths after every step.
+fn push_charger(lateral: [f32; 2], start: f32, end: f32, speed: f32, seconds: f32) -> Vec<f32> {
+    let mut config = WorldConfig::default();
+    // PlugCharger's setting (ms2's default 2 mm stops the charger at the face).
+    config.solver.prediction_distance = plug_charger::PREDICTION_DISTANCE;
+    let mut world = RapierEngine.new_world(&config).unwrap();
+    let (charger, receptacle) = add_plug_and_socket(world.as_mut()).unwrap();
+    let socket = pose_xyz_yaw([0.05, 0.0, 0.1], std::f32::consts::PI + 0.2);
+    world.set_body_pose(receptacle, &socket).unwrap();
+    let mass: f32 = plug_charger::charger_parts()
+        .iter()
+        .map(|b| 8000.0 * b.half.x * b.half.y * b.half.z)
+        .sum();
+    let hand = Hand::with_mass(mass);
+    world
+        .set_body_pose(charger, &charger_at(&socket, start, lateral))
+        .unwrap();
+    let dt = world.timestep();
+    let steps = (seconds / dt).round() as usize;
+    let mut depths = Vec::with_capacity(steps);
+    for i in 0..steps {
+        let d = (start + speed * dt * (i + 1) as f32).min(end);
+        hand.drive(world.as_mut(), charger, &charger_at(&socket, d, lateral));
+        world.step();
+        let tip = socket.inverse() * world.body_pose(charger).unwrap();
+        depths.push(2.0 * plug_charger::PRONG_HALF_SIZE[0] - tip.translation.x);
+    }
+    depths
+}
+
+#[test]
+fn a_charger_pushed_straight_in_at_half_a_millimetre_plugs_in_fully() {
+    let tip = 2.0 * plug_charger::PRONG_HALF_SIZE[0];
+    let depths = push_charger([0.0, 0.0], -0.01, tip, 0.05, 1.5);
+    let end = *depths.last().unwrap();
+    eprintln!("charger: prong tips {end:.5} m deep (full depth {tip:.5})");
+    assert!(
+        end > tip - 0.001,
+        "the charger stopped with its prongs {end:.4} m deep, full depth is {tip:.4}"
+    );
+}
+
+#[test]
+fn a_charger_1mm_off_the_slots_is_stopped_by_the_face() {
+    let tip = 2.0 * plug_charger::PRONG_HALF_SIZE[0];
+    for lateral in [[0.001, 0.0], [0.0, 0.001]] {
+        let depths = push_charger(lateral, -0.01, tip, 0.05, 1.0);
+        let deepest = depths.iter().copied().fold(f32::MIN, f32::max);
+        eprintln!("charger off by {lateral:?}: deepest {deepest:.5} m");
+        assert!(
+            deepest < 0.001,
+            "off by {lateral:?} the prongs went {deepest:.4} m into the face"
         );
     }
 }

@@ -1,5 +1,5 @@
-//! Assembly with real clearances: `PegInsertionSide-v0` (so far; PlugCharger-v0 and
-//! AssemblingKits-v0 are to follow in this folder).
+//! Assembly with real clearances: `PegInsertionSide-v0`, `PlugCharger-v0` (AssemblingKits-v0
+//! is to follow in this folder).
 //!
 //! [`common`] holds what the assembly tasks share (box actors whose collision shapes are their
 //! visual shapes, walls around an opening built from convex boxes, the turned-hand Panda start,
@@ -8,11 +8,13 @@
 
 pub mod common;
 pub mod peg_insertion_side;
+pub mod plug_charger;
 pub mod scripted;
 #[cfg(feature = "demos")]
 pub mod solutions;
 
 pub use peg_insertion_side::PegInsertionSide;
+pub use plug_charger::PlugCharger;
 
 use crate::registry::{Registrar, TaskRegistration};
 use crate::spec::{RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE, RIGID_OBS_MODES};
@@ -45,6 +47,12 @@ pub const PEG_INSERTION_SIDE: TaskSpec = assembly_spec(
     "insert a peg into the hole in the side of a box (3 mm clearance)",
 );
 
+/// `PlugCharger-v0`'s spec.
+pub const PLUG_CHARGER: TaskSpec = assembly_spec(
+    "PlugCharger-v0",
+    "plug a two-prong charger into its receptacle (0.5 mm clearance)",
+);
+
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
     let registration = TaskRegistration::new(PEG_INSERTION_SIDE, |_| {
@@ -53,5 +61,11 @@ pub fn register(r: &mut Registrar) {
     .scripted(scripted::peg_insertion_policy);
     #[cfg(feature = "demos")]
     let registration = registration.solution(&solutions::PEG_INSERTION_SIDE);
+    r.add(registration);
+
+    let registration = TaskRegistration::new(PLUG_CHARGER, |_| Ok(Box::<PlugCharger>::default()))
+        .scripted(scripted::plug_charger_policy);
+    #[cfg(feature = "demos")]
+    let registration = registration.solution(&solutions::PLUG_CHARGER);
     r.add(registration);
 }

@@ -72,6 +72,25 @@ fn peg_goal(obs: &ObsValue) -> Option<InsertionGoal> {
     })
 }
 
+/// PlugCharger's goal: the charger onto the receptacle's goal pose, grasped 2.5 cm behind its
+/// front face.
+fn charger_goal(obs: &ObsValue) -> Option<InsertionGoal> {
+    Some(InsertionGoal {
+        part: pose_at(obs, "extra/charger_pose")?,
+        inserted: pose_at(obs, "extra/goal_pose")?,
+        grasp_point: Vector3::new(-0.025, 0.0, 0.0),
+        entry_distance: 2.0 * super::plug_charger::PRONG_HALF_SIZE[0],
+    })
+}
+
+/// The scripted policy of `PlugCharger-v0`.
+pub fn plug_charger_policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
+    Ok(Box::new(InsertionPolicy::new(
+        charger_goal,
+        tcp_oracle(env)?,
+    )))
+}
+
 /// The scripted policy of `PegInsertionSide-v0`.
 pub fn peg_insertion_policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
     Ok(Box::new(InsertionPolicy::new(peg_goal, tcp_oracle(env)?)))

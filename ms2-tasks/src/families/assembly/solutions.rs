@@ -15,6 +15,7 @@ use ms2_plan::{
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
 use super::peg_insertion_side::PegInsertionSide;
+use super::plug_charger::{self, PlugCharger};
 use crate::demos::solutions::driver::{Gripper, JointTargetDriver};
 use crate::demos::solutions::scene::{BASE_LINK, GROUND};
 use crate::demos::solutions::{Solution, SolveError, SolveTimings};
@@ -35,8 +36,6 @@ const CLOSE_STEPS: u32 = 8;
 const SETTLE_TOLERANCE: f64 = 0.003;
 /// Most env steps spent waiting for the arm to settle.
 const SETTLE_MAX_STEPS: u32 = 15;
-/// Sideways error (m) of the part below which no further correction is made.
-const ALIGNED: f64 = 0.0007;
 /// Most sag corrections before pushing in.
 const MAX_CORRECTIONS: u32 = 4;
 /// Consecutive successful steps that end an episode.
@@ -67,6 +66,9 @@ pub struct InsertionWorld {
     /// Distance along the part's x from the inserted pose to where its leading end reaches the
     /// opening's entrance.
     pub entry_distance: f64,
+    /// Sideways error (m) of the lined-up part below which it is pushed in (a fraction of the
+    /// clearance).
+    pub aligned: f64,
 }
 
 /// An assembly task's solution: its env id and how to sense it.
@@ -84,6 +86,66 @@ pub const PEG_INSERTION_SIDE: InsertionSolution = InsertionSolution {
     sense: sense_peg_insertion,
 };
 
+/// The solution of `PlugCharger-v0`.
+pub const PLUG_CHARGER: InsertionSolution = InsertionSolution {
+    env_id: "PlugCharger-v0",
+    sense: sense_plug_charger,
+};
+
+/// Poses the boxes `parts` of a body at `pose_base_from_body` as named obstacles.
+fn posed_boxes(
+    name: &str,
+    pose_base_from_body: &Isometry3<f64>,
+    parts: &[super::common::BoxPart],
+) -> Vec<(String, OrientedBox)> {
+    parts
+        .iter()
+        .enumerate()
+        .map(|(i, part)| {
+            (
+                format!("{name}_{i}"),
+                OrientedBox {
+                    pose_base_from_box: pose_base_from_body
+                        * Translation3::from(part.center.cast::<f64>()),
+                    half_extents: part.half.cast(),
+                },
+            )
+        })
+        .collect()
+}
+
+fn sense_plug_charger(env: &Env) -> Result<InsertionWorld, SolveError> {
+    let (scene, task) = env
+        .task_scene()
+        .zip(env.task())
+        .ok_or_else(|| SolveError::Sensing("the env has no robot".to_owned()))?;
+    let task = task
+        .downcast_ref::<PlugCharger>()
+        .ok_or_else(|| SolveError::Sensing("not a PlugCharger task".to_owned()))?;
+    let world = scene.world.as_ref();
+    let base_from_world = scene.agent.base_pose().inverse().cast::<f64>();
+    let receptacle = base_from_world * body_pose(world, task.receptacle()).cast::<f64>();
+    // The part is the charger's bounding box: from the base's back to the prongs' tips.
+    let [bx, by, bz] = plug_charger::BASE_HALF_SIZE.map(f64::from);
+    let tip = 2.0 * f64::from(plug_charger::PRONG_HALF_SIZE[0]);
+    let half_x = 0.5 * (2.0 * bx + tip);
+    let box_from_charger = Translation3::new(0.5 * tip - bx, 0.0, 0.0);
+    let charger = base_from_world * body_pose(world, task.charger()).cast::<f64>();
+    let goal = base_from_world * task.goal_pose(world).cast::<f64>();
+    Ok(InsertionWorld {
+        part: OrientedBox {
+            pose_base_from_box: charger * box_from_charger,
+            half_extents: Vector3::new(half_x, by, bz),
+        },
+        obstacles: posed_boxes("receptacle", &receptacle, &plug_charger::receptacle_parts()),
+        inserted: goal * box_from_charger,
+        // 2.5 cm behind the charger's front face, in the box's frame.
+        grasp_point: Vector3::new(-0.025 - box_from_charger.x, 0.0, 0.0),
+        entry_distance: tip,
+        aligned: 0.0002,
+    })
+}
+
 fn sense_peg_insertion(env: &Env) -> Result<InsertionWorld, SolveError> {
     let (scene, task) = env
         .task_scene()
@@ -96,22 +158,7 @@ fn sense_peg_insertion(env: &Env) -> Result<InsertionWorld, SolveError> {
     let base_from_world = scene.agent.base_pose().inverse().cast::<f64>();
     let g = task.geometry();
     let block = body_pose(world, task.block()).cast::<f64>();
-    let obstacles = g
-        .block_parts()
-        .into_iter()
-        .enumerate()
-        .map(|(i, part)| {
-            (
-                format!("block_{i}"),
-                OrientedBox {
-                    pose_base_from_box: base_from_world
-                        * block
-                        * Translation3::from(part.center.cast::<f64>()),
-                    half_extents: part.half.cast(),
-                },
-            )
-        })
-        .collect();
+    let obstacles = posed_boxes("block", &(base_from_world * block), &g.block_parts());
     let inserted =
         base_from_world * task.goal_pose(world).cast::<f64>() * Translation3::new(0.005, 0.0, 0.0);
     Ok(InsertionWorld {
@@ -123,6 +170,7 @@ fn sense_peg_insertion(env: &Env) -> Result<InsertionWorld, SolveError> {
         inserted,
         grasp_point: Vector3::new(-0.055, 0.0, 0.0),
         entry_distance: f64::from(g.length()),
+        aligned: 0.0007,
     })
 }
 
@@ -340,7 +388,7 @@ impl Solution for InsertionSolution {
                     (before.inverse() * part_now).translation.vector.as_slice()
                 );
             }
-            if sideways_error(&before, &part_now, grasped.entry_distance) < ALIGNED {
+            if sideways_error(&before, &part_now, grasped.entry_distance) < grasped.aligned {
                 break;
             }
             tcp_target = before * part_now.inverse() * tcp_target;
@@ -355,7 +403,9 @@ impl Solution for InsertionSolution {
         // axis (the part may touch the walls of its opening).
         let mut inserting =
             collision_scene(&grasped, ground, false).map_err(plan_error("insert"))?;
-        inserting.remove_object(PART).map_err(plan_error("insert"))?;
+        inserting
+            .remove_object(PART)
+            .map_err(plan_error("insert"))?;
         let mut planner = self.planner(&holding, driver, seed, 2, INSERT_SPEED_SCALE)?;
         let _ = tcp_target;
         while !driver.env().evaluate().success {
