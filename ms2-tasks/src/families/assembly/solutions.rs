@@ -298,7 +298,9 @@ impl Solution for InsertionSolution {
         let part_pose = sensed.part.pose_base_from_box;
 
         // Grasp from above, across the part's axis, behind its centre.
-        let rot_now = part_pose.rotation.inverse() * panda.tcp_pose(&start).rotation;
+        // The grasp whose hand, once the part is inserted, is turned least from the hand's
+        // start (the other one may need the wrist beyond its limits there).
+        let rot_now = sensed.inserted.rotation.inverse() * panda.tcp_pose(&start).rotation;
         let mut planner = self.planner(panda, driver, seed, 0, SPEED_SCALE)?;
         let mut reached = None;
         let mut last = PlanError::NoPathFound { iterations: 0 };
@@ -418,7 +420,7 @@ impl Solution for InsertionSolution {
             let wanted = grasped.inserted * Translation3::new(next, 0.0, 0.0);
             let tcp = wanted * part_now.inverse() * holding.tcp_pose(driver.arm_target());
             let segment = timed(timings, || {
-                planner.plan_screw(&inserting, driver.arm_target(), &tcp)
+                move_to_pose(&mut planner, &inserting, driver.arm_target(), &tcp)
             })
             .map_err(plan_error("insert"))?;
             driver.follow(&segment.trajectory, Gripper::Closed)?;
