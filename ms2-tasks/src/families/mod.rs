@@ -7,7 +7,7 @@
 //! | family | tasks | feature |
 //! |---|---|---|
 //! | [`rigid`] | `PickCube-v0`, `LiftCube-v0`, `StackCube-v0` | — |
-//! | [`assembly`] | `PegInsertionSide-v0` | — |
+//! | [`assembly`] | `PegInsertionSide-v0`, `PlugCharger-v0` | — |
 //! | [`soft`] | `Excavate-v0`, `Fill-v0` | `soft` |
 //! | [`dummy`] | `Dummy-v0` (physics-free test env) | — |
 
