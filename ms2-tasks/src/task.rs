@@ -89,6 +89,13 @@ pub trait Task: Any + Send {
         defaults
     }
 
+    /// The task's own world-fixed camera views, `(uid, eye, target)` (m, world): ManiSkill2
+    /// places `base_camera` and `render_camera` per task. Each replaces the pose of the default
+    /// camera of that uid (looking from `eye` at `target`) when the user configures none.
+    fn camera_views(&self) -> Vec<(&'static str, [f32; 3], [f32; 3])> {
+        Vec::new()
+    }
+
     /// Samples task data (e.g. the goal) after actors and robot are placed.
     fn initialize_task(
         &mut self,

@@ -118,17 +118,20 @@ impl TaskEnv {
             ctrl.action_low().iter().map(|&v| v as f32).collect(),
             ctrl.action_high().iter().map(|&v| v as f32).collect(),
         );
-        let camera_cfgs = cfg
-            .camera_cfgs
-            .clone()
-            .unwrap_or_else(CameraConfig::panda_defaults);
+        let views = task.camera_views();
+        let camera_cfgs = cfg.camera_cfgs.clone().unwrap_or_else(|| {
+            CameraConfig::panda_defaults()
+                .into_iter()
+                .map(|cam| with_task_view(cam, &views))
+                .collect()
+        });
         for cam in &camera_cfgs {
             cam.validate()?;
         }
         let render_camera = cfg
             .render_camera
             .clone()
-            .unwrap_or_else(CameraConfig::render_camera);
+            .unwrap_or_else(|| with_task_view(CameraConfig::render_camera(), &views));
         render_camera.validate()?;
         #[cfg(not(feature = "render"))]
         let _ = render_camera;
@@ -231,6 +234,20 @@ fn sync_particles(task: &dyn Task, sensors: &mut Sensors) -> Result<(), EnvError
 #[cfg(feature = "render")]
 fn poisoned<T>(_: std::sync::PoisonError<T>) -> EnvError {
     EnvError::Render("sensor lock poisoned by an earlier panic".to_owned())
+}
+
+/// `cam` looking from the task's view of its uid, if the task has one
+/// ([`Task::camera_views`]).
+fn with_task_view(
+    mut cam: CameraConfig,
+    views: &[(&'static str, [f32; 3], [f32; 3])],
+) -> CameraConfig {
+    if let Some((_, eye, target)) = views.iter().find(|(uid, ..)| *uid == cam.uid) {
+        cam.mount = crate::sensors::camera::CameraMount::World {
+            pose_world_from_camera: crate::sensors::camera::look_at_robotics(*eye, *target),
+        };
+    }
+    cam
 }
 
 /// A fresh world with the ground, the robot and the task's actors.

@@ -218,6 +218,13 @@ impl Task for PegInsertionSide {
         true
     }
 
+    fn camera_views(&self) -> Vec<(&'static str, [f32; 3], [f32; 3])> {
+        vec![
+            ("base_camera", [0.0, -0.3, 0.2], [0.0, 0.0, 0.1]),
+            ("render_camera", [0.5, -0.5, 0.8], [0.05, -0.1, 0.4]),
+        ]
+    }
+
     fn build_scene(
         &mut self,
         world: &mut dyn RigidWorld,

@@ -6,7 +6,8 @@
 //!   `[0.01, 0.05, 0.05]` (its frame at its front face, the plate behind it) with two slots cut
 //!   through it, each 0.5 mm wider than a prong on every side, built from five convex boxes
 //!   (the gold slot linings are drawn only).
-//! - Reset: charger on the ground at xy ~ U([−0.1, −0.2], [−0.026, 0.2]), yaw ~ U(−π/3, π/3);
+//! - Reset (the scene is rebuilt at every reset, see `reconfigure_every_reset`): charger on
+//!   the ground at xy ~ U([−0.1, −0.2], [−0.026, 0.2]), yaw ~ U(−π/3, π/3);
 //!   receptacle at xy ~ U([0.01, −0.1], [0.1, 0.1]), z = 0.1, yaw π + U(−π/8, π/8).
 //! - Goal: the receptacle's frame turned by π about z (the charger's pose when plugged in).
 //! - Success: charger within 5 mm and 0.2 rad of the goal.
@@ -166,11 +167,26 @@ impl Task for PlugCharger {
         MAX_DENSE_REWARD
     }
 
+    /// ManiSkill2 keeps the scene between resets; ms2 rebuilds it: moving the static receptacle
+    /// leaves rapier's broad phase in a state that depends on earlier episodes (the first
+    /// episode after a rebuild differs from later ones with the same seed by ~1e-8), and an
+    /// episode must depend on its seed alone. A rebuild costs ~15 ms.
+    fn reconfigure_every_reset(&self) -> bool {
+        true
+    }
+
     fn solver_config(&self, defaults: SolverConfig) -> SolverConfig {
         SolverConfig {
             prediction_distance: PREDICTION_DISTANCE,
             ..defaults
         }
+    }
+
+    fn camera_views(&self) -> Vec<(&'static str, [f32; 3], [f32; 3])> {
+        vec![
+            ("base_camera", [-0.3, 0.0, 0.1], [0.0, 0.0, 0.1]),
+            ("render_camera", [-0.3, -0.4, 0.2], [0.0, 0.0, 0.1]),
+        ]
     }
 
     fn build_scene(

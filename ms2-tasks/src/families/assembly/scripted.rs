@@ -274,17 +274,6 @@ impl ScriptedPolicy for InsertionPolicy {
                 (next * part_from_tcp, GRIPPER_CLOSED, INSERT_STEP)
             }
         };
-        if std::env::var("MS2_DEBUG_POLICY").is_ok() {
-            let off = goal.inserted.inverse() * part;
-            eprintln!(
-                "{:?} {} off {:.4?} ang {:.3} part_from_tcp {:.4?}",
-                self.phase,
-                self.steps_in_phase,
-                off.translation.vector.as_slice(),
-                off.rotation.angle(),
-                part_from_tcp.translation.vector.as_slice()
-            );
-        }
         let mut target = limited(&tcp, &target, step);
         if matches!(self.phase, Phase::Align | Phase::Insert) {
             target.translation.vector += self.sag_correction;

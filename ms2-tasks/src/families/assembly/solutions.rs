@@ -6,8 +6,6 @@
 //! A task is an [`InsertionSolution`]: a hook that senses its part, obstacles and goal
 //! ([`InsertionWorld`]).
 
-use std::time::Instant;
-
 use ms2_plan::{
     parry3d::shape::SharedShape, AttachedObject, CollisionScene, GripperSpec, KinematicRobot,
     MotionPlanner, OrientedBox, PlanError, PlannedMotion, PlannerConfig, PlanningRobot,
@@ -234,15 +232,6 @@ fn plan_error(phase: &'static str) -> impl Fn(PlanError) -> SolveError {
     move |source| SolveError::Plan { phase, source }
 }
 
-/// Runs one planning query, adding its wall time to `timings`.
-fn timed<T>(timings: &mut SolveTimings, query: impl FnOnce() -> T) -> T {
-    let t0 = Instant::now();
-    let out = query();
-    timings.planning_seconds += t0.elapsed().as_secs_f64();
-    timings.planning_queries += 1;
-    out
-}
-
 /// Screw motion to `pose`, else RRT-Connect to a collision-free IK solution.
 fn move_to_pose(
     planner: &mut MotionPlanner<'_, KinematicRobot>,
@@ -308,7 +297,7 @@ impl Solution for InsertionSolution {
             let grasp =
                 part_pose * Isometry3::from_parts(Translation3::from(sensed.grasp_point), rot);
             let pre = Translation3::new(0.0, 0.0, PRE_GRASP_DISTANCE) * grasp;
-            match timed(timings, || move_to_pose(&mut planner, &scene, &start, &pre)) {
+            match timings.time(|| move_to_pose(&mut planner, &scene, &start, &pre)) {
                 Ok(motion) => {
                     reached = Some((motion, grasp));
                     break;
@@ -322,10 +311,9 @@ impl Solution for InsertionSolution {
         for finger in &gripper.touch_links {
             approach.allow_collision(finger.clone(), PART);
         }
-        let descend = timed(timings, || {
-            planner.plan_screw(&approach, driver.arm_target(), &grasp)
-        })
-        .map_err(plan_error("descend"))?;
+        let descend = timings
+            .time(|| planner.plan_screw(&approach, driver.arm_target(), &grasp))
+            .map_err(plan_error("descend"))?;
         driver.follow(&descend.trajectory, Gripper::Open)?;
         driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Open)?;
         driver.hold(CLOSE_STEPS, Gripper::Closed)?;
@@ -359,21 +347,23 @@ impl Solution for InsertionSolution {
         // Lift, then line the part up in front of the opening.
         let mut planner = self.planner(&holding, driver, seed, 1, SPEED_SCALE)?;
         let up = Translation3::new(0.0, 0.0, LIFT_HEIGHT) * tcp_at_grasp;
-        let lift = timed(timings, || planner.plan_screw(&carrying, &grasp_q, &up))
+        let lift = timings
+            .time(|| planner.plan_screw(&carrying, &grasp_q, &up))
             .map_err(plan_error("lift"))?;
         driver.follow(&lift.trajectory, Gripper::Closed)?;
         let axis = grasped.inserted.rotation * Vector3::x();
         let before = Translation3::from(-axis * (grasped.entry_distance + PRE_INSERT_GAP))
             * grasped.inserted;
-        let carry = timed(timings, || {
-            move_to_pose(
-                &mut planner,
-                &carrying,
-                driver.arm_target(),
-                &(before * part_from_tcp),
-            )
-        })
-        .map_err(plan_error("carry"))?;
+        let carry = timings
+            .time(|| {
+                move_to_pose(
+                    &mut planner,
+                    &carrying,
+                    driver.arm_target(),
+                    &(before * part_from_tcp),
+                )
+            })
+            .map_err(plan_error("carry"))?;
         driver.follow(&carry.trajectory, Gripper::Closed)?;
 
         // Remove the loaded arm's sag and the part's turn in the hand: move the hand by the
@@ -382,22 +372,13 @@ impl Solution for InsertionSolution {
         for _ in 0..MAX_CORRECTIONS {
             driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Closed)?;
             let part_now = (self.sense)(driver.env())?.part.pose_base_from_box;
-            if std::env::var("MS2_DEBUG_POLICY").is_ok() {
-                eprintln!(
-                    "step {} sideways {:.4} off {:?}",
-                    driver.env().elapsed_steps(),
-                    sideways_error(&before, &part_now, grasped.entry_distance),
-                    (before.inverse() * part_now).translation.vector.as_slice()
-                );
-            }
             if sideways_error(&before, &part_now, grasped.entry_distance) < grasped.aligned {
                 break;
             }
             tcp_target = before * part_now.inverse() * tcp_target;
-            let fix = timed(timings, || {
-                planner.plan_screw(&carrying, driver.arm_target(), &tcp_target)
-            })
-            .map_err(plan_error("align"))?;
+            let fix = timings
+                .time(|| planner.plan_screw(&carrying, driver.arm_target(), &tcp_target))
+                .map_err(plan_error("align"))?;
             driver.follow(&fix.trajectory, Gripper::Closed)?;
         }
 
@@ -409,7 +390,6 @@ impl Solution for InsertionSolution {
             .remove_object(PART)
             .map_err(plan_error("insert"))?;
         let mut planner = self.planner(&holding, driver, seed, 2, INSERT_SPEED_SCALE)?;
-        let _ = tcp_target;
         while !driver.env().evaluate().success {
             let part_now = (self.sense)(driver.env())?.part.pose_base_from_box;
             let along = (grasped.inserted.inverse() * part_now).translation.x;
@@ -419,10 +399,9 @@ impl Solution for InsertionSolution {
             let next = (along + INSERT_SEGMENT).min(0.0);
             let wanted = grasped.inserted * Translation3::new(next, 0.0, 0.0);
             let tcp = wanted * part_now.inverse() * holding.tcp_pose(driver.arm_target());
-            let segment = timed(timings, || {
-                move_to_pose(&mut planner, &inserting, driver.arm_target(), &tcp)
-            })
-            .map_err(plan_error("insert"))?;
+            let segment = timings
+                .time(|| move_to_pose(&mut planner, &inserting, driver.arm_target(), &tcp))
+                .map_err(plan_error("insert"))?;
             driver.follow(&segment.trajectory, Gripper::Closed)?;
         }
         driver.hold_until_success(SUCCESS_STEPS, Gripper::Closed)
