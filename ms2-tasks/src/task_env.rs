@@ -110,9 +110,11 @@ impl TaskEnv {
             control_freq_hz: cfg.control_freq,
             sim_freq_hz: cfg.sim_freq,
         };
+        let defaults = WorldConfig::default();
         let world_config = WorldConfig {
             timestep: (1.0 / cfg.sim_freq) as f32,
-            ..WorldConfig::default()
+            solver: task.solver_config(defaults.solver),
+            ..defaults
         };
         let mut rng = episode_rng(BUILD_SEED);
         let scene = build_scene(
@@ -309,8 +311,6 @@ impl EnvBackend for TaskEnv {
 
     fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         self.task.initialize_actors(&mut self.scene, rng)?;
-        let TaskScene { world, agent } = &mut self.scene;
-        agent.initialize(world.as_mut(), rng)?;
         self.task.initialize_agent(&mut self.scene, rng)?;
         self.task.initialize_task(&self.scene, rng)?;
         // The previous episode's contact caches must not leak into this one: an episode is

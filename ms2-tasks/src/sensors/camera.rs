@@ -76,6 +76,30 @@ pub fn look_at_robotics(eye: [f32; 3], target: [f32; 3]) -> Pose3 {
     )
 }
 
+/// `cameras` with those named in `views` — `(uid, eye, target)`, metres, world frame — fixed
+/// in the world looking from `eye` at `target` (ManiSkill2's tasks place `base_camera` and
+/// `render_camera` this way); other cameras unchanged.
+///
+/// ```
+/// use ms2_tasks::sensors::{with_views, CameraConfig, CameraMount};
+/// let cams = with_views(CameraConfig::panda_defaults(), &[("base_camera", [0.0, -0.3, 0.2], [0.0, 0.0, 0.1])]);
+/// assert!(matches!(cams[0].mount, CameraMount::World { .. }));
+/// assert_eq!(cams[1], CameraConfig::hand_camera());
+/// ```
+pub fn with_views(
+    mut cameras: Vec<CameraConfig>,
+    views: &[(&str, [f32; 3], [f32; 3])],
+) -> Vec<CameraConfig> {
+    for cam in &mut cameras {
+        if let Some((_, eye, target)) = views.iter().find(|(uid, ..)| *uid == cam.uid) {
+            cam.mount = CameraMount::World {
+                pose_world_from_camera: look_at_robotics(*eye, *target),
+            };
+        }
+    }
+    cameras
+}
+
 impl CameraConfig {
     /// A camera fixed in the world: `width`×`height` pixels, vertical field of view `fov_y`
     /// (radians), clipping planes `near`..`far` (metres), at `pose_world_from_camera` (robotics
