@@ -71,9 +71,10 @@ def test_visual_modes_see_the_obstacles(obs_mode):
     obs, _ = env.reset(seed=0)
     assert set(obs["extra"]) == {"tcp_pose", "goal_pose"}
     if obs_mode == "rgbd":
-        rgb = obs["image"]["base_camera"]["rgb"]
-        # The white wall fills part of the base camera's view.
-        assert (rgb.reshape(-1, 3).min(axis=1) > 200).mean() > 0.05
+        rgb = obs["image"]["base_camera"]["rgb"].reshape(-1, 3).astype(int)
+        # The white wall fills part of the base camera's view, the coloured obstacles some more.
+        assert (rgb.min(axis=1) > 150).mean() > 0.05
+        assert ((rgb.max(axis=1) - rgb.min(axis=1)) > 80).mean() > 0.001
     else:
         assert obs["pointcloud"]["xyzw"].shape[1] == 4
 

@@ -8,8 +8,9 @@
 //!   origin). Used when present; a file that is there but unreadable is an error naming it.
 //! - **The procedural generator** otherwise ([`generate_layout`]): ms2's own distribution of the
 //!   same kind of scene (ManiSkill2 does not document the file's sampler): a goal configuration
-//!   reaching forward with the gripper pointing at a wall 9-15 cm behind the goal (0.8 m
-//!   high, 1.2 m wide, 4 cm thick), and 6-10
+//!   reaching forward with the gripper pointing at a wall 9-15 cm behind the goal (0.45 m
+//!   high, so ManiSkill2's render camera in front of it still sees the arm; 1.2 m wide, 4 cm
+//!   thick), and 6-10
 //!   boxes (2-9 cm half sizes, random orientations) between the start and goal TCPs, each kept
 //!   off the arm's start and goal configurations (10 cm around every link origin and the
 //!   midpoints between them) so both ends are collision-free; whether a path exists between
@@ -201,8 +202,8 @@ pub fn generate_layout(rng: &mut EpisodeRng) -> ObstacleLayout {
     };
     let wall_x = goal_tcp.translation.vector.x + rng.random_range(0.09..0.15);
     let wall = BoxObstacle {
-        half_size: Vector3::new(0.02, 0.6, 0.4),
-        pose: Pose3::translation(wall_x + 0.02, 0.0, 0.4),
+        half_size: Vector3::new(0.02, 0.6, 0.225),
+        pose: Pose3::translation(wall_x + 0.02, 0.0, 0.225),
     };
     let count = rng.random_range(6..=10);
     let mut obstacles = Vec::with_capacity(count);
