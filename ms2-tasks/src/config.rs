@@ -50,6 +50,11 @@ pub struct EnvConfig {
     /// `None` = the default scene. ms2 ships no background scenes, so any name is refused with
     /// [`EnvError::InvalidConfig`].
     pub bg_name: Option<String>,
+    /// ManiSkill2's `model_ids` of the object-variation tasks (`PickSingleYCB-v0`,
+    /// `PickSingleEGAD-v0`, `PickClutterYCB-v0`): the model ids episodes draw from; `None` (or
+    /// empty) = every model of the task's info json. An id not in the json is an error naming
+    /// it; setting it on a task without object models is an error.
+    pub model_ids: Option<Vec<String>>,
 }
 
 impl Default for EnvConfig {
@@ -69,6 +74,7 @@ impl Default for EnvConfig {
             enable_shadow: false,
             render_camera: None,
             bg_name: None,
+            model_ids: None,
         }
     }
 }

@@ -5,7 +5,8 @@
 //!
 //! | when | hook |
 //! |---|---|
-//! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
+//! | every reset, first | [`Task::prepare_episode`] (per-episode scene choices, e.g. the object model; may ask for a rebuild) |
+//! | make / `reset(reconfigure = true)` / a rebuild asked for | [`Task::build_scene`] (add actors to the world) |
 //! | every reset, in this order | [`Task::initialize_actors`], robot reset (rest qpos + noise), [`Task::initialize_task`] |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
@@ -45,6 +46,13 @@ impl std::fmt::Debug for TaskScene {
 pub trait Task: Any + Send {
     /// Largest value of [`Task::dense_reward`] (divides it in `normalized_dense` mode).
     fn max_dense_reward(&self) -> f64;
+
+    /// Makes the episode's scene-level choices (e.g. which object model, at which scale) before
+    /// the scene is (re)built; returns `true` when they differ from the current scene's, so
+    /// that the runtime rebuilds it ([`Task::build_scene`]). Default: no choices.
+    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(false)
+    }
 
     /// Adds the task's actors to a fresh world (which has the ground and the robot already).
     fn build_scene(

@@ -264,6 +264,10 @@ impl EnvBackend for TaskEnv {
         self.task.max_dense_reward()
     }
 
+    fn prepare_episode(&mut self, rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        self.task.prepare_episode(rng)
+    }
+
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let mode = self.scene.agent.control_mode();
         self.scene = build_scene(

@@ -11,6 +11,7 @@
 //! | [`dummy`] | `Dummy-v0` (physics-free test env) | — |
 
 pub mod dummy;
+pub mod objects;
 pub mod rigid;
 #[cfg(feature = "soft")]
 pub mod soft;
@@ -20,6 +21,7 @@ use crate::registry::Registrar;
 /// Registers every built-in family, one call each.
 pub(crate) fn register_builtin(r: &mut Registrar) {
     rigid::register(r);
+    objects::register(r);
     #[cfg(feature = "soft")]
     soft::register(r);
     dummy::register(r);
