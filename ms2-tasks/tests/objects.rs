@@ -7,7 +7,7 @@ use std::sync::OnceLock;
 
 use ms2_tasks::families::objects::fixture::{write_fixture, FIXTURE_MODELS};
 use ms2_tasks::families::objects::model_db::{
-    read_convex_pieces, ModelDb, ModelLayout, ObjectModelError,
+    ModelDb, ModelLayout, ObjectModelError,
 };
 use ms2_tasks::families::objects::PickSingle;
 use ms2_tasks::{info_get, make_env, make_scripted_policy, Env, EnvConfig, EnvError, InfoValue};
@@ -49,7 +49,9 @@ fn reader_reads_ids_sizes_pieces_and_colours() {
     let bbox = db.scaled_bbox("can_b", 2.0).unwrap().unwrap();
     assert!((bbox.max[2] - 0.2).abs() < 1e-6);
     let can = db.load("can_b", 1.0).unwrap();
-    let pieces = read_convex_pieces(&root.join("models/can_b/collision.obj"), 1.0).unwrap();
+    let pieces =
+        ms2_assets::objects::read_collision_pieces(&root.join("models/can_b/collision.obj"), "can_b")
+            .unwrap();
     assert_eq!(pieces.len(), 2, "one convex piece per OBJ object");
     // Each 12-sided piece is split into octants for rapier's 4-vertex contact faces.
     assert_eq!(can.pieces.len(), 16);

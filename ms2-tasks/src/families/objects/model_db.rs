@@ -1,5 +1,7 @@
-//! The reader of ManiSkill2's object-model layout: an info json (model id → scales, density,
-//! bounding box) beside the model files, and the models as ms2-physics actor parts.
+//! The object models of a task as ms2-physics actor parts: ManiSkill2's info json (model id →
+//! scales, density, bounding box) and OBJ files, read through [`ms2_assets::objects`] (json,
+//! paths, `o`/`g` pieces, `.mtl` colours), checked, and turned into convex collision shapes and
+//! coloured visual meshes.
 //!
 //! Two layouts are read, ManiSkill2 0.5.3's own (the procedural families of `ms2_assets` are
 //! written in the same layout under sibling directories):
@@ -17,10 +19,10 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use ms2_physics::mesh::{load_mesh_parts, split_convex_for_contact};
+use ms2_assets::objects::{read_collision_pieces, read_visual_parts};
+use ms2_physics::mesh::split_convex_for_contact;
 use ms2_physics::{MassSpec, Pose3, ShapeDesc, ShapeSpec, VisualShape};
 use nalgebra::{Point3, Vector3};
-use serde::Deserialize;
 
 /// Why an object model or its info json could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -61,17 +63,9 @@ pub enum ObjectModelError {
         /// What is wrong.
         reason: String,
     },
-    /// A mesh file would not load.
-    #[error("model {id:?}: cannot load {path}: {source}")]
-    Mesh {
-        /// The model id.
-        id: String,
-        /// The mesh file.
-        path: PathBuf,
-        /// What the mesh loader said.
-        #[source]
-        source: ms2_physics::MeshError,
-    },
+    /// A mesh file would not load (the message names the file and the model id).
+    #[error("{0}")]
+    BadMesh(String),
     /// The collision file holds no convex piece with volume.
     #[error("model {id:?}: {path} holds no convex piece with at least 4 non-coplanar vertices")]
     NoCollisionPiece {
@@ -89,7 +83,7 @@ impl From<ObjectModelError> for crate::error::EnvError {
 }
 
 /// Axis-aligned bounding box of a model at scale 1 (m, model frame).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ModelBbox {
     /// Lower corner.
     pub min: [f32; 3],
@@ -98,16 +92,13 @@ pub struct ModelBbox {
 }
 
 /// One model's entry of the info json.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ModelInfo {
     /// Scales to choose from per episode (absent: 1).
-    #[serde(default)]
     pub scales: Option<Vec<f32>>,
     /// Density (kg/m³); absent: the layout's default ([`ModelLayout::default_density`]).
-    #[serde(default)]
     pub density: Option<f32>,
     /// Bounding box at scale 1.
-    #[serde(default)]
     pub bbox: Option<ModelBbox>,
 }
 
@@ -132,29 +123,16 @@ impl ModelLayout {
 
     /// `(collision, visual)` files of model `id` under `root`.
     pub fn model_files(self, root: &Path, id: &str) -> (PathBuf, PathBuf) {
-        match self {
-            ModelLayout::Ycb => {
-                let dir = root.join("models").join(id);
-                (dir.join("collision.obj"), dir.join("textured.obj"))
-            }
-            ModelLayout::Egad => {
-                let split = egad_split(id);
-                (
-                    root.join(format!("egad_{split}_set_coacd"))
-                        .join(format!("{id}.obj")),
-                    root.join(format!("egad_{split}_set")).join(format!("{id}.obj")),
-                )
-            }
-        }
+        let files = ms2_assets::objects::model_files(root, self.kind(), id);
+        (files.collision, files.visual)
     }
-}
 
-/// ManiSkill2's EGAD split of a model id: `train` when it has an underscore, else `eval`.
-pub fn egad_split(id: &str) -> &'static str {
-    if id.contains('_') {
-        "train"
-    } else {
-        "eval"
+    /// The asset store's name of the layout.
+    pub fn kind(self) -> ms2_assets::objects::ObjectKind {
+        match self {
+            ModelLayout::Ycb => ms2_assets::objects::ObjectKind::Ycb,
+            ModelLayout::Egad => ms2_assets::objects::ObjectKind::Egad,
+        }
     }
 }
 
@@ -175,21 +153,34 @@ impl ModelDb {
     /// Reads `root/json_name` (a json object: model id → [`ModelInfo`]).
     pub fn open(root: &Path, json_name: &str, layout: ModelLayout) -> Result<Self, ObjectModelError> {
         let json = root.join(json_name);
-        let text = std::fs::read_to_string(&json).map_err(|e| match e.kind() {
-            std::io::ErrorKind::NotFound => ObjectModelError::Missing {
+        if !json.is_file() {
+            return Err(ObjectModelError::Missing {
                 what: "model info json",
-                path: json.clone(),
-            },
-            _ => ObjectModelError::BadJson {
+                path: json,
+            });
+        }
+        let read = ms2_assets::objects::db::load_model_db_file(&json).map_err(|e| {
+            ObjectModelError::BadJson {
                 path: json.clone(),
                 reason: e.to_string(),
-            },
+            }
         })?;
-        let models: BTreeMap<String, ModelInfo> =
-            serde_json::from_str(&text).map_err(|e| ObjectModelError::BadJson {
-                path: json.clone(),
-                reason: e.to_string(),
-            })?;
+        let to_f32 = |v: [f64; 3]| v.map(|x| x as f32);
+        let models: BTreeMap<String, ModelInfo> = read
+            .models
+            .into_iter()
+            .map(|(id, info)| {
+                let entry = ModelInfo {
+                    scales: info.scales.map(|s| s.into_iter().map(|x| x as f32).collect()),
+                    density: info.density.map(|d| d as f32),
+                    bbox: info.bbox.map(|b| ModelBbox {
+                        min: to_f32(b.min),
+                        max: to_f32(b.max),
+                    }),
+                };
+                (id, entry)
+            })
+            .collect();
         if models.is_empty() {
             return Err(ObjectModelError::BadJson {
                 path: json,
@@ -331,32 +322,20 @@ impl ObjectModel {
         scale: f32,
         density: f32,
     ) -> Result<Self, ObjectModelError> {
-        let read = |path: &Path, what: &'static str| {
+        for (what, path) in [("collision mesh", collision), ("visual mesh", visual)] {
             if !path.is_file() {
                 return Err(ObjectModelError::Missing {
                     what,
                     path: path.to_owned(),
                 });
             }
-            load_mesh_parts(path, Vector3::repeat(scale)).map_err(|source| ObjectModelError::Mesh {
-                id: id.to_owned(),
-                path: path.to_owned(),
-                source,
-            })
-        };
-        if !collision.is_file() {
-            return Err(ObjectModelError::Missing {
-                what: "collision mesh",
-                path: collision.to_owned(),
-            });
         }
-        let pieces: Vec<Vec<Point3<f32>>> = read_convex_pieces(collision, scale)
-            .map_err(|source| ObjectModelError::Mesh {
-                id: id.to_owned(),
-                path: collision.to_owned(),
-                source,
-            })?
-            .into_iter()
+        let mesh_err = |e: ms2_assets::AssetError| ObjectModelError::BadMesh(e.to_string());
+        let scaled = |v: &[f32; 3]| Point3::new(v[0], v[1], v[2]) * scale;
+        let pieces: Vec<Vec<Point3<f32>>> = read_collision_pieces(collision, id)
+            .map_err(mesh_err)?
+            .iter()
+            .map(|p| p.vertices.iter().map(scaled).collect::<Vec<_>>())
             .filter(|v| has_volume(v))
             .flat_map(|v| split_convex_for_contact(&v))
             .collect();
@@ -366,15 +345,17 @@ impl ObjectModel {
                 path: collision.to_owned(),
             });
         }
-        let visuals = read(visual, "visual mesh")?
+        let visuals = read_visual_parts(visual, id)
+            .map_err(mesh_err)?
             .into_iter()
+            .filter(|p| !p.triangles.is_empty())
             .map(|p| VisualShape {
                 shape: ShapeDesc::TriMesh {
-                    vertices: p.mesh.vertices,
-                    indices: p.mesh.indices,
+                    vertices: p.vertices.iter().map(scaled).collect(),
+                    indices: p.triangles,
                 },
                 pose_body_from_shape: Pose3::identity(),
-                rgba: p.diffuse_rgba.unwrap_or(DEFAULT_RGBA),
+                rgba: p.rgba.unwrap_or(DEFAULT_RGBA),
             })
             .collect();
         Ok(Self {
@@ -439,91 +420,3 @@ fn has_volume(points: &[Point3<f32>]) -> bool {
     points.iter().any(|p| n.dot(&(p - a)).abs() > 1e-9)
 }
 
-/// Reads the convex pieces of a collision OBJ: the vertices used by the faces of each `o` (or
-/// `g`) object, scaled by `scale` (ManiSkill2 loads such files as one convex shape per object).
-/// A file without objects is one piece.
-pub fn read_convex_pieces(
-    path: &Path,
-    scale: f32,
-) -> Result<Vec<Vec<Point3<f32>>>, ms2_physics::MeshError> {
-    use ms2_physics::MeshError;
-    let parse_err = |line: usize, what: String| MeshError::Parse {
-        source: std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!("line {line}: {what}"),
-        ),
-    };
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .unwrap_or_default();
-    if ext != "obj" {
-        return Err(MeshError::UnsupportedFormat { extension: ext });
-    }
-    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Parse { source })?;
-    let mut vertices: Vec<Point3<f32>> = Vec::new();
-    let mut pieces: Vec<Vec<usize>> = vec![Vec::new()];
-    for (n, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => {
-                let xyz: Vec<f32> = words
-                    .take(3)
-                    .map(|w| w.parse::<f32>())
-                    .collect::<Result<_, _>>()
-                    .map_err(|e| parse_err(n + 1, format!("bad vertex: {e}")))?;
-                if xyz.len() != 3 {
-                    return Err(parse_err(n + 1, "a vertex needs 3 coordinates".to_owned()));
-                }
-                let p = Point3::new(xyz[0], xyz[1], xyz[2]) * scale;
-                if !p.coords.iter().all(|v| v.is_finite()) {
-                    return Err(MeshError::NonFiniteVertex { vertex: p });
-                }
-                vertices.push(p);
-            }
-            Some("o") | Some("g") => {
-                if pieces.last().is_some_and(|p| !p.is_empty()) {
-                    pieces.push(Vec::new());
-                }
-            }
-            Some("f") => {
-                let piece = pieces.last_mut().expect("one piece at least");
-                for w in words {
-                    let idx: i64 = w
-                        .split('/')
-                        .next()
-                        .unwrap_or("")
-                        .parse()
-                        .map_err(|e| parse_err(n + 1, format!("bad face index {w:?}: {e}")))?;
-                    let i = if idx < 0 {
-                        vertices.len() as i64 + idx
-                    } else {
-                        idx - 1
-                    };
-                    if i < 0 || i as usize >= vertices.len() {
-                        return Err(parse_err(
-                            n + 1,
-                            format!("face index {idx} outside the {} vertices so far", vertices.len()),
-                        ));
-                    }
-                    piece.push(i as usize);
-                }
-            }
-            _ => {}
-        }
-    }
-    let pieces: Vec<Vec<Point3<f32>>> = pieces
-        .into_iter()
-        .filter(|p| !p.is_empty())
-        .map(|mut idx| {
-            idx.sort_unstable();
-            idx.dedup();
-            idx.into_iter().map(|i| vertices[i]).collect()
-        })
-        .collect();
-    if pieces.is_empty() {
-        return Err(MeshError::NoTriangles);
-    }
-    Ok(pieces)
-}

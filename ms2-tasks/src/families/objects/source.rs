@@ -35,25 +35,24 @@ pub fn override_var(source: ObjectSource) -> &'static str {
     }
 }
 
-/// The model directory of `source`: `$MS2_YCB_DIR` / `$MS2_EGAD_DIR` when set; else
-/// ManiSkill2's data in the asset directory when present; else the procedural family.
+/// The model directory of `source`: `$MS2_YCB_DIR` / `$MS2_EGAD_DIR` when set (a directory in
+/// ManiSkill2's layout); else ManiSkill2's data in the asset directory when present; else the
+/// procedural family, generated on first use ([`ms2_assets::objects::resolve_object_root`]).
 pub fn resolve_model_root(source: ObjectSource) -> Result<PathBuf, EnvError> {
     if let Some(dir) = std::env::var_os(override_var(source)) {
-        return Ok(PathBuf::from(dir));
+        let dir = PathBuf::from(dir);
+        let marker = dir.join(source.dirs().2);
+        if !marker.is_file() {
+            return Err(ObjectModelError::Missing {
+                what: "model info json",
+                path: marker,
+            }
+            .into());
+        }
+        return Ok(dir);
     }
-    let (ms2_dir, procedural, marker) = source.dirs();
-    let asset_dir = ms2_assets::store::asset_dir();
-    let real = asset_dir.join(ms2_dir);
-    if real.join(marker).is_file() {
-        return Ok(real);
-    }
-    let generated = asset_dir.join(procedural);
-    if generated.join(marker).is_file() {
-        return Ok(generated);
-    }
-    Err(ObjectModelError::Missing {
-        what: "object models",
-        path: real,
-    }
-    .into())
+    let kind = source.layout().kind();
+    ms2_assets::objects::resolve_object_root(kind)
+        .map(|(root, _)| root)
+        .map_err(|e| EnvError::Asset(e.to_string()))
 }
