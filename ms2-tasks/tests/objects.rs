@@ -112,7 +112,10 @@ fn bad_assets_are_errors_naming_the_file_or_id() {
 #[test]
 fn model_ids_keyword_is_checked() {
     let err = env("PickSingleYCB-v0", Some(&["box_a", "missing_model"])).unwrap_err();
-    assert!(matches!(err, EnvError::Asset(_)) && err.to_string().contains("missing_model"), "{err}");
+    assert!(
+        matches!(err, EnvError::InvalidConfig(_)) && err.to_string().contains("missing_model"),
+        "{err}"
+    );
     let err = make_env(&EnvConfig {
         model_ids: Some(vec!["box_a".to_owned()]),
         ..EnvConfig::new("PickCube-v0")

@@ -139,6 +139,10 @@ class Ms2Env(gym.Env):
             the key ``"render_camera"``).
         bg_name: ManiSkill2's visual background; only ``None`` (ms2 ships no background
             scenes: any name raises ``ValueError``).
+        model_ids: the object models episodes draw from in the object-variation tasks
+            (``PickSingleYCB-v0``, ``PickSingleEGAD-v0``), ManiSkill2's keyword: one id or a
+            list; ``None`` = every model of the task's info json. An unknown id raises
+            ``ValueError`` naming it; other tasks refuse the keyword.
 
     Unknown ids or modes raise ``ValueError`` listing the valid ones.
     """
@@ -161,6 +165,7 @@ class Ms2Env(gym.Env):
         enable_shadow: bool = False,
         render_camera_cfgs: dict[str, Any] | None = None,
         bg_name: str | None = None,
+        model_ids: str | list[str] | None = None,
     ) -> None:
         _assets.register_installed_packages()
         self._native = _native.NativeEnv(
@@ -178,6 +183,7 @@ class Ms2Env(gym.Env):
             enable_shadow=enable_shadow,
             render_camera_cfgs=render_camera_cfgs,
             bg_name=bg_name,
+            model_ids=model_ids,
         )
         adopt_config(self, self._native.config())
         _assets.warn_if_primitive_panda()

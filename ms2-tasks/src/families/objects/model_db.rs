@@ -77,8 +77,15 @@ pub enum ObjectModelError {
 }
 
 impl From<ObjectModelError> for crate::error::EnvError {
+    /// An unknown model id is a bad config (Python `ValueError`); file problems are asset
+    /// errors.
     fn from(e: ObjectModelError) -> Self {
-        crate::error::EnvError::Asset(e.to_string())
+        match e {
+            ObjectModelError::UnknownModel { .. } => {
+                crate::error::EnvError::InvalidConfig(e.to_string())
+            }
+            _ => crate::error::EnvError::Asset(e.to_string()),
+        }
     }
 }
 
