@@ -275,10 +275,11 @@ fn spans_volume(points: &[Point3<f32>]) -> bool {
         return false;
     };
     let ab = b - a;
-    let Some(c) = points
-        .iter()
-        .max_by(|p, q| ab.cross(&(*p - a)).norm().total_cmp(&ab.cross(&(*q - a)).norm()))
-    else {
+    let Some(c) = points.iter().max_by(|p, q| {
+        ab.cross(&(*p - a))
+            .norm()
+            .total_cmp(&ab.cross(&(*q - a)).norm())
+    }) else {
         return false;
     };
     let n = ab.cross(&(c - a));

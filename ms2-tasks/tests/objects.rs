@@ -6,9 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use ms2_tasks::families::objects::fixture::{write_fixture, FIXTURE_MODELS};
-use ms2_tasks::families::objects::model_db::{
-    ModelDb, ModelLayout, ObjectModelError,
-};
+use ms2_tasks::families::objects::model_db::{ModelDb, ModelLayout, ObjectModelError};
 use ms2_tasks::families::objects::PickSingle;
 use ms2_tasks::{info_get, make_env, make_scripted_policy, Env, EnvConfig, EnvError, InfoValue};
 
@@ -49,9 +47,11 @@ fn reader_reads_ids_sizes_pieces_and_colours() {
     let bbox = db.scaled_bbox("can_b", 2.0).unwrap().unwrap();
     assert!((bbox.max[2] - 0.2).abs() < 1e-6);
     let can = db.load("can_b", 1.0).unwrap();
-    let pieces =
-        ms2_assets::objects::read_collision_pieces(&root.join("models/can_b/collision.obj"), "can_b")
-            .unwrap();
+    let pieces = ms2_assets::objects::read_collision_pieces(
+        &root.join("models/can_b/collision.obj"),
+        "can_b",
+    )
+    .unwrap();
     assert_eq!(pieces.len(), 2, "one convex piece per OBJ object");
     // Each 12-sided piece is split into octants for rapier's 4-vertex contact faces.
     assert_eq!(can.pieces.len(), 16);
@@ -65,8 +65,12 @@ fn reader_reads_ids_sizes_pieces_and_colours() {
             .all(|v| (v.rgba[0] - rgb[0]).abs() < 1e-3 && (v.rgba[2] - rgb[2]).abs() < 1e-3),
         "visual colour comes from the .mtl"
     );
-    let egad = ModelDb::open(&fixture().join("egad"), "info_pick_train_v0.json", ModelLayout::Egad)
-        .unwrap();
+    let egad = ModelDb::open(
+        &fixture().join("egad"),
+        "info_pick_train_v0.json",
+        ModelLayout::Egad,
+    )
+    .unwrap();
     assert_eq!(egad.load("box_a", 0.5).unwrap().pieces.len(), 1);
 }
 
@@ -79,7 +83,9 @@ fn bad_assets_are_errors_naming_the_file_or_id() {
     // Unknown id.
     let db = open().unwrap();
     let err = db.info("nope").unwrap_err();
-    assert!(matches!(err, ObjectModelError::UnknownModel { .. }) && err.to_string().contains("nope"));
+    assert!(
+        matches!(err, ObjectModelError::UnknownModel { .. }) && err.to_string().contains("nope")
+    );
     // Missing collision file.
     std::fs::remove_file(dir.join("models/box_a/collision.obj")).unwrap();
     let err = db.load("box_a", 1.0).unwrap_err();
@@ -88,7 +94,10 @@ fn bad_assets_are_errors_naming_the_file_or_id() {
     // A mesh that will not load.
     std::fs::write(dir.join("models/can_b/collision.obj"), "v 1 2\nf 1 2 9\n").unwrap();
     let err = db.load("can_b", 1.0).unwrap_err();
-    assert!(err.to_string().contains("can_b") && err.to_string().contains("collision.obj"), "{err}");
+    assert!(
+        err.to_string().contains("can_b") && err.to_string().contains("collision.obj"),
+        "{err}"
+    );
     // A flat collision mesh has no convex piece.
     std::fs::write(
         dir.join("models/bar_c/collision.obj"),
@@ -96,13 +105,22 @@ fn bad_assets_are_errors_naming_the_file_or_id() {
     )
     .unwrap();
     let err = db.load("bar_c", 1.0).unwrap_err();
-    assert!(matches!(err, ObjectModelError::NoCollisionPiece { .. }), "{err}");
+    assert!(
+        matches!(err, ObjectModelError::NoCollisionPiece { .. }),
+        "{err}"
+    );
     // Bad values in the json.
     std::fs::write(dir.join("info_pick_v0.json"), r#"{"a": {"scales": [-1]}}"#).unwrap();
     let err = open().unwrap_err();
-    assert!(err.to_string().contains("\"a\"") && err.to_string().contains("scales"), "{err}");
+    assert!(
+        err.to_string().contains("\"a\"") && err.to_string().contains("scales"),
+        "{err}"
+    );
     std::fs::write(dir.join("info_pick_v0.json"), "{not json").unwrap();
-    assert!(matches!(open().unwrap_err(), ObjectModelError::BadJson { .. }));
+    assert!(matches!(
+        open().unwrap_err(),
+        ObjectModelError::BadJson { .. }
+    ));
     std::fs::remove_file(dir.join("info_pick_v0.json")).unwrap();
     let err = open().unwrap_err();
     assert!(err.to_string().contains("info_pick_v0.json"), "{err}");
@@ -136,12 +154,26 @@ fn reset_settles_the_object_and_observes_maniskill2_layout() {
     })
     .unwrap()
     .observe();
-    assert_eq!(state.as_f32().unwrap().len(), 51, "ManiSkill2's PickSingle state dims");
-    let com = obs.get("extra/obj_pose").unwrap().as_f32().unwrap().to_vec();
+    assert_eq!(
+        state.as_f32().unwrap().len(),
+        51,
+        "ManiSkill2's PickSingle state dims"
+    );
+    let com = obs
+        .get("extra/obj_pose")
+        .unwrap()
+        .as_f32()
+        .unwrap()
+        .to_vec();
     // The 10 cm can stands on the ground: centre of mass 5 cm up, at rest.
     assert!((com[2] - 0.05).abs() < 0.006, "com {com:?}");
     assert!(com[0].abs() <= 0.11 && com[1].abs() <= 0.11);
-    let goal = obs.get("extra/goal_pos").unwrap().as_f32().unwrap().to_vec();
+    let goal = obs
+        .get("extra/goal_pos")
+        .unwrap()
+        .as_f32()
+        .unwrap()
+        .to_vec();
     assert!(goal[0].abs() <= 0.15 && goal[1].abs() <= 0.25 && goal[2] <= 0.5 + 1e-6);
     let t = task(&env);
     let world = env.task_scene().unwrap().world.as_ref();
@@ -160,7 +192,11 @@ fn each_episode_draws_a_model_and_episodes_are_functions_of_the_seed() {
         env.reset(Some(seed), false).unwrap();
         seen.insert(task(&env).model_id.clone());
     }
-    assert_eq!(seen.len(), 3, "all fixture models drawn over 12 seeds: {seen:?}");
+    assert_eq!(
+        seen.len(),
+        3,
+        "all fixture models drawn over 12 seeds: {seen:?}"
+    );
     let (a, _) = env.reset(Some(5), false).unwrap();
     let id = task(&env).model_id.clone();
     env.reset(Some(6), false).unwrap();
@@ -201,8 +237,12 @@ fn solve(env: &mut Env, seed: u64) -> bool {
         eprintln!(
             "seed {seed} model {} obj {:?} goal {:?} info {:?}",
             task(env).model_id,
-            obs.get("extra/obj_pose").and_then(|v| v.as_f32()).map(|v| v.to_vec()),
-            obs.get("extra/goal_pos").and_then(|v| v.as_f32()).map(|v| v.to_vec()),
+            obs.get("extra/obj_pose")
+                .and_then(|v| v.as_f32())
+                .map(|v| v.to_vec()),
+            obs.get("extra/goal_pos")
+                .and_then(|v| v.as_f32())
+                .map(|v| v.to_vec()),
             env.evaluate().terms
         );
     }

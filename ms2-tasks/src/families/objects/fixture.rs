@@ -85,13 +85,7 @@ fn prism_obj(m: &FixtureModel, mtl: Option<&str>) -> String {
         }
         for k in 1..n - 1 {
             let _ = writeln!(s, "f {} {} {}", base, base + k + 1, base + k);
-            let _ = writeln!(
-                s,
-                "f {} {} {}",
-                base + n,
-                base + n + k,
-                base + n + k + 1
-            );
+            let _ = writeln!(s, "f {} {} {}", base + n, base + n + k, base + n + k + 1);
         }
         base += 2 * n;
     }
@@ -111,16 +105,19 @@ pub fn write_fixture(root: &Path, layout: ModelLayout) -> io::Result<()> {
             "density": 500.0,
         });
         info.insert(m.id.to_owned(), entry);
-        let mtl = format!(
-            "newmtl body\nKd {} {} {}\n",
-            m.rgb[0], m.rgb[1], m.rgb[2]
-        );
+        let mtl = format!("newmtl body\nKd {} {} {}\n", m.rgb[0], m.rgb[1], m.rgb[2]);
         let (collision, visual) = layout.model_files(root, m.id);
         for f in [&collision, &visual] {
             std::fs::create_dir_all(f.parent().expect("model files have a parent"))?;
         }
         std::fs::write(&collision, prism_obj(&m, None))?;
-        let mtl_name = format!("{}.mtl", visual.file_stem().and_then(|s| s.to_str()).unwrap_or("textured"));
+        let mtl_name = format!(
+            "{}.mtl",
+            visual
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("textured")
+        );
         std::fs::write(visual.with_file_name(&mtl_name), mtl)?;
         std::fs::write(&visual, prism_obj(&m, Some(&mtl_name)))?;
     }

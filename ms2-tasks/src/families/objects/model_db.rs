@@ -158,7 +158,11 @@ pub struct ModelDb {
 
 impl ModelDb {
     /// Reads `root/json_name` (a json object: model id → [`ModelInfo`]).
-    pub fn open(root: &Path, json_name: &str, layout: ModelLayout) -> Result<Self, ObjectModelError> {
+    pub fn open(
+        root: &Path,
+        json_name: &str,
+        layout: ModelLayout,
+    ) -> Result<Self, ObjectModelError> {
         let json = root.join(json_name);
         if !json.is_file() {
             return Err(ObjectModelError::Missing {
@@ -178,7 +182,9 @@ impl ModelDb {
             .into_iter()
             .map(|(id, info)| {
                 let entry = ModelInfo {
-                    scales: info.scales.map(|s| s.into_iter().map(|x| x as f32).collect()),
+                    scales: info
+                        .scales
+                        .map(|s| s.into_iter().map(|x| x as f32).collect()),
                     density: info.density.map(|d| d as f32),
                     bbox: info.bbox.map(|b| ModelBbox {
                         min: to_f32(b.min),
@@ -234,17 +240,28 @@ impl ModelDb {
         let info = self.info(id)?;
         if let Some(scales) = &info.scales {
             if scales.is_empty() || scales.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-                return Err(self.bad(id, format!("scales must be finite positive numbers, got {scales:?}")));
+                return Err(self.bad(
+                    id,
+                    format!("scales must be finite positive numbers, got {scales:?}"),
+                ));
             }
         }
         if let Some(d) = info.density {
             if !(d.is_finite() && d > 0.0) {
-                return Err(self.bad(id, format!("density must be a finite positive kg/m³, got {d}")));
+                return Err(self.bad(
+                    id,
+                    format!("density must be a finite positive kg/m³, got {d}"),
+                ));
             }
         }
         if let Some(b) = info.bbox {
-            if (0..3).any(|i| !(b.min[i].is_finite() && b.max[i].is_finite() && b.min[i] <= b.max[i])) {
-                return Err(self.bad(id, format!("bbox min {:?} must be finite and <= max {:?}", b.min, b.max)));
+            if (0..3)
+                .any(|i| !(b.min[i].is_finite() && b.max[i].is_finite() && b.min[i] <= b.max[i]))
+            {
+                return Err(self.bad(
+                    id,
+                    format!("bbox min {:?} must be finite and <= max {:?}", b.min, b.max),
+                ));
             }
         }
         Ok(())
@@ -411,19 +428,20 @@ fn has_volume(points: &[Point3<f32>]) -> bool {
     let Some(a) = points.first() else {
         return false;
     };
-    let Some(b) = points.iter().max_by(|p, q| {
-        (*p - a).norm_squared().total_cmp(&(*q - a).norm_squared())
-    }) else {
+    let Some(b) = points
+        .iter()
+        .max_by(|p, q| (*p - a).norm_squared().total_cmp(&(*q - a).norm_squared()))
+    else {
         return false;
     };
     let ab = b - a;
-    let Some(c) = points
-        .iter()
-        .max_by(|p, q| ab.cross(&(*p - a)).norm().total_cmp(&ab.cross(&(*q - a)).norm()))
-    else {
+    let Some(c) = points.iter().max_by(|p, q| {
+        ab.cross(&(*p - a))
+            .norm()
+            .total_cmp(&ab.cross(&(*q - a)).norm())
+    }) else {
         return false;
     };
     let n = ab.cross(&(c - a));
     points.iter().any(|p| n.dot(&(p - a)).abs() > 1e-9)
 }
-

@@ -329,9 +329,15 @@ impl Task for PickSingle {
         Evaluation {
             success: is_obj_placed && is_robot_static,
             terms: vec![
-                ("obj_to_goal_dist".to_owned(), InfoValue::F64(f64::from(dist))),
+                (
+                    "obj_to_goal_dist".to_owned(),
+                    InfoValue::F64(f64::from(dist)),
+                ),
                 ("is_obj_placed".to_owned(), InfoValue::Bool(is_obj_placed)),
-                ("is_robot_static".to_owned(), InfoValue::Bool(is_robot_static)),
+                (
+                    "is_robot_static".to_owned(),
+                    InfoValue::Bool(is_robot_static),
+                ),
             ],
         }
     }
