@@ -81,4 +81,12 @@ pub enum AssetError {
         /// Each place looked at and why it did not serve.
         tried: Vec<String>,
     },
+    /// An articulated model's info file is malformed.
+    #[error("bad articulated-model info file {file}: {reason}")]
+    BadInfo {
+        /// The info file.
+        file: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
 }

@@ -16,6 +16,10 @@ pub enum MeshCollision {
     ConvexHull,
     /// An approximate convex decomposition (V-HACD) into a compound of convex parts.
     ConvexDecomposition,
+    /// One convex hull per mesh of the file (per OBJ object), as a compound: for files whose
+    /// parts are already convex pieces, like PartNet-Mobility's `mobility_cvx.urdf` meshes
+    /// (SAPIEN's `load_multiple_collisions_from_file`).
+    PerPartHulls,
 }
 
 /// A triangle mesh read from a file, scaled, in the file's frame (m).
@@ -149,13 +153,35 @@ pub fn load_mesh_parts(path: &Path, scale: Vector3<f32>) -> Result<Vec<MeshPart>
     Ok(parts)
 }
 
+/// One convex hull per part, as a compound (a single hull for a single part).
+pub fn per_part_hulls(parts: &[MeshPart]) -> Result<ShapeDesc, MeshError> {
+    let mut hulls: Vec<(crate::math::Pose3, ShapeDesc)> = parts
+        .iter()
+        .filter(|p| p.mesh.vertices.len() >= 4)
+        .map(|p| {
+            (
+                crate::math::Pose3::identity(),
+                ShapeDesc::ConvexHull {
+                    points: p.mesh.vertices.clone(),
+                },
+            )
+        })
+        .collect();
+    match hulls.len() {
+        0 => Err(MeshError::NoTriangles),
+        1 => Ok(hulls.remove(0).1),
+        _ => Ok(ShapeDesc::Compound { parts: hulls }),
+    }
+}
+
 /// Turns a triangle mesh into a convex collision shape description.
 pub fn mesh_collision_shape(
     mesh: &TriangleMesh,
     mode: MeshCollision,
 ) -> Result<ShapeDesc, MeshError> {
     match mode {
-        MeshCollision::ConvexHull => Ok(ShapeDesc::ConvexHull {
+        // A single mesh has a single part: its hull.
+        MeshCollision::ConvexHull | MeshCollision::PerPartHulls => Ok(ShapeDesc::ConvexHull {
             points: mesh.vertices.clone(),
         }),
         MeshCollision::ConvexDecomposition => {
