@@ -25,6 +25,10 @@ pub(crate) trait EnvBackend: Send {
     fn max_dense_reward(&self) -> f64;
     /// (Re)builds the scene.
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError>;
+    /// Draws the episode's scene choice from `rng`; `true` when the scene must be rebuilt.
+    fn select_episode_scene(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(false)
+    }
     /// Samples a new episode (robot and objects) from `rng`.
     fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError>;
     /// Applies one (validated, finite, right-length) action and advances one control period.

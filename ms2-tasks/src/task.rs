@@ -6,7 +6,8 @@
 //! | when | hook |
 //! |---|---|
 //! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
-//! | every reset, in this order | [`Task::initialize_actors`], robot reset (rest qpos + noise), [`Task::initialize_task`] |
+//! | every reset, first | [`Task::select_episode_scene`] (per-episode scene choice; `true` rebuilds the scene) |
+//! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_robot`] (default: rest qpos + noise), [`Task::initialize_task`] |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
@@ -59,6 +60,25 @@ pub trait Task: Any + Send {
         scene: &mut TaskScene,
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError>;
+
+    /// Puts the robot at its episode start (after [`Task::initialize_actors`]). The default
+    /// is the agent's own: its rest configuration plus noise ([`Agent::initialize`]); tasks
+    /// whose robot starts elsewhere (ManiSkill2's TurnFaucet) override it.
+    fn initialize_robot(
+        &mut self,
+        scene: &mut TaskScene,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
+        let TaskScene { world, agent } = scene;
+        agent.initialize(world.as_mut(), rng)
+    }
+
+    /// Called first at every reset, before the scene is (re)built: a task that draws its
+    /// scene per episode (e.g. which articulated model to load) draws it here from `rng` and
+    /// returns `true` when the scene must be rebuilt. Default: the scene never changes.
+    fn select_episode_scene(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(false)
+    }
 
     /// Samples task data (e.g. the goal) after actors and robot are placed.
     fn initialize_task(

@@ -283,10 +283,13 @@ impl EnvBackend for TaskEnv {
         Ok(())
     }
 
+    fn select_episode_scene(&mut self, rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        self.task.select_episode_scene(rng)
+    }
+
     fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         self.task.initialize_actors(&mut self.scene, rng)?;
-        let TaskScene { world, agent } = &mut self.scene;
-        agent.initialize(world.as_mut(), rng)?;
+        self.task.initialize_robot(&mut self.scene, rng)?;
         self.task.initialize_task(&self.scene, rng)?;
         // The previous episode's contact caches must not leak into this one: an episode is
         // determined by its seed alone.

@@ -27,7 +27,7 @@ pub const FAUCET_VARIANTS: usize = 40;
 /// Category name of the faucets in info file names (`info_faucet_<split>.json`).
 pub const CATEGORY: &str = "faucet";
 /// Version of the generator; a change regenerates the models (it is part of the info files).
-pub const GENERATOR_VERSION: u32 = 1;
+pub const GENERATOR_VERSION: u32 = 2;
 
 /// Segments of the prisms that approximate cylinders.
 const SEGMENTS: usize = 16;
@@ -50,7 +50,7 @@ pub struct HandleParams {
     pub kind: HandleKind,
     /// Joint position (m) in the base frame; the joint axis is +z.
     pub pivot: [f64; 3],
-    /// Lever / bar half length or knob radius plus fin (m).
+    /// Lever length, cross-bar half length, or the knob's fin reach (knob radius + 3.5 cm) (m).
     pub reach: f64,
     /// Upper joint limit (rad); the lower is 0.
     pub range: f64,
@@ -177,7 +177,7 @@ fn handle_pieces(h: &HandleParams) -> Vec<Piece> {
             ),
         ],
         HandleKind::Knob => {
-            let r = h.reach - 0.02;
+            let r = (h.reach - 0.035).max(0.018);
             vec![
                 Piece::cylinder_z(0.0, 0.0, r, 0.0, 0.035, SEGMENTS),
                 Piece::cuboid(

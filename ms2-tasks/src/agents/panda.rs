@@ -290,6 +290,10 @@ impl Agent for PandaAgent {
         self.base_pose
     }
 
+    fn set_base_pose(&mut self, pose: Pose3) {
+        self.base_pose = pose;
+    }
+
     /// Pose of the TCP (`panda_hand_tcp`) in the world.
     fn tcp_pose(&self, world: &dyn RigidWorld) -> Pose3 {
         world

@@ -10,6 +10,7 @@
 //! | [`soft`] | `Excavate-v0`, `Fill-v0` | `soft` |
 //! | [`dummy`] | `Dummy-v0` (physics-free test env) | — |
 
+pub mod articulated;
 pub mod dummy;
 pub mod rigid;
 #[cfg(feature = "soft")]
@@ -20,6 +21,7 @@ use crate::registry::Registrar;
 /// Registers every built-in family, one call each.
 pub(crate) fn register_builtin(r: &mut Registrar) {
     rigid::register(r);
+    articulated::register(r);
     #[cfg(feature = "soft")]
     soft::register(r);
     dummy::register(r);
