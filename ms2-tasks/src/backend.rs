@@ -23,12 +23,12 @@ pub(crate) trait EnvBackend: Send {
     fn action_space(&self) -> &BoxSpace;
     /// Largest dense reward (for `normalized_dense`).
     fn max_dense_reward(&self) -> f64;
+    /// Whether every episode starts with [`EnvBackend::reconfigure`] (per-episode scenes).
+    fn rebuild_every_episode(&self) -> bool {
+        false
+    }
     /// (Re)builds the scene.
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError>;
-    /// Draws the episode's scene choice from `rng`; `true` when the scene must be rebuilt.
-    fn select_episode_scene(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
-        Ok(false)
-    }
     /// Samples a new episode (robot and objects) from `rng`.
     fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError>;
     /// Applies one (validated, finite, right-length) action and advances one control period.

@@ -6,14 +6,16 @@
 //! | when | hook |
 //! |---|---|
 //! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
-//! | every reset, first | [`Task::select_episode_scene`] (per-episode scene choice; `true` rebuilds the scene) |
-//! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_robot`] (default: rest qpos + noise), [`Task::initialize_task`] |
+//! | every reset, first, when [`Task::rebuild_every_episode`] | [`Task::build_scene`] on a fresh world, with the episode's RNG (per-episode layouts and geometry) |
+//! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_agent`] (default: the robot's reset, rest qpos + noise), [`Task::initialize_task`] |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
 //! | soft-body tasks only | [`Task::soft`]: one [`SoftComponent`] (substeps after each physics step, particles observed and drawn) |
 
 use std::any::Any;
+
+use ms2_physics::SolverConfig;
 
 use crate::agents::Agent;
 use crate::error::EnvError;
@@ -22,6 +24,7 @@ use crate::obs::{DictBuilder, ObsValue};
 use crate::particles::ParticleVisual;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::CameraConfig;
 
 /// What a task's hooks see: the rigid world (through the port) and the robot.
 pub struct TaskScene {
@@ -61,10 +64,10 @@ pub trait Task: Any + Send {
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError>;
 
-    /// Puts the robot at its episode start (after [`Task::initialize_actors`]). The default
-    /// is the agent's own: its rest configuration plus noise ([`Agent::initialize`]); tasks
-    /// whose robot starts elsewhere (ManiSkill2's TurnFaucet) override it.
-    fn initialize_robot(
+    /// Puts the robot at its episode start (after [`Task::initialize_actors`]). The default is
+    /// the agent's own reset (rest qpos plus noise); a task with another start posture (e.g.
+    /// PegInsertionSide's turned hand, an obstacle layout's start configuration) overrides it.
+    fn initialize_agent(
         &mut self,
         scene: &mut TaskScene,
         rng: &mut EpisodeRng,
@@ -73,11 +76,19 @@ pub trait Task: Any + Send {
         agent.initialize(world.as_mut(), rng)
     }
 
-    /// Called first at every reset, before the scene is (re)built: a task that draws its
-    /// scene per episode (e.g. which articulated model to load) draws it here from `rng` and
-    /// returns `true` when the scene must be rebuilt. Default: the scene never changes.
-    fn select_episode_scene(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
-        Ok(false)
+    /// Whether every episode builds a fresh world ([`Task::build_scene`] with the episode's
+    /// RNG), for tasks whose actors or geometry differ per episode (ManiSkill2 reconfigures on
+    /// a new episode layout; PegInsertionSide draws its peg and hole per episode). Default:
+    /// `false` (the world is built at make and on `reconfigure`).
+    fn rebuild_every_episode(&self) -> bool {
+        false
+    }
+
+    /// The physics solver settings of the task's worlds, given ms2's defaults (a task whose
+    /// contacts need other settings, e.g. PlugCharger's 0.5 mm clearance a shorter contact
+    /// prediction distance, changes them here). Read once when the env is made.
+    fn solver_config(&self, defaults: SolverConfig) -> SolverConfig {
+        defaults
     }
 
     /// Samples task data (e.g. the goal) after actors and robot are placed.
@@ -120,6 +131,22 @@ pub trait Task: Any + Send {
     /// [`Task::soft`], mutably (the runtime steps it).
     fn soft_mut(&mut self) -> Option<&mut dyn SoftComponent> {
         None
+    }
+
+    /// The observation cameras of the visual obs modes, given the robot's
+    /// ([`crate::agents::RobotSpec::cameras`]: the Panda's `base_camera` and `hand_camera`).
+    /// ManiSkill2 places `base_camera` per task (its `_register_cameras`): a task that does
+    /// returns the list with that camera changed. The user's `camera_cfgs` updates are applied
+    /// to the result. Default: the robot's cameras.
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        robot_cameras
+    }
+
+    /// The camera of `render()`, given the robot's default
+    /// ([`crate::agents::RobotSpec::render_camera`]); ManiSkill2's `_register_render_cameras`
+    /// of the task. `render_camera_cfgs` updates the result. Default: the robot's.
+    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
+        robot_default
     }
 }
 

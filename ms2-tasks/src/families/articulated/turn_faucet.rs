@@ -187,19 +187,19 @@ impl Task for TurnFaucet {
         MAX_DENSE_REWARD
     }
 
-    fn select_episode_scene(&mut self, rng: &mut EpisodeRng) -> Result<bool, EnvError> {
-        let ids = self.models.ids();
-        let id = ids[rng.random_range(0..ids.len())].to_owned();
-        let changed = id != self.model_id || self.faucet.is_none();
-        self.model_id = id;
-        Ok(changed)
+    fn rebuild_every_episode(&self) -> bool {
+        true
     }
 
     fn build_scene(
         &mut self,
         world: &mut dyn RigidWorld,
-        _rng: &mut EpisodeRng,
+        rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
+        // The episode's model, drawn first (the parsed description is cached, so a rebuild
+        // costs the world's construction only).
+        let ids = self.models.ids();
+        self.model_id = ids[rng.random_range(0..ids.len())].to_owned();
         let info = self.models.info(&self.model_id)?.clone();
         let desc = self.models.load(&self.model_id)?;
         let switch_links = info.links_labelled("switch");
@@ -302,7 +302,7 @@ impl Task for TurnFaucet {
         Ok(())
     }
 
-    fn initialize_robot(
+    fn initialize_agent(
         &mut self,
         scene: &mut TaskScene,
         rng: &mut EpisodeRng,
