@@ -2,7 +2,7 @@
 //!
 //! - Models: the procedural faucets' train split by default ([`FAUCET_MODELS_ENV`] selects
 //!   `test` or ManiSkill2's `partnet` models); one is drawn per episode (the scene is rebuilt
-//!   when it changes). Links weigh 8000 kg/m³; every joint has friction 1 N·m and damping
+//!   at every reset, `rebuild_every_episode`). Links weigh 8000 kg/m³; every joint has friction 1 N·m and damping
 //!   10 N·m·s/rad, the `switch` joints friction 0.1 N·m and damping 2 N·m·s/rad.
 //! - Reset: faucet root at xy uniform in [-0.05, 0.05]², z = offset z + 0.01, yaw uniform in
 //!   [-π/12, π/12]; the target handle uniform among the `switch` links, its angle at its lower
