@@ -119,4 +119,12 @@ pub enum AssetError {
         /// What went wrong.
         reason: String,
     },
+    /// An articulated model's info file is malformed.
+    #[error("bad articulated-model info file {file}: {reason}")]
+    BadInfo {
+        /// The info file.
+        file: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
 }

@@ -150,10 +150,20 @@ impl AssetGroup {
 /// Name of the Panda description group.
 pub const FRANKA_DESCRIPTION: &str = "franka_description";
 
-const BUILTIN_JSON: &[(&str, &str)] = &[(
-    "ms2-assets/groups/franka_description.json",
-    include_str!("../groups/franka_description.json"),
-)];
+/// Name of the group of ManiSkill2's PartNet-Mobility info files
+/// (`partnet_mobility/meta/info_<category>_train.json`).
+pub const PARTNET_MOBILITY_META: &str = "partnet_mobility_meta";
+
+const BUILTIN_JSON: &[(&str, &str)] = &[
+    (
+        "ms2-assets/groups/franka_description.json",
+        include_str!("../groups/franka_description.json"),
+    ),
+    (
+        "ms2-assets/groups/partnet_mobility_meta.json",
+        include_str!("../groups/partnet_mobility_meta.json"),
+    ),
+];
 
 /// Every asset group ms2 knows, parsed once.
 pub fn builtin_groups() -> &'static [AssetGroup] {

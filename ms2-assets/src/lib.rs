@@ -15,11 +15,13 @@
 pub mod error;
 pub mod group;
 pub mod objects;
+pub mod partnet;
 pub mod store;
 
 pub use error::AssetError;
 pub use group::{
     builtin_groups, find_group, AssetFile, AssetGroup, AssetSource, FRANKA_DESCRIPTION,
+    PARTNET_MOBILITY_META,
 };
 pub use store::{asset_dir, locate, locate_in, register_package_dir, LocatedGroup, ASSET_DIR_ENV};
 

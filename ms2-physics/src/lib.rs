@@ -79,7 +79,7 @@ pub use description::{
 pub use error::{PhysicsError, Result, UrdfError};
 pub use ids::{ArticulationId, BodyId, BodyKind};
 pub use math::Pose3;
-pub use mesh::{MeshCollision, MeshError};
+pub use mesh::{connected_components, per_part_hulls, MeshCollision, MeshError, MeshPart};
 #[cfg(feature = "rapier")]
 pub use panda::{add_panda, add_panda_from_file, add_panda_from_urdf};
 pub use panda::{PandaOptions, PANDA_FINGER_FRICTION};

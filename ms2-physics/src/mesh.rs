@@ -16,6 +16,10 @@ pub enum MeshCollision {
     ConvexHull,
     /// An approximate convex decomposition (V-HACD) into a compound of convex parts.
     ConvexDecomposition,
+    /// One convex hull per connected piece of the file, as a compound: for files whose
+    /// pieces are already convex, like PartNet-Mobility's `mobility_cvx.urdf` meshes
+    /// (SAPIEN's `load_multiple_collisions_from_file`).
+    PerPartHulls,
 }
 
 /// A triangle mesh read from a file, scaled, in the file's frame (m).
@@ -149,13 +153,93 @@ pub fn load_mesh_parts(path: &Path, scale: Vector3<f32>) -> Result<Vec<MeshPart>
     Ok(parts)
 }
 
+/// The connected components of a triangle mesh (triangles sharing a vertex position: loaders
+/// may give every triangle its own copy of a vertex), each with its own vertices, in order of
+/// first appearance.
+pub fn connected_components(mesh: &TriangleMesh) -> Vec<TriangleMesh> {
+    let n = mesh.vertices.len();
+    // Vertices at the same position (bit for bit) are one vertex.
+    let mut first_at: std::collections::HashMap<[u32; 3], usize> = std::collections::HashMap::new();
+    let canonical: Vec<usize> = (0..n)
+        .map(|i| {
+            let p = mesh.vertices[i];
+            let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+            *first_at.entry(key).or_insert(i)
+        })
+        .collect();
+    let mut parent: Vec<usize> = canonical.clone();
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for t in &mesh.indices {
+        let t = t.map(|v| canonical[v as usize] as u32);
+        let a = find(&mut parent, t[0] as usize);
+        for &v in &t[1..] {
+            let b = find(&mut parent, v as usize);
+            parent[b] = a;
+        }
+    }
+    let mut component_of_root: std::collections::HashMap<usize, usize> =
+        std::collections::HashMap::new();
+    let mut out: Vec<(TriangleMesh, std::collections::HashMap<u32, u32>)> = Vec::new();
+    for t in &mesh.indices {
+        let root = find(&mut parent, t[0] as usize);
+        let c = *component_of_root.entry(root).or_insert_with(|| {
+            out.push((
+                TriangleMesh {
+                    vertices: Vec::new(),
+                    indices: Vec::new(),
+                },
+                std::collections::HashMap::new(),
+            ));
+            out.len() - 1
+        });
+        let (m, map) = &mut out[c];
+        let tri = t.map(|v| canonical[v as usize] as u32).map(|v| {
+            *map.entry(v).or_insert_with(|| {
+                m.vertices.push(mesh.vertices[v as usize]);
+                (m.vertices.len() - 1) as u32
+            })
+        });
+        m.indices.push(tri);
+    }
+    out.into_iter().map(|(m, _)| m).collect()
+}
+
+/// One convex hull per connected piece of every part (SAPIEN's
+/// `load_multiple_collisions_from_file`), as a compound (a single hull for a single piece).
+/// Pieces with fewer than 4 vertices are skipped.
+pub fn per_part_hulls(parts: &[MeshPart]) -> Result<ShapeDesc, MeshError> {
+    let mut hulls: Vec<(crate::math::Pose3, ShapeDesc)> = parts
+        .iter()
+        .flat_map(|p| connected_components(&p.mesh))
+        .filter(|m| m.vertices.len() >= 4)
+        .map(|m| {
+            (
+                crate::math::Pose3::identity(),
+                ShapeDesc::ConvexHull { points: m.vertices },
+            )
+        })
+        .collect();
+    match hulls.len() {
+        0 => Err(MeshError::NoTriangles),
+        1 => Ok(hulls.remove(0).1),
+        _ => Ok(ShapeDesc::Compound { parts: hulls }),
+    }
+}
+
 /// Turns a triangle mesh into a convex collision shape description.
 pub fn mesh_collision_shape(
     mesh: &TriangleMesh,
     mode: MeshCollision,
 ) -> Result<ShapeDesc, MeshError> {
     match mode {
-        MeshCollision::ConvexHull => Ok(ShapeDesc::ConvexHull {
+        // A single mesh has a single part: its hull.
+        MeshCollision::ConvexHull | MeshCollision::PerPartHulls => Ok(ShapeDesc::ConvexHull {
             points: mesh.vertices.clone(),
         }),
         MeshCollision::ConvexDecomposition => {

@@ -18,17 +18,34 @@ use crate::error::UrdfError;
 use crate::ids::ArticulationId;
 use crate::math::{pose_f64_to_f32, pose_from_xyz_rpy};
 use crate::mesh::{
-    load_mesh_file, load_mesh_parts, mesh_collision_shape, MeshCollision, MeshError,
+    load_mesh_file, load_mesh_parts, mesh_collision_shape, per_part_hulls, MeshCollision, MeshError,
 };
 use crate::shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
 #[cfg(feature = "rapier")]
 use crate::world::World;
 
 /// Options of URDF parsing.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct UrdfLoadOptions {
     /// How mesh collision geometry becomes convex shapes.
     pub mesh_collision: MeshCollision,
+    /// Uniform scale of the whole description (SAPIEN's `loader.scale`): every origin, mesh
+    /// and primitive size and every prismatic limit is multiplied by it. 1 by default.
+    pub scale: f32,
+    /// Density (kg/m³) giving links without an `<inertial>` their mass and inertia from their
+    /// collision shapes (SAPIEN's `density` config; PartNet-Mobility files have no inertials).
+    /// `None`: such links stay massless frames.
+    pub density: Option<f32>,
+}
+
+impl Default for UrdfLoadOptions {
+    fn default() -> Self {
+        UrdfLoadOptions {
+            mesh_collision: MeshCollision::default(),
+            scale: 1.0,
+            density: None,
+        }
+    }
 }
 
 /// Default colour of visuals without a material (linear RGBA).
@@ -56,6 +73,21 @@ pub fn parse_urdf_str(
     options: &UrdfLoadOptions,
 ) -> std::result::Result<ArticulationDesc, UrdfError> {
     precheck(text, file)?;
+    let scale = options.scale;
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(UrdfError::Invalid {
+            file: file.into(),
+            element: "<robot>".into(),
+            reason: format!("load scale {scale}: expected a finite positive factor"),
+        });
+    }
+    let origin = |xyz: [f64; 3], rpy: [f64; 3]| {
+        let s = f64::from(scale);
+        pose_f64_to_f32(&pose_from_xyz_rpy(
+            [xyz[0] * s, xyz[1] * s, xyz[2] * s],
+            rpy,
+        ))
+    };
     let robot = urdf_rs::read_from_string(text).map_err(|e| UrdfError::Malformed {
         file: file.into(),
         reason: e.to_string(),
@@ -82,10 +114,7 @@ pub fn parse_urdf_str(
             } else {
                 Some(Inertial {
                     mass: m,
-                    pose_link_from_inertial: pose_f64_to_f32(&pose_from_xyz_rpy(
-                        i.origin.xyz.0,
-                        i.origin.rpy.0,
-                    )),
+                    pose_link_from_inertial: origin(i.origin.xyz.0, i.origin.rpy.0),
                     inertia,
                 })
             }
@@ -99,13 +128,11 @@ pub fn parse_urdf_str(
                 &l.name,
                 "collision",
                 Some(options.mesh_collision),
+                scale,
             )?;
             collisions.push(ShapeSpec {
                 shape,
-                pose_body_from_shape: pose_f64_to_f32(&pose_from_xyz_rpy(
-                    c.origin.xyz.0,
-                    c.origin.rpy.0,
-                )),
+                pose_body_from_shape: origin(c.origin.xyz.0, c.origin.rpy.0),
                 material: Material::default(),
                 mass: MassSpec::Massless,
             });
@@ -125,9 +152,9 @@ pub fn parse_urdf_str(
                     })
                 })
                 .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32]);
-            let pose_body_from_shape =
-                pose_f64_to_f32(&pose_from_xyz_rpy(v.origin.xyz.0, v.origin.rpy.0));
-            for (shape, file_rgba) in visual_geometry(&v.geometry, base_dir, file, &l.name)? {
+            let pose_body_from_shape = origin(v.origin.xyz.0, v.origin.rpy.0);
+            for (shape, file_rgba) in visual_geometry(&v.geometry, base_dir, file, &l.name, scale)?
+            {
                 visuals.push(VisualShape {
                     shape,
                     pose_body_from_shape,
@@ -135,6 +162,18 @@ pub fn parse_urdf_str(
                 });
             }
         }
+        let inertial = match (inertial, options.density) {
+            (None, Some(density)) if !collisions.is_empty() => Some(
+                inertial_from_shapes(&collisions, density).map_err(|reason| {
+                    UrdfError::Invalid {
+                        file: file.into(),
+                        element: format!("<link name=\"{}\"> <collision>", l.name),
+                        reason,
+                    }
+                })?,
+            ),
+            (inertial, _) => inertial,
+        };
         links.push(LinkDesc {
             name: l.name.clone(),
             inertial,
@@ -158,8 +197,9 @@ pub fn parse_urdf_str(
             }
         };
         let limits = match joint_type {
-            JointType::Revolute | JointType::Prismatic => {
-                Some([j.limit.lower as f32, j.limit.upper as f32])
+            JointType::Revolute => Some([j.limit.lower as f32, j.limit.upper as f32]),
+            JointType::Prismatic => {
+                Some([j.limit.lower as f32 * scale, j.limit.upper as f32 * scale])
             }
             _ => None,
         };
@@ -168,10 +208,7 @@ pub fn parse_urdf_str(
             joint_type,
             parent: j.parent.link.clone(),
             child: j.child.link.clone(),
-            pose_parent_from_joint: pose_f64_to_f32(&pose_from_xyz_rpy(
-                j.origin.xyz.0,
-                j.origin.rpy.0,
-            )),
+            pose_parent_from_joint: origin(j.origin.xyz.0, j.origin.rpy.0),
             axis: Vector3::from(j.axis.xyz.0).cast::<f32>(),
             limits,
             effort_limit: j.limit.effort as f32,
@@ -260,10 +297,11 @@ fn visual_geometry(
     base_dir: &Path,
     file: &str,
     link: &str,
+    load_scale: f32,
 ) -> std::result::Result<VisualParts, UrdfError> {
     let urdf_rs::Geometry::Mesh { filename, scale } = g else {
         return Ok(vec![(
-            geometry(g, base_dir, file, link, "visual", None)?,
+            geometry(g, base_dir, file, link, "visual", None, load_scale)?,
             None,
         )]);
     };
@@ -277,14 +315,13 @@ fn visual_geometry(
         });
     }
     let s = scale.as_ref().map(|s| s.0).unwrap_or([1.0; 3]);
-    let parts = load_mesh_parts(&path, Vector3::from(s).cast::<f32>()).map_err(|source| {
-        UrdfError::MeshLoad {
-            file: file.into(),
-            link: link.into(),
-            element: "visual",
-            mesh: path.clone(),
-            source,
-        }
+    let s = Vector3::from(s).cast::<f32>() * load_scale;
+    let parts = load_mesh_parts(&path, s).map_err(|source| UrdfError::MeshLoad {
+        file: file.into(),
+        link: link.into(),
+        element: "visual",
+        mesh: path.clone(),
+        source,
     })?;
     Ok(parts
         .into_iter()
@@ -307,6 +344,7 @@ fn geometry(
     link: &str,
     element: &'static str,
     mesh_collision: Option<MeshCollision>,
+    load_scale: f32,
 ) -> std::result::Result<ShapeDesc, UrdfError> {
     let bad = |reason: String| UrdfError::Invalid {
         file: file.into(),
@@ -315,7 +353,7 @@ fn geometry(
     };
     let positive = |what: &str, v: f64| {
         if v.is_finite() && v > 0.0 {
-            Ok(v as f32)
+            Ok(v as f32 * load_scale)
         } else {
             Err(bad(format!(
                 "{what} = {v}: expected a positive length in metres"
@@ -350,6 +388,7 @@ fn geometry(
                 });
             }
             let s = scale.as_ref().map(|s| s.0).unwrap_or([1.0; 3]);
+            let s = Vector3::from(s).cast::<f32>() * load_scale;
             let mesh_err = |source: MeshError| UrdfError::MeshLoad {
                 file: file.into(),
                 link: link.into(),
@@ -357,7 +396,11 @@ fn geometry(
                 mesh: path.clone(),
                 source,
             };
-            let mesh = load_mesh_file(&path, Vector3::from(s).cast::<f32>()).map_err(mesh_err)?;
+            if mesh_collision == Some(MeshCollision::PerPartHulls) {
+                let parts = load_mesh_parts(&path, s).map_err(mesh_err)?;
+                return per_part_hulls(&parts).map_err(mesh_err);
+            }
+            let mesh = load_mesh_file(&path, s).map_err(mesh_err)?;
             match mesh_collision {
                 Some(mode) => mesh_collision_shape(&mesh, mode).map_err(mesh_err)?,
                 None => ShapeDesc::TriMesh {
@@ -366,6 +409,84 @@ fn geometry(
                 },
             }
         }
+    })
+}
+
+/// Mass properties of a parry shape for one shape description (cylinders and capsules along z).
+fn shape_mass(
+    shape: &ShapeDesc,
+    density: f32,
+) -> std::result::Result<parry3d::mass_properties::MassProperties, String> {
+    use parry3d::math::{Pose, Rotation, Vector};
+    use parry3d::shape::{Ball, Capsule, ConvexPolyhedron, Cuboid, Cylinder, Shape};
+    let y_to_z = Pose::from_rotation(Rotation::from_rotation_x(std::f32::consts::FRAC_PI_2));
+    Ok(match shape {
+        ShapeDesc::Box { half_extents } => {
+            Cuboid::new(crate::math::vec_from_na(half_extents)).mass_properties(density)
+        }
+        ShapeDesc::Sphere { radius } => Ball::new(*radius).mass_properties(density),
+        ShapeDesc::Capsule {
+            radius,
+            half_length,
+        } => Capsule::new_z(*half_length, *radius).mass_properties(density),
+        ShapeDesc::Cylinder {
+            radius,
+            half_length,
+        } => Cylinder::new(*half_length, *radius)
+            .mass_properties(density)
+            .transform_by(&y_to_z),
+        ShapeDesc::ConvexHull { points } => {
+            let pts: Vec<Vector> = points
+                .iter()
+                .map(|p| crate::math::vec_from_na(&p.coords))
+                .collect();
+            ConvexPolyhedron::from_convex_hull(&pts)
+                .ok_or_else(|| {
+                    format!(
+                        "convex hull of {} points failed: expected at least 4 points not all coplanar",
+                        points.len()
+                    )
+                })?
+                .mass_properties(density)
+        }
+        ShapeDesc::Compound { parts } => {
+            let mut total = parry3d::mass_properties::MassProperties::default();
+            for (pose, part) in parts {
+                total += shape_mass(part, density)?.transform_by(&crate::math::pose_from_na(pose));
+            }
+            total
+        }
+        ShapeDesc::TriMesh { .. } => {
+            return Err("a triangle-mesh collision has no volume: expected convex shapes".into())
+        }
+    })
+}
+
+/// The inertial of a link whose collision shapes are made of a material of `density` kg/m³.
+fn inertial_from_shapes(
+    shapes: &[ShapeSpec],
+    density: f32,
+) -> std::result::Result<Inertial, String> {
+    if !(density.is_finite() && density > 0.0) {
+        return Err(format!(
+            "density {density}: expected a finite positive density in kg/m^3"
+        ));
+    }
+    let mut total = parry3d::mass_properties::MassProperties::default();
+    for s in shapes {
+        total += shape_mass(&s.shape, density)?
+            .transform_by(&crate::math::pose_from_na(&s.pose_body_from_shape));
+    }
+    let m = total.reconstruct_inertia_matrix();
+    let inertia = Matrix3::from_fn(|r, c| m.col(c)[r]);
+    Ok(Inertial {
+        mass: total.mass(),
+        pose_link_from_inertial: crate::math::Pose3::translation(
+            total.local_com.x,
+            total.local_com.y,
+            total.local_com.z,
+        ),
+        inertia: (inertia + inertia.transpose()) * 0.5,
     })
 }
 

@@ -273,6 +273,10 @@ impl Agent for GripperArmAgent {
         self.base_pose
     }
 
+    fn set_base_pose(&mut self, pose: Pose3) {
+        self.base_pose = pose;
+    }
+
     /// Pose of the TCP link in the world.
     fn tcp_pose(&self, world: &dyn RigidWorld) -> Pose3 {
         world

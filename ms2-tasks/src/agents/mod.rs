@@ -61,6 +61,9 @@ pub trait Agent: Any + Send + Debug {
     fn controller_mut(&mut self) -> &mut CombinedController;
     /// Pose of the robot base in the world.
     fn base_pose(&self) -> Pose3;
+    /// Moves the robot base to `pose` (world) from the next [`Agent::initialize`] or
+    /// [`Agent::set_joint_state`] on (tasks whose robot stands elsewhere, e.g. TurnFaucet).
+    fn set_base_pose(&mut self, pose: Pose3);
     /// Puts the robot at its episode-start configuration (drawn from `rng`), at rest, with
     /// drive targets there, and resets the controller.
     fn initialize(

@@ -9,9 +9,11 @@
 //! | [`rigid`] | `PickCube-v0`, `LiftCube-v0`, `StackCube-v0` | — |
 //! | [`assembly`] | `PegInsertionSide-v0`, `PlugCharger-v0` | — |
 //! | [`soft`] | `Excavate-v0`, `Fill-v0` | `soft` |
+//! | [`articulated`] | `TurnFaucet-v0` (PartNet-Mobility-layout models) | — |
 //! | [`misc`] | `PandaAvoidObstacles-v0` | — |
 //! | [`dummy`] | `Dummy-v0` (physics-free test env) | — |
 
+pub mod articulated;
 pub mod assembly;
 pub mod dummy;
 pub mod misc;
@@ -25,6 +27,7 @@ use crate::registry::Registrar;
 /// Registers every built-in family, one call each.
 pub(crate) fn register_builtin(r: &mut Registrar) {
     rigid::register(r);
+    articulated::register(r);
     assembly::register(r);
     objects::register(r);
     #[cfg(feature = "soft")]

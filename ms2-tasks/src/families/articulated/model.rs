@@ -1,0 +1,143 @@
+//! Articulated models in the PartNet-Mobility layout ([`ms2_assets::partnet`]): model sets
+//! (an info file and its dataset folder) and their descriptions, parsed once per process.
+//!
+//! A model's URDF is read with its info's scale, the links' mass from a density (ManiSkill2's
+//! 8000 kg/m³ unless the info gives one) and one convex hull per mesh object (PartNet-Mobility's
+//! `mobility_cvx.urdf` meshes are convex pieces). Parsed descriptions are cached by
+//! (URDF path, scale, density): reloading a model for a new episode costs nothing.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, OnceLock};
+
+use ms2_assets::partnet::{self, ModelDb, ModelInfo};
+use ms2_physics::{parse_urdf_file, ArticulationDesc, MeshCollision, UrdfLoadOptions};
+
+use crate::error::EnvError;
+
+/// ManiSkill2's default density of articulated-object links (kg/m³).
+pub const DEFAULT_DENSITY: f32 = 8e3;
+
+/// Where a task's models come from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ModelSource {
+    /// ms2's procedural models of a category (generated on first use), `train` or `test` split.
+    Procedural {
+        /// `train` or `test`.
+        split: String,
+    },
+    /// ManiSkill2's PartNet-Mobility models (`partnet_mobility/dataset`, fetched by the user)
+    /// listed by its info file (`ms2 assets fetch partnet_mobility_meta`).
+    PartNet,
+}
+
+/// A set of models of one category: their dataset folder and info entries.
+#[derive(Clone, Debug)]
+pub struct ModelSet {
+    /// The dataset root (`<asset dir>/ms2_partnet_mobility` or `<asset dir>/partnet_mobility`).
+    pub root: PathBuf,
+    /// The info file read.
+    pub info_file: PathBuf,
+    /// Models by id (sorted).
+    pub db: ModelDb,
+}
+
+impl ModelSet {
+    /// The models of `category` from `source` under the asset directory `asset_dir`.
+    /// Procedural faucets are generated on first use.
+    pub fn open(asset_dir: &Path, category: &str, source: &ModelSource) -> Result<Self, EnvError> {
+        let asset = |e: ms2_assets::AssetError| EnvError::Asset(e.to_string());
+        let (root, info_file) = match source {
+            ModelSource::Procedural { split } => {
+                let root = match category {
+                    ms2_assets::partnet::faucet::CATEGORY => {
+                        ms2_assets::partnet::faucet::ensure_faucets(asset_dir).map_err(asset)?
+                    }
+                    other => {
+                        return Err(EnvError::Asset(format!(
+                            "no procedural models of category \"{other}\": expected \"faucet\""
+                        )))
+                    }
+                };
+                let info = partnet::info_path(&root, category, split);
+                (root, info)
+            }
+            ModelSource::PartNet => {
+                let root = asset_dir.join(partnet::PARTNET_DIR);
+                let info = partnet::info_path(&root, category, "train");
+                (root, info)
+            }
+        };
+        let db = partnet::read_info(&info_file).map_err(asset)?;
+        if db.is_empty() {
+            return Err(EnvError::Asset(format!(
+                "info file {} lists no model: expected at least one",
+                info_file.display()
+            )));
+        }
+        Ok(ModelSet {
+            root,
+            info_file,
+            db,
+        })
+    }
+
+    /// The ids, sorted.
+    pub fn ids(&self) -> Vec<&str> {
+        self.db.keys().map(String::as_str).collect()
+    }
+
+    /// The info of `id`, or an error naming the info file.
+    pub fn info(&self, id: &str) -> Result<&ModelInfo, EnvError> {
+        self.db.get(id).ok_or_else(|| {
+            EnvError::Asset(format!(
+                "model \"{id}\" is not in {}: expected one of {:?}",
+                self.info_file.display(),
+                self.ids()
+            ))
+        })
+    }
+
+    /// The parsed description of model `id` (cached per process).
+    pub fn load(&self, id: &str) -> Result<Arc<ArticulationDesc>, EnvError> {
+        let info = self.info(id)?;
+        let urdf =
+            partnet::find_urdf(&self.root, id).map_err(|e| EnvError::Asset(e.to_string()))?;
+        load_model(
+            &urdf,
+            info.effective_scale(),
+            info.density.unwrap_or(DEFAULT_DENSITY),
+        )
+    }
+}
+
+type CacheKey = (PathBuf, u32, u32);
+
+fn cache() -> &'static Mutex<HashMap<CacheKey, Arc<ArticulationDesc>>> {
+    static CACHE: OnceLock<Mutex<HashMap<CacheKey, Arc<ArticulationDesc>>>> = OnceLock::new();
+    CACHE.get_or_init(|| Mutex::new(HashMap::new()))
+}
+
+/// Parses an articulated model's URDF at `scale` with links of `density` kg/m³ and one convex
+/// hull per mesh object; cached per process. Errors name the file.
+pub fn load_model(
+    urdf: &Path,
+    scale: f32,
+    density: f32,
+) -> Result<Arc<ArticulationDesc>, EnvError> {
+    let key = (urdf.to_path_buf(), scale.to_bits(), density.to_bits());
+    if let Some(d) = cache().lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+        return Ok(d.clone());
+    }
+    let options = UrdfLoadOptions {
+        mesh_collision: MeshCollision::PerPartHulls,
+        scale,
+        density: Some(density),
+    };
+    let desc = Arc::new(parse_urdf_file(urdf, &options)?);
+    cache()
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(key, desc.clone());
+    Ok(desc)
+}
