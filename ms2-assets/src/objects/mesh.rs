@@ -157,27 +157,52 @@ impl Mesh {
     }
 
     /// Convex hull of points (m), through parry3d. `None` when the points are degenerate.
+    ///
+    /// parry's hull of many nearly coplanar points (cylinder and box pieces) sometimes keeps a
+    /// few non-hull vertices; the result is checked and, when it is not convex, the hull is
+    /// taken again of its own vertices or of the points moved by a deterministic jitter of
+    /// 1e-6 of their extent, keeping the most convex result.
     pub fn convex_hull(points: &[[f64; 3]]) -> Option<Mesh> {
         if points.len() < 4 {
             return None;
         }
-        let pts: Vec<parry3d::math::Vector> = points
-            .iter()
-            .map(|p| parry3d::math::Vector::new(p[0] as f32, p[1] as f32, p[2] as f32))
-            .collect();
-        let (v, t) = parry3d::transformation::try_convex_hull(&pts).ok()?;
-        if t.is_empty() {
-            return None;
+        let (lo, hi) = Mesh {
+            vertices: points.to_vec(),
+            triangles: Vec::new(),
         }
-        let mut m = Mesh {
-            vertices: v
-                .iter()
-                .map(|p| [p.x as f64, p.y as f64, p.z as f64])
-                .collect(),
-            triangles: t,
-        };
-        m.orient_outward();
-        Some(m)
+        .bbox();
+        let extent = (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max).max(1e-9);
+        let mut best: Option<(f64, Mesh)> = None;
+        let mut input = points.to_vec();
+        for attempt in 0..6 {
+            let Some(m) = parry_hull(&input) else {
+                break;
+            };
+            let err = convexity_error(&m);
+            if best.as_ref().is_none_or(|(e, _)| err < *e) {
+                best = Some((err, m.clone()));
+            }
+            if err <= 1e-7 * extent {
+                break;
+            }
+            input = if attempt % 2 == 0 {
+                m.vertices.clone()
+            } else {
+                let mut state = 0x2545_f491_4f6c_dd1du64.wrapping_add(attempt as u64);
+                points
+                    .iter()
+                    .map(|p| {
+                        p.map(|c| {
+                            state ^= state << 13;
+                            state ^= state >> 7;
+                            state ^= state << 17;
+                            c + extent * 1e-6 * ((state % 2001) as f64 / 1000.0 - 1.0)
+                        })
+                    })
+                    .collect()
+            };
+        }
+        best.map(|(_, m)| m)
     }
 
     /// Scales each axis.
@@ -280,6 +305,61 @@ impl Mesh {
     }
 }
 
+fn parry_hull(points: &[[f64; 3]]) -> Option<Mesh> {
+    let pts: Vec<parry3d::math::Vector> = points
+        .iter()
+        .map(|p| parry3d::math::Vector::new(p[0] as f32, p[1] as f32, p[2] as f32))
+        .collect();
+    let (v, t) = parry3d::transformation::try_convex_hull(&pts).ok()?;
+    if t.is_empty() {
+        return None;
+    }
+    let mut m = Mesh {
+        vertices: v
+            .iter()
+            .map(|p| [p.x as f64, p.y as f64, p.z as f64])
+            .collect(),
+        triangles: t,
+    };
+    // Each face outward from the centroid (slivers can come back wound either way).
+    let n = m.vertices.len() as f64;
+    let c = m
+        .vertices
+        .iter()
+        .fold([0.0; 3], |acc, v| add(acc, scale3(*v, 1.0 / n)));
+    for t in &mut m.triangles {
+        let [a, b, d] = t.map(|i| m.vertices[i as usize]);
+        if dot(
+            cross(sub(b, a), sub(d, a)),
+            sub(scale3(add(add(a, b), d), 1.0 / 3.0), c),
+        ) < 0.0
+        {
+            t.swap(1, 2);
+        }
+    }
+    Some(m)
+}
+
+/// How far (m) the farthest vertex lies outside the plane of a face (0 for a convex mesh);
+/// sliver faces without a reliable plane are skipped.
+pub fn convexity_error(m: &Mesh) -> f64 {
+    let (lo, hi) = m.bbox();
+    let diag2: f64 = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum();
+    let mut worst = 0.0f64;
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+        let n = cross(sub(b, a), sub(c, a));
+        let nn = dot(n, n).sqrt();
+        if nn < 1e-4 * diag2 {
+            continue;
+        }
+        for v in &m.vertices {
+            worst = worst.max(dot(n, sub(*v, a)) / nn);
+        }
+    }
+    worst
+}
+
 pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
@@ -317,12 +397,13 @@ mod tests {
         let c = Mesh::cuboid([0.01, 0.02, 0.03]);
         assert!((c.volume() - 0.02 * 0.04 * 0.06).abs() < 1e-12);
         // A cylinder of radius 3 cm, height 10 cm (polygon area with 64 sides).
-        let cyl = Mesh::lathe(
-            &[[0.0, 0.0], [0.03, 0.0], [0.03, 0.1], [0.0, 0.1]],
-            64,
-        );
+        let cyl = Mesh::lathe(&[[0.0, 0.0], [0.03, 0.0], [0.03, 0.1], [0.0, 0.1]], 64);
         let poly_area = 0.5 * 64.0 * 0.03f64.powi(2) * (TAU / 64.0).sin();
-        assert!((cyl.volume() - poly_area * 0.1).abs() < 1e-9, "{}", cyl.volume());
+        assert!(
+            (cyl.volume() - poly_area * 0.1).abs() < 1e-9,
+            "{}",
+            cyl.volume()
+        );
         let e = Mesh::ellipsoid([0.02, 0.03, 0.04], 24, 48);
         let exact = 4.0 / 3.0 * std::f64::consts::PI * 0.02 * 0.03 * 0.04;
         assert!((e.volume() - exact).abs() / exact < 0.02);
