@@ -364,7 +364,7 @@ def _cmd_download(args: argparse.Namespace) -> int:
     for name in names:
         last = [-1]
 
-        def progress(got: int, total: int | None, last: list[int] = last) -> None:
+        def progress(got: int, total: int | None, last: list[int] = last, name: str = name) -> None:
             step = got >> 24  # a line every 16 MiB
             if not args.quiet and step != last[0]:
                 last[0] = step
