@@ -21,6 +21,7 @@ use crate::obs::{DictBuilder, ObsValue};
 use crate::particles::ParticleVisual;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::CameraConfig;
 
 /// What a task's hooks see: the rigid world (through the port) and the robot.
 pub struct TaskScene {
@@ -100,6 +101,19 @@ pub trait Task: Any + Send {
     /// [`Task::soft`], mutably (the runtime steps it).
     fn soft_mut(&mut self) -> Option<&mut dyn SoftComponent> {
         None
+    }
+
+    /// The observation cameras of the visual obs modes (ManiSkill2's `_register_cameras` of the
+    /// task); default: the Panda tasks' `base_camera` and `hand_camera`. The user's
+    /// `camera_cfgs` updates are applied to these.
+    fn sensor_cameras(&self) -> Vec<CameraConfig> {
+        CameraConfig::panda_defaults()
+    }
+
+    /// The camera of `render()` (ManiSkill2's `_register_render_cameras`); default: the Panda
+    /// pick-and-place tasks' [`CameraConfig::render_camera`]. `render_camera_cfgs` updates it.
+    fn render_camera(&self) -> CameraConfig {
+        CameraConfig::render_camera()
     }
 }
 

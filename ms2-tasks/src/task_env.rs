@@ -51,6 +51,8 @@ pub(crate) struct TaskEnv {
     /// Whether the first directional light casts shadows (`enable_shadow`).
     #[cfg(feature = "render")]
     enable_shadow: bool,
+    /// [`crate::EnvConfig::exact_restore`].
+    exact_restore: bool,
     /// Cameras and render scene, built on the first render (state-only envs never render).
     #[cfg(feature = "render")]
     sensors: Mutex<Option<Sensors>>,
@@ -116,17 +118,23 @@ impl TaskEnv {
             ctrl.action_low().iter().map(|&v| v as f32).collect(),
             ctrl.action_high().iter().map(|&v| v as f32).collect(),
         );
-        let camera_cfgs = cfg
+        let mut camera_cfgs = cfg
             .camera_cfgs
             .clone()
-            .unwrap_or_else(CameraConfig::panda_defaults);
+            .unwrap_or_else(|| task.sensor_cameras());
+        if let Some(updates) = &cfg.camera_updates {
+            camera_cfgs = updates.applied_to(camera_cfgs)?;
+        }
         for cam in &camera_cfgs {
             cam.validate()?;
         }
-        let render_camera = cfg
+        let mut render_camera = cfg
             .render_camera
             .clone()
-            .unwrap_or_else(CameraConfig::render_camera);
+            .unwrap_or_else(|| task.render_camera());
+        if let Some(updates) = &cfg.render_camera_updates {
+            render_camera = updates.applied_to(vec![render_camera])?.remove(0);
+        }
         render_camera.validate()?;
         #[cfg(not(feature = "render"))]
         let _ = render_camera;
@@ -146,6 +154,7 @@ impl TaskEnv {
             render_camera,
             #[cfg(feature = "render")]
             enable_shadow: cfg.enable_shadow,
+            exact_restore: cfg.exact_restore,
             #[cfg(feature = "render")]
             sensors: Mutex::new(None),
         })
@@ -297,6 +306,12 @@ impl EnvBackend for TaskEnv {
     fn apply_action(&mut self, action: &[f32]) -> Result<(), EnvError> {
         let TaskScene { world, agent } = &mut self.scene;
         let world = world.as_mut();
+        // With `exact_restore`, every env step starts from the flat state alone (no warm-start
+        // impulses or contact pairs carried over from the previous step), so a state restored
+        // into any env of the same build continues exactly as the run it was recorded from.
+        if self.exact_restore {
+            world.forget_solver_history()?;
+        }
         agent.set_action(world, action)?;
         let mut soft = self.task.soft_mut();
         for _ in 0..self.substeps {

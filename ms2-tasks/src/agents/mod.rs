@@ -29,7 +29,9 @@ use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
 
 pub use panda::{PandaAgent, ARM_DOF, ARM_QPOS_NOISE_STD, GRASP_MIN_IMPULSE, ROBOT_STATIC_QVEL};
-pub use panda_model::{panda_model, PandaModel, PandaModelSource, PANDA_DESCRIPTION_ENV};
+pub use panda_model::{
+    panda_bucket_model, panda_model, PandaModel, PandaModelSource, PANDA_DESCRIPTION_ENV,
+};
 
 /// A robot in a rigid world with the controller of one control mode.
 ///

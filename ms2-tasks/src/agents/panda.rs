@@ -34,11 +34,12 @@ pub const PANDA: RobotSpec = RobotSpec {
 /// (`ms2_assets::PANDA_BUCKET_URDF`), ManiSkill2's robot of Excavate and Fill.
 pub const PANDA_BUCKET: RobotSpec = RobotSpec {
     name: "panda_bucket",
-    description: "the Panda with a bucket fixed to its hand (ms2_assets::PANDA_BUCKET_URDF)",
+    description: "the Panda with a bucket fixed to its hand (ms2_assets::PANDA_BUCKET_URDF; the \
+                  real Panda's meshes on its links when fetched)",
     control_modes: panda_control_modes,
     build: |world, mode, timing| {
-        let urdf = ms2_assets::PANDA_BUCKET_URDF;
-        let agent = PandaAgent::build_from_urdf(world, mode, timing, urdf)?;
+        let model = super::panda_model::panda_bucket_model()?;
+        let agent = PandaAgent::build_from_desc(world, mode, timing, &model.desc)?;
         Ok(Box::new(agent.named("panda_bucket")))
     },
 };
