@@ -30,7 +30,7 @@ impl Default for DecompositionParams {
 }
 
 /// Bumped when the decomposition output for the same input changes (invalidates the cache).
-const DECOMPOSITION_VERSION: u32 = 1;
+const DECOMPOSITION_VERSION: u32 = 3;
 
 /// The V-HACD convex parts of a closed mesh (m), each the exact convex hull of the mesh's
 /// triangles in that part. Falls back to one convex hull of the whole mesh when V-HACD gives no

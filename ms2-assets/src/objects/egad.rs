@@ -28,7 +28,7 @@ use super::{ObjectFamily, Split};
 use crate::error::AssetError;
 
 /// Bumped whenever the generated files change.
-pub const GENERATOR_VERSION: u32 = 1;
+pub const GENERATOR_VERSION: u32 = 3;
 /// Seed of the EGAD-like family.
 pub const SEED: u64 = 2020;
 /// Training models (ManiSkill2's EGAD training set size).

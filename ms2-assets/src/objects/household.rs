@@ -22,7 +22,7 @@ use super::ObjectFamily;
 use crate::error::AssetError;
 
 /// Bumped whenever the generated files change.
-pub const GENERATOR_VERSION: u32 = 1;
+pub const GENERATOR_VERSION: u32 = 3;
 /// Seed of the household family.
 pub const SEED: u64 = 16;
 

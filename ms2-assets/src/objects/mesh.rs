@@ -158,49 +158,66 @@ impl Mesh {
 
     /// Convex hull of points (m), through parry3d. `None` when the points are degenerate.
     ///
-    /// parry's hull of many nearly coplanar points (cylinder and box pieces) sometimes keeps a
-    /// few non-hull vertices; the result is checked and, when it is not convex, the hull is
-    /// taken again of its own vertices or of the points moved by a deterministic jitter of
-    /// 1e-6 of their extent, keeping the most convex result.
+    /// Points closer than 0.1 mm are welded first. parry's hull of many nearly coplanar
+    /// points (disc, cylinder and box pieces) sometimes keeps non-hull vertices or leaves
+    /// input points outside; the result is checked and, when either is off by more than
+    /// 10 µm, the hull is taken again of the points moved by a deterministic jitter of
+    /// 10-80 µm, keeping the best result.
     pub fn convex_hull(points: &[[f64; 3]]) -> Option<Mesh> {
         if points.len() < 4 {
             return None;
         }
-        let (lo, hi) = Mesh {
-            vertices: points.to_vec(),
-            triangles: Vec::new(),
+        // Weld points closer than 0.1 mm: near-duplicates on nearly coplanar faces are what
+        // trips the hull, and the pieces are written with µm precision.
+        let mut seen = std::collections::HashSet::new();
+        let points: Vec<[f64; 3]> = points
+            .iter()
+            .map(|p| p.map(|c| (c / WELD_M).round() * WELD_M))
+            .filter(|p| seen.insert(p.map(|c| (c / WELD_M).round() as i64)))
+            .collect();
+        if points.len() < 4 {
+            return None;
         }
-        .bbox();
-        let extent = (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max).max(1e-9);
+        let points = &points[..];
         let mut best: Option<(f64, Mesh)> = None;
         let mut input = points.to_vec();
-        for attempt in 0..6 {
+        for attempt in 0..8u64 {
             let Some(m) = parry_hull(&input) else {
                 break;
             };
-            let err = convexity_error(&m);
+            // Not convex, or an input point left outside: the hull lost a vertex.
+            let mut err = convexity_error(&m).max(outside_distance(&m, points));
+            // A reader hulls the written (µm-rounded) vertices again: that hull must keep them.
+            let written: Vec<[f64; 3]> = m
+                .vertices
+                .iter()
+                .map(|v| v.map(|c| (c * 1e6).round() / 1e6))
+                .collect();
+            match parry_hull(&written) {
+                Some(again) => err = err.max(outside_distance(&again, &written)),
+                None => err = f64::INFINITY,
+            }
             if best.as_ref().is_none_or(|(e, _)| err < *e) {
                 best = Some((err, m.clone()));
             }
-            if err <= 1e-7 * extent {
+            if err <= 1e-5 {
                 break;
             }
-            input = if attempt % 2 == 0 {
-                m.vertices.clone()
-            } else {
-                let mut state = 0x2545_f491_4f6c_dd1du64.wrapping_add(attempt as u64);
-                points
-                    .iter()
-                    .map(|p| {
-                        p.map(|c| {
-                            state ^= state << 13;
-                            state ^= state >> 7;
-                            state ^= state << 17;
-                            c + extent * 1e-6 * ((state % 2001) as f64 / 1000.0 - 1.0)
-                        })
+            // Retry with the points moved by a deterministic jitter of up to 10 µm per try
+            // (well above the µm precision of the files, so readers hull the same points).
+            let mut state = 0x2545_f491_4f6c_dd1du64.wrapping_add(attempt);
+            let amp = 1e-5 * (attempt + 1) as f64;
+            input = points
+                .iter()
+                .map(|p| {
+                    p.map(|c| {
+                        state ^= state << 13;
+                        state ^= state >> 7;
+                        state ^= state << 17;
+                        c + amp * ((state % 2001) as f64 / 1000.0 - 1.0)
                     })
-                    .collect()
-            };
+                })
+                .collect();
         }
         best.map(|(_, m)| m)
     }
@@ -305,6 +322,9 @@ impl Mesh {
     }
 }
 
+/// Points closer than this (m) are one point for [`Mesh::convex_hull`].
+const WELD_M: f64 = 1e-4;
+
 fn parry_hull(points: &[[f64; 3]]) -> Option<Mesh> {
     let pts: Vec<parry3d::math::Vector> = points
         .iter()
@@ -338,6 +358,29 @@ fn parry_hull(points: &[[f64; 3]]) -> Option<Mesh> {
         }
     }
     Some(m)
+}
+
+/// How far (m) the farthest of `points` lies outside the convex mesh `m`.
+fn outside_distance(m: &Mesh, points: &[[f64; 3]]) -> f64 {
+    let planes: Vec<([f64; 3], [f64; 3])> = m
+        .triangles
+        .iter()
+        .filter_map(|t| {
+            let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+            let n = cross(sub(b, a), sub(c, a));
+            let nn = dot(n, n).sqrt();
+            (nn > 1e-12).then(|| (scale3(n, 1.0 / nn), a))
+        })
+        .collect();
+    points
+        .iter()
+        .map(|p| {
+            planes
+                .iter()
+                .map(|(n, a)| dot(*n, sub(*p, *a)))
+                .fold(f64::NEG_INFINITY, f64::max)
+        })
+        .fold(0.0, f64::max)
 }
 
 /// How far (m) the farthest vertex lies outside the plane of a face (0 for a convex mesh);
