@@ -23,6 +23,10 @@ pub(crate) trait EnvBackend: Send {
     fn action_space(&self) -> &BoxSpace;
     /// Largest dense reward (for `normalized_dense`).
     fn max_dense_reward(&self) -> f64;
+    /// Whether every episode starts with [`EnvBackend::reconfigure`] (per-episode scenes).
+    fn rebuild_every_episode(&self) -> bool {
+        false
+    }
     /// (Re)builds the scene.
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError>;
     /// Samples a new episode (robot and objects) from `rng`.

@@ -6,13 +6,16 @@
 //! | when | hook |
 //! |---|---|
 //! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
-//! | every reset, in this order | [`Task::initialize_actors`], robot reset (rest qpos + noise), [`Task::initialize_task`] |
+//! | every reset, first, when [`Task::rebuild_every_episode`] | [`Task::build_scene`] on a fresh world, with the episode's RNG (per-episode layouts and geometry) |
+//! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_agent`] (default: the robot's reset, rest qpos + noise), [`Task::initialize_task`] |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
 //! | soft-body tasks only | [`Task::soft`]: one [`SoftComponent`] (substeps after each physics step, particles observed and drawn) |
 
 use std::any::Any;
+
+use ms2_physics::SolverConfig;
 
 use crate::agents::Agent;
 use crate::error::EnvError;
@@ -61,6 +64,33 @@ pub trait Task: Any + Send {
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError>;
 
+    /// Puts the robot at its episode start (after [`Task::initialize_actors`]). The default is
+    /// the agent's own reset (rest qpos plus noise); a task with another start posture (e.g.
+    /// PegInsertionSide's turned hand, an obstacle layout's start configuration) overrides it.
+    fn initialize_agent(
+        &mut self,
+        scene: &mut TaskScene,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
+        let TaskScene { world, agent } = scene;
+        agent.initialize(world.as_mut(), rng)
+    }
+
+    /// Whether every episode builds a fresh world ([`Task::build_scene`] with the episode's
+    /// RNG), for tasks whose actors or geometry differ per episode (ManiSkill2 reconfigures on
+    /// a new episode layout; PegInsertionSide draws its peg and hole per episode). Default:
+    /// `false` (the world is built at make and on `reconfigure`).
+    fn rebuild_every_episode(&self) -> bool {
+        false
+    }
+
+    /// The physics solver settings of the task's worlds, given ms2's defaults (a task whose
+    /// contacts need other settings, e.g. PlugCharger's 0.5 mm clearance a shorter contact
+    /// prediction distance, changes them here). Read once when the env is made.
+    fn solver_config(&self, defaults: SolverConfig) -> SolverConfig {
+        defaults
+    }
+
     /// Samples task data (e.g. the goal) after actors and robot are placed.
     fn initialize_task(
         &mut self,
@@ -103,17 +133,20 @@ pub trait Task: Any + Send {
         None
     }
 
-    /// The observation cameras of the visual obs modes (ManiSkill2's `_register_cameras` of the
-    /// task); default: the Panda tasks' `base_camera` and `hand_camera`. The user's
-    /// `camera_cfgs` updates are applied to these.
-    fn sensor_cameras(&self) -> Vec<CameraConfig> {
-        CameraConfig::panda_defaults()
+    /// The observation cameras of the visual obs modes, given the robot's
+    /// ([`crate::agents::RobotSpec::cameras`]: the Panda's `base_camera` and `hand_camera`).
+    /// ManiSkill2 places `base_camera` per task (its `_register_cameras`): a task that does
+    /// returns the list with that camera changed. The user's `camera_cfgs` updates are applied
+    /// to the result. Default: the robot's cameras.
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        robot_cameras
     }
 
-    /// The camera of `render()` (ManiSkill2's `_register_render_cameras`); default: the Panda
-    /// pick-and-place tasks' [`CameraConfig::render_camera`]. `render_camera_cfgs` updates it.
-    fn render_camera(&self) -> CameraConfig {
-        CameraConfig::render_camera()
+    /// The camera of `render()`, given the robot's default
+    /// ([`crate::agents::RobotSpec::render_camera`]); ManiSkill2's `_register_render_cameras`
+    /// of the task. `render_camera_cfgs` updates the result. Default: the robot's.
+    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
+        robot_default
     }
 }
 

@@ -10,7 +10,7 @@ use ms2_physics::WorldConfig;
 
 #[cfg(feature = "render")]
 use crate::adapters::RenderContext;
-use crate::agents::{robot_spec, RobotSpec};
+use crate::agents::{robot_spec, RobotSpec, CONTROL_MODE_ALIASES};
 use crate::backend::EnvBackend;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
@@ -83,14 +83,25 @@ impl TaskEnv {
             .filter(|m| spec.control_modes.is_empty() || spec.control_modes.contains(&m.name()))
             .collect();
         let control_modes: Vec<String> = supported.iter().map(|m| m.name().to_owned()).collect();
-        let mode_name = cfg
-            .control_mode
-            .as_deref()
-            .unwrap_or(spec.default_control_mode);
+        // The task's default for its default robot, else the robot's own first mode
+        // (ManiSkill2: the agent's first mode; `xmate3_robotiq` starts with `pd_joint_pos`).
+        let default_mode = if robot_uid == Some(spec.default_robot()) {
+            spec.default_control_mode
+        } else {
+            control_modes
+                .first()
+                .map_or(spec.default_control_mode, String::as_str)
+        };
+        let mode_name = cfg.control_mode.as_deref().unwrap_or(default_mode);
         let mode = supported
             .iter()
             .copied()
-            .find(|m| m.name() == mode_name)
+            .find(|m| {
+                m.name() == mode_name
+                    || CONTROL_MODE_ALIASES
+                        .iter()
+                        .any(|(alias, aliased)| *alias == mode_name && aliased == m)
+            })
             .ok_or_else(|| EnvError::UnknownControlMode {
                 got: mode_name.to_owned(),
                 valid: control_modes.clone(),
@@ -99,9 +110,11 @@ impl TaskEnv {
             control_freq_hz: cfg.control_freq,
             sim_freq_hz: cfg.sim_freq,
         };
+        let defaults = WorldConfig::default();
         let world_config = WorldConfig {
             timestep: (1.0 / cfg.sim_freq) as f32,
-            ..WorldConfig::default()
+            solver: task.solver_config(defaults.solver),
+            ..defaults
         };
         let mut rng = episode_rng(BUILD_SEED);
         let scene = build_scene(
@@ -121,7 +134,7 @@ impl TaskEnv {
         let mut camera_cfgs = cfg
             .camera_cfgs
             .clone()
-            .unwrap_or_else(|| task.sensor_cameras());
+            .unwrap_or_else(|| task.sensor_cameras((robot.cameras)()));
         if let Some(updates) = &cfg.camera_updates {
             camera_cfgs = updates.applied_to(camera_cfgs)?;
         }
@@ -131,7 +144,7 @@ impl TaskEnv {
         let mut render_camera = cfg
             .render_camera
             .clone()
-            .unwrap_or_else(|| task.render_camera());
+            .unwrap_or_else(|| task.render_camera((robot.render_camera)()));
         if let Some(updates) = &cfg.render_camera_updates {
             render_camera = updates.applied_to(vec![render_camera])?.remove(0);
         }
@@ -273,6 +286,10 @@ impl EnvBackend for TaskEnv {
         self.task.max_dense_reward()
     }
 
+    fn rebuild_every_episode(&self) -> bool {
+        self.task.rebuild_every_episode()
+    }
+
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let mode = self.scene.agent.control_mode();
         self.scene = build_scene(
@@ -294,8 +311,7 @@ impl EnvBackend for TaskEnv {
 
     fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         self.task.initialize_actors(&mut self.scene, rng)?;
-        let TaskScene { world, agent } = &mut self.scene;
-        agent.initialize(world.as_mut(), rng)?;
+        self.task.initialize_agent(&mut self.scene, rng)?;
         self.task.initialize_task(&self.scene, rng)?;
         // The previous episode's contact caches must not leak into this one: an episode is
         // determined by its seed alone.

@@ -52,19 +52,25 @@ fn pitched_camera(uid: &str, size: u32, fov_y: f32, position: [f32; 3], yaw: f32
     CameraConfig::in_world(uid, size, size, fov_y, 0.001, 10.0, pose)
 }
 
-/// ManiSkill2's observation cameras of a bucket task: its `base_camera` (128×128, fov π/2) at
-/// `base_position` (m) looking along +x, pitched down by π/6, and the Panda's `hand_camera`.
-pub fn bucket_task_cameras(base_position: [f32; 3]) -> Vec<CameraConfig> {
-    vec![
-        pitched_camera(
-            "base_camera",
-            128,
-            std::f32::consts::FRAC_PI_2,
-            base_position,
-            0.0,
-        ),
-        CameraConfig::hand_camera(),
-    ]
+/// The robot's cameras with ManiSkill2's `base_camera` of a bucket task (128×128, fov π/2) at
+/// `base_position` (m) looking along +x, pitched down by π/6, in place of the robot's.
+pub fn bucket_task_cameras(
+    robot_cameras: Vec<CameraConfig>,
+    base_position: [f32; 3],
+) -> Vec<CameraConfig> {
+    let base = pitched_camera(
+        "base_camera",
+        128,
+        std::f32::consts::FRAC_PI_2,
+        base_position,
+        0.0,
+    );
+    let mut cameras: Vec<CameraConfig> = robot_cameras
+        .into_iter()
+        .filter(|c| c.uid != base.uid)
+        .collect();
+    cameras.insert(0, base);
+    cameras
 }
 
 /// ManiSkill2's `render()` camera of a bucket task: 512×512, fov 1 rad, at `position` (m),

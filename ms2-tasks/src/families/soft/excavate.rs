@@ -86,12 +86,12 @@ impl Task for Excavate {
     }
 
     /// ManiSkill2's Excavate cameras: `base_camera` at (-0.2, 0, 0.4).
-    fn sensor_cameras(&self) -> Vec<CameraConfig> {
-        bucket_task_cameras([-0.2, 0.0, 0.4])
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        bucket_task_cameras(robot_cameras, [-0.2, 0.0, 0.4])
     }
 
     /// ManiSkill2's Excavate render camera: at (-0.35, 0, 0.4), looking along +x.
-    fn render_camera(&self) -> CameraConfig {
+    fn render_camera(&self, _robot_default: CameraConfig) -> CameraConfig {
         bucket_render_camera([-0.35, 0.0, 0.4], 0.0)
     }
 

@@ -160,12 +160,12 @@ impl Task for Fill {
     }
 
     /// ManiSkill2's Fill cameras: `base_camera` at (-0.4, 0, 0.4).
-    fn sensor_cameras(&self) -> Vec<CameraConfig> {
-        bucket_task_cameras([-0.4, 0.0, 0.4])
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        bucket_task_cameras(robot_cameras, [-0.4, 0.0, 0.4])
     }
 
     /// ManiSkill2's Fill render camera: at (-0.5, -0.4, 0.6), turned by π/2 − π/5.
-    fn render_camera(&self) -> CameraConfig {
+    fn render_camera(&self, _robot_default: CameraConfig) -> CameraConfig {
         bucket_render_camera(
             [-0.5, -0.4, 0.6],
             std::f32::consts::FRAC_PI_2 - std::f32::consts::PI / 5.0,
