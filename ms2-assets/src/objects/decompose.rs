@@ -30,7 +30,7 @@ impl Default for DecompositionParams {
 }
 
 /// Bumped when the decomposition output for the same input changes (invalidates the cache).
-const DECOMPOSITION_VERSION: u32 = 1;
+const DECOMPOSITION_VERSION: u32 = 3;
 
 /// The V-HACD convex parts of a closed mesh (m), each the exact convex hull of the mesh's
 /// triangles in that part. Falls back to one convex hull of the whole mesh when V-HACD gives no
@@ -53,7 +53,10 @@ pub fn decompose(mesh: &Mesh, params: &DecompositionParams) -> Vec<Mesh> {
         .compute_exact_convex_hulls(&pts, &mesh.triangles)
         .into_iter()
         .filter_map(|(v, _)| {
-            let v: Vec<[f64; 3]> = v.iter().map(|p| [p.x as f64, p.y as f64, p.z as f64]).collect();
+            let v: Vec<[f64; 3]> = v
+                .iter()
+                .map(|p| [p.x as f64, p.y as f64, p.z as f64])
+                .collect();
             Mesh::convex_hull(&v)
         })
         .filter(|m| m.volume() > 1e-12)
@@ -124,7 +127,10 @@ pub fn decompose_cached(mesh: &Mesh, params: &DecompositionParams, cache_dir: &P
         .map(|m| {
             let (v, t) = m.to_f32();
             Mesh {
-                vertices: v.iter().map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]).collect(),
+                vertices: v
+                    .iter()
+                    .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
+                    .collect(),
                 triangles: t,
             }
         })

@@ -28,7 +28,7 @@ use super::{ObjectFamily, Split};
 use crate::error::AssetError;
 
 /// Bumped whenever the generated files change.
-pub const GENERATOR_VERSION: u32 = 1;
+pub const GENERATOR_VERSION: u32 = 3;
 /// Seed of the EGAD-like family.
 pub const SEED: u64 = 2020;
 /// Training models (ManiSkill2's EGAD training set size).
@@ -67,7 +67,11 @@ pub fn ids(split: Split) -> Vec<(String, usize, usize)> {
         .map(|i| {
             let cell = i % (LEVELS * LEVELS);
             let (c, d) = (cell / LEVELS, cell % LEVELS);
-            (format!("{}{sep}{}", cell_name(c, d), i / (LEVELS * LEVELS)), c, d)
+            (
+                format!("{}{sep}{}", cell_name(c, d), i / (LEVELS * LEVELS)),
+                c,
+                d,
+            )
         })
         .collect()
 }
@@ -148,7 +152,11 @@ pub fn generate_model(id: &str, complexity: usize, difficulty: usize) -> EgadMod
     let narrow = size.iter().cloned().fold(f64::INFINITY, f64::min).max(1e-9);
     let long = size.iter().cloned().fold(0.0, f64::max).max(1e-9);
     let s = ((0.03 + 0.04 * d) / narrow).min(0.12 / long);
-    let centre = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, (lo[2] + hi[2]) / 2.0];
+    let centre = [
+        (lo[0] + hi[0]) / 2.0,
+        (lo[1] + hi[1]) / 2.0,
+        (lo[2] + hi[2]) / 2.0,
+    ];
     for l in &mut lobes {
         l.translate([-centre[0], -centre[1], -centre[2]]);
         l.scale([s; 3]);

@@ -22,7 +22,7 @@ use super::ObjectFamily;
 use crate::error::AssetError;
 
 /// Bumped whenever the generated files change.
-pub const GENERATOR_VERSION: u32 = 1;
+pub const GENERATOR_VERSION: u32 = 3;
 /// Seed of the household family.
 pub const SEED: u64 = 16;
 
@@ -57,7 +57,10 @@ impl HouseholdModel {
 fn colour(rng: &mut ChaCha8Rng) -> [f32; 4] {
     // Saturated label colours: a random hue at high saturation and mid value.
     let h = rng.random_range(0.0..6.0f32);
-    let (s, v) = (rng.random_range(0.55..0.9f32), rng.random_range(0.55..0.95f32));
+    let (s, v) = (
+        rng.random_range(0.55..0.9f32),
+        rng.random_range(0.55..0.95f32),
+    );
     let c = v * s;
     let x = c * (1.0 - ((h % 2.0) - 1.0).abs());
     let (r, g, b) = match h as u32 {
@@ -129,7 +132,11 @@ fn bottle(rng: &mut ChaCha8Rng) -> (&'static str, Vec<(Mesh, [f32; 4])>, f64) {
     );
     let cap = cylinder(rn + 0.002, h - 0.02, h);
     let mass = body.volume() * rng.random_range(350.0..750.0);
-    ("bottle", vec![(body, colour(rng)), (cap, colour(rng))], mass)
+    (
+        "bottle",
+        vec![(body, colour(rng)), (cap, colour(rng))],
+        mass,
+    )
 }
 
 fn jar(rng: &mut ChaCha8Rng) -> (&'static str, Vec<(Mesh, [f32; 4])>, f64) {
@@ -149,7 +156,11 @@ fn jar(rng: &mut ChaCha8Rng) -> (&'static str, Vec<(Mesh, [f32; 4])>, f64) {
     );
     let lid = cylinder(r * 0.9, h - 0.016, h);
     let mass = body.volume() * rng.random_range(600.0..1000.0);
-    ("jar", vec![(body, [0.85, 0.88, 0.9, 1.0]), (lid, colour(rng))], mass)
+    (
+        "jar",
+        vec![(body, [0.85, 0.88, 0.9, 1.0]), (lid, colour(rng))],
+        mass,
+    )
 }
 
 fn mug(rng: &mut ChaCha8Rng) -> (&'static str, Vec<(Mesh, [f32; 4])>, f64) {
@@ -219,7 +230,11 @@ fn fruit(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>
         }
         1 => {
             let r = rng.random_range(0.036..0.042);
-            ("orange", Mesh::ellipsoid([r; 3], 16, SEGMENTS), [0.95, 0.55, 0.08, 1.0])
+            (
+                "orange",
+                Mesh::ellipsoid([r; 3], 16, SEGMENTS),
+                [0.95, 0.55, 0.08, 1.0],
+            )
         }
         2 => {
             let r = rng.random_range(0.026..0.03);
@@ -258,15 +273,27 @@ fn fruit(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>
                     rr * (0.35 + 0.65 * (PI * t).sin())
                 })
                 .collect();
-            ("banana", Mesh::tube(&path, &radii, 10), [0.96, 0.85, 0.25, 1.0])
+            (
+                "banana",
+                Mesh::tube(&path, &radii, 10),
+                [0.96, 0.85, 0.25, 1.0],
+            )
         }
         5 => {
             let r = rng.random_range(0.022..0.026);
-            ("plum", Mesh::ellipsoid([r, r, r * 1.1], 16, SEGMENTS), [0.45, 0.1, 0.35, 1.0])
+            (
+                "plum",
+                Mesh::ellipsoid([r, r, r * 1.1], 16, SEGMENTS),
+                [0.45, 0.1, 0.35, 1.0],
+            )
         }
         6 => {
             let r = rng.random_range(0.032..0.038);
-            ("peach", Mesh::ellipsoid([r, r * 0.95, r], 16, SEGMENTS), [0.98, 0.65, 0.45, 1.0])
+            (
+                "peach",
+                Mesh::ellipsoid([r, r * 0.95, r], 16, SEGMENTS),
+                [0.98, 0.65, 0.45, 1.0],
+            )
         }
         7 => {
             // Strawberry: a rounded cone, tip down.
@@ -274,15 +301,26 @@ fn fruit(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>
             let prof: Vec<[f64; 2]> = (0..=14)
                 .map(|i| {
                     let t = i as f64 / 14.0;
-                    [r * (t * PI * 0.5).sin().powf(0.7) * (1.0 - (t - 0.8).max(0.0) * 4.0), 2.4 * r * t]
+                    [
+                        r * (t * PI * 0.5).sin().powf(0.7) * (1.0 - (t - 0.8).max(0.0) * 4.0),
+                        2.4 * r * t,
+                    ]
                 })
                 .chain(std::iter::once([0.0, 2.4 * r]))
                 .collect();
-            ("strawberry", Mesh::lathe(&prof, SEGMENTS), [0.85, 0.1, 0.15, 1.0])
+            (
+                "strawberry",
+                Mesh::lathe(&prof, SEGMENTS),
+                [0.85, 0.1, 0.15, 1.0],
+            )
         }
         _ => {
             let r = rng.random_range(0.022..0.026);
-            ("lime", Mesh::ellipsoid([r, r, r * 1.15], 16, SEGMENTS), [0.35, 0.7, 0.2, 1.0])
+            (
+                "lime",
+                Mesh::ellipsoid([r, r, r * 1.15], 16, SEGMENTS),
+                [0.35, 0.7, 0.2, 1.0],
+            )
         }
     };
     let mass = mesh.volume() * rng.random_range(850.0..1000.0);
@@ -303,7 +341,10 @@ fn tool(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>,
                 "hammer",
                 vec![
                     (rod(0.014, 0.0, l), WOOD),
-                    (at(Mesh::cuboid([0.016, 0.055, 0.016]), [l - 0.01, 0.0, 0.0]), METAL),
+                    (
+                        at(Mesh::cuboid([0.016, 0.055, 0.016]), [l - 0.01, 0.0, 0.0]),
+                        METAL,
+                    ),
                 ],
                 rng.random_range(0.45..0.65),
             )
@@ -311,7 +352,13 @@ fn tool(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>,
         1 => {
             let l = rng.random_range(0.18..0.23);
             let handle = Mesh::lathe(
-                &[[0.0, 0.0], [0.014, 0.0], [0.016, 0.05], [0.012, 0.1], [0.0, 0.1]],
+                &[
+                    [0.0, 0.0],
+                    [0.014, 0.0],
+                    [0.016, 0.05],
+                    [0.012, 0.1],
+                    [0.0, 0.1],
+                ],
                 16,
             );
             let mut handle = handle;
@@ -326,7 +373,10 @@ fn tool(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>,
             "spatula",
             vec![
                 (rod(0.01, 0.0, 0.2), handle_col),
-                (at(Mesh::cuboid([0.045, 0.035, 0.002]), [0.24, 0.0, 0.0]), DARK),
+                (
+                    at(Mesh::cuboid([0.045, 0.035, 0.002]), [0.24, 0.0, 0.0]),
+                    DARK,
+                ),
             ],
             rng.random_range(0.06..0.12),
         ),
@@ -336,8 +386,14 @@ fn tool(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>,
                 "wrench",
                 vec![
                     (Mesh::cuboid([l / 2.0, 0.009, 0.004]), METAL),
-                    (at(Mesh::cuboid([0.016, 0.02, 0.005]), [l / 2.0, 0.0, 0.0]), METAL),
-                    (at(Mesh::cuboid([0.013, 0.016, 0.005]), [-l / 2.0, 0.0, 0.0]), METAL),
+                    (
+                        at(Mesh::cuboid([0.016, 0.02, 0.005]), [l / 2.0, 0.0, 0.0]),
+                        METAL,
+                    ),
+                    (
+                        at(Mesh::cuboid([0.013, 0.016, 0.005]), [-l / 2.0, 0.0, 0.0]),
+                        METAL,
+                    ),
                 ],
                 rng.random_range(0.1..0.2),
             )
@@ -346,7 +402,10 @@ fn tool(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>,
             let r = rng.random_range(0.008..0.011);
             (
                 "marker",
-                vec![(rod(r, 0.0, 0.1), [0.95, 0.95, 0.95, 1.0]), (rod(r + 0.001, 0.1, 0.14), handle_col)],
+                vec![
+                    (rod(r, 0.0, 0.1), [0.95, 0.95, 0.95, 1.0]),
+                    (rod(r + 0.001, 0.1, 0.14), handle_col),
+                ],
                 rng.random_range(0.015..0.03),
             )
         }
@@ -354,7 +413,13 @@ fn tool(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>,
             "spoon",
             vec![
                 (rod(0.004, 0.0, 0.14), METAL),
-                (at(Mesh::ellipsoid([0.03, 0.018, 0.006], 8, 20), [0.165, 0.0, 0.0]), METAL),
+                (
+                    at(
+                        Mesh::ellipsoid([0.03, 0.018, 0.006], 8, 20),
+                        [0.165, 0.0, 0.0],
+                    ),
+                    METAL,
+                ),
             ],
             rng.random_range(0.03..0.06),
         ),
@@ -362,7 +427,10 @@ fn tool(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>,
             "knife",
             vec![
                 (rod(0.01, 0.0, 0.1), DARK),
-                (at(Mesh::cuboid([0.06, 0.011, 0.0015]), [0.16, 0.0, 0.0]), METAL),
+                (
+                    at(Mesh::cuboid([0.06, 0.011, 0.0015]), [0.16, 0.0, 0.0]),
+                    METAL,
+                ),
             ],
             rng.random_range(0.06..0.1),
         ),
@@ -370,8 +438,14 @@ fn tool(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>,
             "clamp",
             vec![
                 (Mesh::cuboid([0.008, 0.045, 0.008]), handle_col),
-                (at(Mesh::cuboid([0.03, 0.008, 0.008]), [0.022, 0.037, 0.0]), handle_col),
-                (at(Mesh::cuboid([0.03, 0.008, 0.008]), [0.022, -0.037, 0.0]), handle_col),
+                (
+                    at(Mesh::cuboid([0.03, 0.008, 0.008]), [0.022, 0.037, 0.0]),
+                    handle_col,
+                ),
+                (
+                    at(Mesh::cuboid([0.03, 0.008, 0.008]), [0.022, -0.037, 0.0]),
+                    handle_col,
+                ),
             ],
             rng.random_range(0.1..0.2),
         ),
@@ -381,7 +455,10 @@ fn tool(rng: &mut ChaCha8Rng, k: usize) -> (&'static str, Vec<(Mesh, [f32; 4])>,
                 "brush",
                 vec![
                     (rod(0.011, 0.0, l), WOOD),
-                    (at(Mesh::cuboid([0.03, 0.022, 0.016]), [l + 0.02, 0.0, 0.0]), handle_col),
+                    (
+                        at(Mesh::cuboid([0.03, 0.022, 0.016]), [l + 0.02, 0.0, 0.0]),
+                        handle_col,
+                    ),
                 ],
                 rng.random_range(0.07..0.14),
             )
@@ -423,7 +500,11 @@ pub fn catalogue() -> Vec<HouseholdModel> {
                 all.append(p);
             }
             let (lo, hi) = all.bbox();
-            let c = [-(lo[0] + hi[0]) / 2.0, -(lo[1] + hi[1]) / 2.0, -(lo[2] + hi[2]) / 2.0];
+            let c = [
+                -(lo[0] + hi[0]) / 2.0,
+                -(lo[1] + hi[1]) / 2.0,
+                -(lo[2] + hi[2]) / 2.0,
+            ];
             for (p, _) in &mut parts {
                 p.translate(c);
             }
@@ -464,11 +545,19 @@ pub(super) fn generate_into(root: &Path, asset_dir: &Path) -> Result<usize, Asse
                 }
             })
             .collect();
-        write(fam, &dir.join("textured.obj"), &obj_text(&visual, Some("textured.mtl")))?;
+        write(
+            fam,
+            &dir.join("textured.obj"),
+            &obj_text(&visual, Some("textured.mtl")),
+        )?;
         write(fam, &dir.join("textured.mtl"), &mtl_text(&visual))?;
         let parts = decompose_cached(&m.merged(), &params, &cache);
         let hull_volume: f64 = parts.iter().map(Mesh::volume).sum();
-        write(fam, &dir.join("collision.obj"), &obj_text(&pieces_of(&parts, "convex"), None))?;
+        write(
+            fam,
+            &dir.join("collision.obj"),
+            &obj_text(&pieces_of(&parts, "convex"), None),
+        )?;
         let (lo, hi) = m.merged().bbox();
         let r6 = |v: [f64; 3]| v.map(|x| (x * 1e6).round() / 1e6);
         db.insert(

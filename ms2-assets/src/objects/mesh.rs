@@ -157,27 +157,69 @@ impl Mesh {
     }
 
     /// Convex hull of points (m), through parry3d. `None` when the points are degenerate.
+    ///
+    /// Points closer than 0.1 mm are welded first. parry's hull of many nearly coplanar
+    /// points (disc, cylinder and box pieces) sometimes keeps non-hull vertices or leaves
+    /// input points outside; the result is checked and, when either is off by more than
+    /// 10 µm, the hull is taken again of the points moved by a deterministic jitter of
+    /// 10-80 µm, keeping the best result.
     pub fn convex_hull(points: &[[f64; 3]]) -> Option<Mesh> {
         if points.len() < 4 {
             return None;
         }
-        let pts: Vec<parry3d::math::Vector> = points
+        // Weld points closer than 0.1 mm: near-duplicates on nearly coplanar faces are what
+        // trips the hull, and the pieces are written with µm precision.
+        let mut seen = std::collections::HashSet::new();
+        let points: Vec<[f64; 3]> = points
             .iter()
-            .map(|p| parry3d::math::Vector::new(p[0] as f32, p[1] as f32, p[2] as f32))
+            .map(|p| p.map(|c| (c / WELD_M).round() * WELD_M))
+            .filter(|p| seen.insert(p.map(|c| (c / WELD_M).round() as i64)))
             .collect();
-        let (v, t) = parry3d::transformation::try_convex_hull(&pts).ok()?;
-        if t.is_empty() {
+        if points.len() < 4 {
             return None;
         }
-        let mut m = Mesh {
-            vertices: v
+        let points = &points[..];
+        let mut best: Option<(f64, Mesh)> = None;
+        let mut input = points.to_vec();
+        for attempt in 0..8u64 {
+            let Some(m) = parry_hull(&input) else {
+                break;
+            };
+            // Not convex, or an input point left outside: the hull lost a vertex.
+            let mut err = convexity_error(&m).max(outside_distance(&m, points));
+            // A reader hulls the written (µm-rounded) vertices again: that hull must keep them.
+            let written: Vec<[f64; 3]> = m
+                .vertices
                 .iter()
-                .map(|p| [p.x as f64, p.y as f64, p.z as f64])
-                .collect(),
-            triangles: t,
-        };
-        m.orient_outward();
-        Some(m)
+                .map(|v| v.map(|c| (c * 1e6).round() / 1e6))
+                .collect();
+            match parry_hull(&written) {
+                Some(again) => err = err.max(outside_distance(&again, &written)),
+                None => err = f64::INFINITY,
+            }
+            if best.as_ref().is_none_or(|(e, _)| err < *e) {
+                best = Some((err, m.clone()));
+            }
+            if err <= 1e-5 {
+                break;
+            }
+            // Retry with the points moved by a deterministic jitter of up to 10 µm per try
+            // (well above the µm precision of the files, so readers hull the same points).
+            let mut state = 0x2545_f491_4f6c_dd1du64.wrapping_add(attempt);
+            let amp = 1e-5 * (attempt + 1) as f64;
+            input = points
+                .iter()
+                .map(|p| {
+                    p.map(|c| {
+                        state ^= state << 13;
+                        state ^= state >> 7;
+                        state ^= state << 17;
+                        c + amp * ((state % 2001) as f64 / 1000.0 - 1.0)
+                    })
+                })
+                .collect();
+        }
+        best.map(|(_, m)| m)
     }
 
     /// Scales each axis.
@@ -280,6 +322,87 @@ impl Mesh {
     }
 }
 
+/// Points closer than this (m) are one point for [`Mesh::convex_hull`].
+const WELD_M: f64 = 1e-4;
+
+fn parry_hull(points: &[[f64; 3]]) -> Option<Mesh> {
+    let pts: Vec<parry3d::math::Vector> = points
+        .iter()
+        .map(|p| parry3d::math::Vector::new(p[0] as f32, p[1] as f32, p[2] as f32))
+        .collect();
+    let (v, t) = parry3d::transformation::try_convex_hull(&pts).ok()?;
+    if t.is_empty() {
+        return None;
+    }
+    let mut m = Mesh {
+        vertices: v
+            .iter()
+            .map(|p| [p.x as f64, p.y as f64, p.z as f64])
+            .collect(),
+        triangles: t,
+    };
+    // Each face outward from the centroid (slivers can come back wound either way).
+    let n = m.vertices.len() as f64;
+    let c = m
+        .vertices
+        .iter()
+        .fold([0.0; 3], |acc, v| add(acc, scale3(*v, 1.0 / n)));
+    for t in &mut m.triangles {
+        let [a, b, d] = t.map(|i| m.vertices[i as usize]);
+        if dot(
+            cross(sub(b, a), sub(d, a)),
+            sub(scale3(add(add(a, b), d), 1.0 / 3.0), c),
+        ) < 0.0
+        {
+            t.swap(1, 2);
+        }
+    }
+    Some(m)
+}
+
+/// How far (m) the farthest of `points` lies outside the convex mesh `m`.
+fn outside_distance(m: &Mesh, points: &[[f64; 3]]) -> f64 {
+    let planes: Vec<([f64; 3], [f64; 3])> = m
+        .triangles
+        .iter()
+        .filter_map(|t| {
+            let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+            let n = cross(sub(b, a), sub(c, a));
+            let nn = dot(n, n).sqrt();
+            (nn > 1e-12).then(|| (scale3(n, 1.0 / nn), a))
+        })
+        .collect();
+    points
+        .iter()
+        .map(|p| {
+            planes
+                .iter()
+                .map(|(n, a)| dot(*n, sub(*p, *a)))
+                .fold(f64::NEG_INFINITY, f64::max)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// How far (m) the farthest vertex lies outside the plane of a face (0 for a convex mesh);
+/// sliver faces without a reliable plane are skipped.
+pub fn convexity_error(m: &Mesh) -> f64 {
+    let (lo, hi) = m.bbox();
+    let diag2: f64 = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum();
+    let mut worst = 0.0f64;
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| m.vertices[i as usize]);
+        let n = cross(sub(b, a), sub(c, a));
+        let nn = dot(n, n).sqrt();
+        if nn < 1e-4 * diag2 {
+            continue;
+        }
+        for v in &m.vertices {
+            worst = worst.max(dot(n, sub(*v, a)) / nn);
+        }
+    }
+    worst
+}
+
 pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
@@ -317,12 +440,13 @@ mod tests {
         let c = Mesh::cuboid([0.01, 0.02, 0.03]);
         assert!((c.volume() - 0.02 * 0.04 * 0.06).abs() < 1e-12);
         // A cylinder of radius 3 cm, height 10 cm (polygon area with 64 sides).
-        let cyl = Mesh::lathe(
-            &[[0.0, 0.0], [0.03, 0.0], [0.03, 0.1], [0.0, 0.1]],
-            64,
-        );
+        let cyl = Mesh::lathe(&[[0.0, 0.0], [0.03, 0.0], [0.03, 0.1], [0.0, 0.1]], 64);
         let poly_area = 0.5 * 64.0 * 0.03f64.powi(2) * (TAU / 64.0).sin();
-        assert!((cyl.volume() - poly_area * 0.1).abs() < 1e-9, "{}", cyl.volume());
+        assert!(
+            (cyl.volume() - poly_area * 0.1).abs() < 1e-9,
+            "{}",
+            cyl.volume()
+        );
         let e = Mesh::ellipsoid([0.02, 0.03, 0.04], 24, 48);
         let exact = 4.0 / 3.0 * std::f64::consts::PI * 0.02 * 0.03 * 0.04;
         assert!((e.volume() - exact).abs() / exact < 0.02);

@@ -356,9 +356,34 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     return 1 if bad else 0
 
 
+def _cmd_download(args: argparse.Namespace) -> int:
+    from . import download as dl
+
+    root = asset_dir()
+    names = dl.resolve(args.what)
+    for name in names:
+        last = [-1]
+
+        def progress(got: int, total: int | None, last: list[int] = last, name: str = name) -> None:
+            step = got >> 24  # a line every 16 MiB
+            if not args.quiet and step != last[0]:
+                last[0] = step
+                of = f" of {_human(total)}" if total else ""
+                print(f"  {name}: {_human(got)}{of}", flush=True)
+
+        path = dl.download_archive(
+            name, root, base=args.base_url, force=args.force, progress=progress
+        )
+        print(f"{name}: {path}")
+    return 0
+
+
 def add_parser(sub: Any) -> None:
     """Adds ``ms2 assets ...`` to the command line."""
-    p = sub.add_parser("assets", help="list, fetch and verify fetched assets (real Panda meshes)")
+    p = sub.add_parser(
+        "assets",
+        help="list, fetch, download and verify fetched assets (real Panda meshes, ManiSkill2 data)",
+    )
     a = p.add_subparsers(dest="assets_command", required=True)
     lp = a.add_parser("list", help="asset groups, where they are found, sizes and licences")
     lp.set_defaults(func=_cmd_list)
@@ -377,6 +402,21 @@ def add_parser(sub: Any) -> None:
     )
     fp.add_argument("-q", "--quiet", action="store_true", help="no pip output")
     fp.set_defaults(func=_cmd_fetch)
+    dp = a.add_parser(
+        "download",
+        help="download ManiSkill2's published data archives (YCB, EGAD, clutter episodes, ...)",
+    )
+    dp.add_argument(
+        "what", help="env id (e.g. PickSingleYCB-v0), archive name (ycb, egad), or 'all'"
+    )
+    dp.add_argument(
+        "--base-url",
+        default=None,
+        help="download from this base URL instead of ManiSkill2's (also $MS2_DOWNLOAD_BASE_URL)",
+    )
+    dp.add_argument("--force", action="store_true", help="download even if the data is present")
+    dp.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    dp.set_defaults(func=_cmd_download)
     vp = a.add_parser("verify", help="check sizes and sha256 of an asset group's files")
     vp.add_argument("group", nargs="?", default="all", help="asset group name (default: all)")
     vp.set_defaults(func=_cmd_verify)
