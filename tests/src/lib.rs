@@ -24,8 +24,7 @@ impl Rig {
         let mut world = World::new(WorldConfig::default()).expect("world");
         let timing = ControlTiming::MANISKILL2;
         let mut agent =
-            build_panda_from_urdf(&mut world, mode, timing, ms2_assets::PANDA_URDF)
-                .expect("agent");
+            build_panda_from_urdf(&mut world, mode, timing, ms2_assets::PANDA_URDF).expect("agent");
         agent
             .initialize(&mut world, &mut episode_rng(seed))
             .expect("initialize");

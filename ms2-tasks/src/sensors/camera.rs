@@ -204,6 +204,8 @@ impl CameraConfig {
     /// `base_camera` on `camera_base_link` (fixed in front of the robot, looking back down at
     /// it) and `hand_camera` on `camera_hand_link` (the wrist), both 128×128, fov 1.5707,
     /// near 0.01, far 10, at the link frame.
+    // ManiSkill2's configs write the field of view as the literal 1.5707, not π/2.
+    #[allow(clippy::approx_constant)]
     pub fn xmate3_defaults() -> Vec<CameraConfig> {
         let on_link = |uid: &str, link: &str| CameraConfig {
             uid: uid.to_owned(),
