@@ -6,13 +6,13 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat};
 
-use crate::cameras::{cameras_from_py, render_camera_from_py};
+use crate::cameras::camera_updates_from_py;
 
 /// The keyword arguments every native env constructor and demonstration binding accepts, with
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
 /// (ManiSkill2's `state` obs mode, then [`EnvConfig::new`]'s: the task's control/reward mode, 500 Hz / 20 Hz, the task's
 /// episode limit, no render mode, the task's default robot and cameras, the soft-body task's MPM frequency).
-pub const ENV_KWARGS: [&str; 14] = [
+pub const ENV_KWARGS: [&str; 15] = [
     "obs_mode",
     "robot",
     "control_mode",
@@ -27,6 +27,7 @@ pub const ENV_KWARGS: [&str; 14] = [
     "render_camera_cfgs",
     "bg_name",
     "exact_restore",
+    "model_ids",
 ];
 
 /// The obs mode of an env made from Python without `obs_mode` (ManiSkill2's default).
@@ -76,6 +77,14 @@ fn extract_real(key: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
     extract_kwarg(key, value, "a real number (Hz)")
 }
 
+/// ManiSkill2's `model_ids`: one id (a str) or a sequence of str.
+fn extract_model_ids(value: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+    if let Ok(one) = value.extract::<String>() {
+        return Ok(vec![one]);
+    }
+    extract_kwarg("model_ids", value, "a str or a list of str")
+}
+
 /// The config of env `env_id` made with `kwargs` (keys from [`ENV_KWARGS`]). An unknown key
 /// raises `TypeError` listing the valid ones, as Python does for an unexpected keyword; a value
 /// of the wrong type raises `TypeError` naming the key; bad camera configs raise `ValueError`.
@@ -120,13 +129,13 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                 let dict = value.cast::<PyDict>().map_err(|_| {
                     PyTypeError::new_err(format!("camera_cfgs must be a dict, got {value}"))
                 })?;
-                cfg.camera_cfgs = cameras_from_py(Some(dict))?;
+                cfg.camera_updates = Some(camera_updates_from_py(dict)?);
             }
             "render_camera_cfgs" => {
                 let dict = value.cast::<PyDict>().map_err(|_| {
                     PyTypeError::new_err(format!("render_camera_cfgs must be a dict, got {value}"))
                 })?;
-                cfg.render_camera = Some(render_camera_from_py(dict)?);
+                cfg.render_camera_updates = Some(camera_updates_from_py(dict)?);
             }
             "enable_shadow" => {
                 if !value.is_instance_of::<pyo3::types::PyBool>() {
@@ -145,6 +154,7 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                 cfg.exact_restore = value.extract()?;
             }
             "bg_name" => cfg.bg_name = Some(extract_kwarg(&key, &value, "a str")?),
+            "model_ids" => cfg.model_ids = Some(extract_model_ids(&value)?),
             other => {
                 return Err(PyTypeError::new_err(format!(
                     "unexpected keyword argument {other:?}; valid keywords: {ENV_KWARGS:?}"
@@ -171,5 +181,6 @@ pub fn config_to_py<'py>(py: Python<'py>, cfg: &EnvConfig) -> PyResult<Bound<'py
     dict.set_item("enable_shadow", cfg.enable_shadow)?;
     dict.set_item("bg_name", &cfg.bg_name)?;
     dict.set_item("exact_restore", cfg.exact_restore)?;
+    dict.set_item("model_ids", &cfg.model_ids)?;
     Ok(dict)
 }

@@ -1,7 +1,7 @@
 //! Environment configuration and the observation / reward mode enums.
 
 use crate::error::EnvError;
-use crate::sensors::{CameraConfig, VisualLayout};
+use crate::sensors::{CameraCfgUpdates, CameraConfig, VisualLayout};
 
 /// How an environment is made: which task, which observation, control and reward modes, and the
 /// simulation / control frequencies.
@@ -26,9 +26,13 @@ pub struct EnvConfig {
     pub reward_mode: Option<String>,
     /// Render mode: `None` or `"rgb_array"` ([`crate::Env::render`]: a 512×512 view for people).
     pub render_mode: Option<String>,
-    /// Observation cameras of the visual obs modes; `None` = the task's defaults
-    /// (`base_camera` and `hand_camera`, see [`CameraConfig::panda_defaults`]).
+    /// Observation cameras of the visual obs modes, replacing the task's; `None` = the task's
+    /// defaults ([`crate::Task::sensor_cameras`]; for most tasks `base_camera` and
+    /// `hand_camera`, see [`CameraConfig::panda_defaults`]).
     pub camera_cfgs: Option<Vec<CameraConfig>>,
+    /// ManiSkill2's `camera_cfgs` keyword: field updates applied to the cameras above (the
+    /// task's defaults unless `camera_cfgs` is set) when the env is made.
+    pub camera_updates: Option<CameraCfgUpdates>,
     /// Physics frequency in Hz (default 500). Must be a whole multiple of `control_freq`.
     pub sim_freq: f64,
     /// Control (env step) frequency in Hz (default 20).
@@ -46,6 +50,9 @@ pub struct EnvConfig {
     /// default ([`CameraConfig::render_camera`]). ManiSkill2's `render_camera_cfgs` keyword
     /// changes it field by field.
     pub render_camera: Option<CameraConfig>,
+    /// ManiSkill2's `render_camera_cfgs` keyword: field updates applied to the render camera
+    /// above (the task's default unless `render_camera` is set) when the env is made.
+    pub render_camera_updates: Option<CameraCfgUpdates>,
     /// ManiSkill2's `bg_name` (a visual background scene replacing the default lights);
     /// `None` = the default scene. ms2 ships no background scenes, so any name is refused with
     /// [`EnvError::InvalidConfig`].
@@ -61,6 +68,11 @@ pub struct EnvConfig {
     /// exact, and a restore mid-episode into a fresh env drifts once objects touch (see
     /// docs/trajectory_format.md, "Restoring states").
     pub exact_restore: bool,
+    /// ManiSkill2's `model_ids` of the object-variation tasks (`PickSingleYCB-v0`,
+    /// `PickSingleEGAD-v0`, `PickClutterYCB-v0`): the model ids episodes draw from; `None` (or
+    /// empty) = every model of the task's info json. An id not in the json is an error naming
+    /// it; setting it on a task without object models is an error.
+    pub model_ids: Option<Vec<String>>,
 }
 
 impl Default for EnvConfig {
@@ -73,14 +85,17 @@ impl Default for EnvConfig {
             reward_mode: None,
             render_mode: None,
             camera_cfgs: None,
+            camera_updates: None,
             sim_freq: 500.0,
             control_freq: 20.0,
             max_episode_steps: None,
             mpm_freq: None,
             enable_shadow: false,
             render_camera: None,
+            render_camera_updates: None,
             bg_name: None,
             exact_restore: false,
+            model_ids: None,
         }
     }
 }

@@ -5,15 +5,17 @@
 //!
 //! | when | hook |
 //! |---|---|
-//! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
-//! | every reset, in this order | [`Task::initialize_actors`], robot reset (rest qpos + noise), [`Task::initialize_agent`], [`Task::initialize_task`] |
-//! | every reset, first, when [`Task::rebuild_every_episode`] | [`Task::build_scene`] on a fresh world, with the episode's RNG (per-episode layouts) |
+//! | every reset, first | [`Task::prepare_episode`] (per-episode scene choices, e.g. the object model or an obstacle layout; returns whether the scene must be rebuilt) |
+//! | make / `reset(reconfigure = true)` / a rebuild asked for | [`Task::build_scene`] on a fresh world, with the episode's RNG (add actors to the world) |
+//! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_agent`] (default: the robot's reset, rest qpos + noise), [`Task::initialize_task`] |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
 //! | soft-body tasks only | [`Task::soft`]: one [`SoftComponent`] (substeps after each physics step, particles observed and drawn) |
 
 use std::any::Any;
+
+use ms2_physics::SolverConfig;
 
 use crate::agents::Agent;
 use crate::error::EnvError;
@@ -22,6 +24,7 @@ use crate::obs::{DictBuilder, ObsValue};
 use crate::particles::ParticleVisual;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::CameraConfig;
 
 /// What a task's hooks see: the rigid world (through the port) and the robot.
 pub struct TaskScene {
@@ -47,6 +50,13 @@ pub trait Task: Any + Send {
     /// Largest value of [`Task::dense_reward`] (divides it in `normalized_dense` mode).
     fn max_dense_reward(&self) -> f64;
 
+    /// Makes the episode's scene-level choices (e.g. which object model, at which scale) before
+    /// the scene is (re)built; returns `true` when they differ from the current scene's, so
+    /// that the runtime rebuilds it ([`Task::build_scene`]). Default: no choices.
+    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(false)
+    }
+
     /// Adds the task's actors to a fresh world (which has the ground and the robot already).
     fn build_scene(
         &mut self,
@@ -61,21 +71,23 @@ pub trait Task: Any + Send {
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError>;
 
-    /// Adjusts the robot after its reset (e.g. an episode's own start configuration:
-    /// `scene.agent.set_joint_state`). Default: nothing.
+    /// Puts the robot at its episode start (after [`Task::initialize_actors`]). The default is
+    /// the agent's own reset (rest qpos plus noise); a task with another start posture (e.g.
+    /// PegInsertionSide's turned hand, an obstacle layout's start configuration) overrides it.
     fn initialize_agent(
         &mut self,
-        _scene: &mut TaskScene,
-        _rng: &mut EpisodeRng,
+        scene: &mut TaskScene,
+        rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
-        Ok(())
+        let TaskScene { world, agent } = scene;
+        agent.initialize(world.as_mut(), rng)
     }
 
-    /// Whether every episode builds a fresh world ([`Task::build_scene`] with the episode's
-    /// RNG), for tasks whose actors differ per episode (ManiSkill2 reconfigures on a new
-    /// episode layout). Default: `false` (the world is built at make and on `reconfigure`).
-    fn rebuild_every_episode(&self) -> bool {
-        false
+    /// The physics solver settings of the task's worlds, given ms2's defaults (a task whose
+    /// contacts need other settings, e.g. PlugCharger's 0.5 mm clearance a shorter contact
+    /// prediction distance, changes them here). Read once when the env is made.
+    fn solver_config(&self, defaults: SolverConfig) -> SolverConfig {
+        defaults
     }
 
     /// Samples task data (e.g. the goal) after actors and robot are placed.
@@ -118,6 +130,22 @@ pub trait Task: Any + Send {
     /// [`Task::soft`], mutably (the runtime steps it).
     fn soft_mut(&mut self) -> Option<&mut dyn SoftComponent> {
         None
+    }
+
+    /// The observation cameras of the visual obs modes, given the robot's
+    /// ([`crate::agents::RobotSpec::cameras`]: the Panda's `base_camera` and `hand_camera`).
+    /// ManiSkill2 places `base_camera` per task (its `_register_cameras`): a task that does
+    /// returns the list with that camera changed. The user's `camera_cfgs` updates are applied
+    /// to the result. Default: the robot's cameras.
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        robot_cameras
+    }
+
+    /// The camera of `render()`, given the robot's default
+    /// ([`crate::agents::RobotSpec::render_camera`]); ManiSkill2's `_register_render_cameras`
+    /// of the task. `render_camera_cfgs` updates the result. Default: the robot's.
+    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
+        robot_default
     }
 }
 

@@ -110,9 +110,11 @@ impl TaskEnv {
             control_freq_hz: cfg.control_freq,
             sim_freq_hz: cfg.sim_freq,
         };
+        let defaults = WorldConfig::default();
         let world_config = WorldConfig {
             timestep: (1.0 / cfg.sim_freq) as f32,
-            ..WorldConfig::default()
+            solver: task.solver_config(defaults.solver),
+            ..defaults
         };
         let mut rng = episode_rng(BUILD_SEED);
         let scene = build_scene(
@@ -129,14 +131,23 @@ impl TaskEnv {
             ctrl.action_low().iter().map(|&v| v as f32).collect(),
             ctrl.action_high().iter().map(|&v| v as f32).collect(),
         );
-        let camera_cfgs = cfg.camera_cfgs.clone().unwrap_or_else(robot.cameras);
+        let mut camera_cfgs = cfg
+            .camera_cfgs
+            .clone()
+            .unwrap_or_else(|| task.sensor_cameras((robot.cameras)()));
+        if let Some(updates) = &cfg.camera_updates {
+            camera_cfgs = updates.applied_to(camera_cfgs)?;
+        }
         for cam in &camera_cfgs {
             cam.validate()?;
         }
-        let render_camera = cfg
+        let mut render_camera = cfg
             .render_camera
             .clone()
-            .unwrap_or_else(robot.render_camera);
+            .unwrap_or_else(|| task.render_camera((robot.render_camera)()));
+        if let Some(updates) = &cfg.render_camera_updates {
+            render_camera = updates.applied_to(vec![render_camera])?.remove(0);
+        }
         render_camera.validate()?;
         #[cfg(not(feature = "render"))]
         let _ = render_camera;
@@ -275,8 +286,8 @@ impl EnvBackend for TaskEnv {
         self.task.max_dense_reward()
     }
 
-    fn rebuild_every_episode(&self) -> bool {
-        self.task.rebuild_every_episode()
+    fn prepare_episode(&mut self, rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        self.task.prepare_episode(rng)
     }
 
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
@@ -300,8 +311,6 @@ impl EnvBackend for TaskEnv {
 
     fn initialize_episode(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         self.task.initialize_actors(&mut self.scene, rng)?;
-        let TaskScene { world, agent } = &mut self.scene;
-        agent.initialize(world.as_mut(), rng)?;
         self.task.initialize_agent(&mut self.scene, rng)?;
         self.task.initialize_task(&self.scene, rng)?;
         // The previous episode's contact caches must not leak into this one: an episode is

@@ -40,7 +40,9 @@ pub use panda::{
     build_panda_from_desc, build_panda_from_urdf, PandaAgent, ARM_DOF, PANDA_MODEL,
     ROBOT_STATIC_QVEL,
 };
-pub use panda_model::{panda_model, PandaModel, PandaModelSource, PANDA_DESCRIPTION_ENV};
+pub use panda_model::{
+    panda_bucket_model, panda_model, PandaModel, PandaModelSource, PANDA_DESCRIPTION_ENV,
+};
 pub use xmate3::{XMATE3_MODEL, XMATE3_ROBOTIQ};
 
 /// A robot in a rigid world with the controller of one control mode.

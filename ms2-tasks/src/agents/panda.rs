@@ -35,14 +35,21 @@ pub const PANDA: RobotSpec = RobotSpec {
 /// (`ms2_assets::PANDA_BUCKET_URDF`), ManiSkill2's robot of Excavate and Fill.
 pub const PANDA_BUCKET: RobotSpec = RobotSpec {
     name: "panda_bucket",
-    description: "the Panda with a bucket fixed to its hand (ms2_assets::PANDA_BUCKET_URDF)",
+    description: "the Panda with a bucket fixed to its hand (ms2_assets::PANDA_BUCKET_URDF; the \
+                  real Panda's meshes on its links when fetched)",
     control_modes: panda_control_modes,
     cameras: crate::sensors::CameraConfig::panda_defaults,
     render_camera: crate::sensors::CameraConfig::render_camera,
     build: |world, mode, timing| {
-        let desc = parse_robot_urdf(ms2_assets::PANDA_BUCKET_URDF)?;
-        let agent =
-            GripperArmAgent::build(world, mode, timing, &desc, &PANDA_MODEL, "panda_bucket")?;
+        let model = super::panda_model::panda_bucket_model()?;
+        let agent = GripperArmAgent::build(
+            world,
+            mode,
+            timing,
+            &model.desc,
+            &PANDA_MODEL,
+            "panda_bucket",
+        )?;
         Ok(Box::new(agent))
     },
 };

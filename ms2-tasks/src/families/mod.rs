@@ -7,12 +7,15 @@
 //! | family | tasks | feature |
 //! |---|---|---|
 //! | [`rigid`] | `PickCube-v0`, `LiftCube-v0`, `StackCube-v0` | — |
+//! | [`assembly`] | `PegInsertionSide-v0`, `PlugCharger-v0` | — |
 //! | [`soft`] | `Excavate-v0`, `Fill-v0` | `soft` |
 //! | [`misc`] | `PandaAvoidObstacles-v0` | — |
 //! | [`dummy`] | `Dummy-v0` (physics-free test env) | — |
 
+pub mod assembly;
 pub mod dummy;
 pub mod misc;
+pub mod objects;
 pub mod rigid;
 #[cfg(feature = "soft")]
 pub mod soft;
@@ -22,6 +25,8 @@ use crate::registry::Registrar;
 /// Registers every built-in family, one call each.
 pub(crate) fn register_builtin(r: &mut Registrar) {
     rigid::register(r);
+    assembly::register(r);
+    objects::register(r);
     #[cfg(feature = "soft")]
     soft::register(r);
     misc::register(r);

@@ -76,7 +76,64 @@ pub fn look_at_robotics(eye: [f32; 3], target: [f32; 3]) -> Pose3 {
     )
 }
 
+/// `cameras` with those named in `views` — `(uid, eye, target)`, metres, world frame — fixed
+/// in the world looking from `eye` at `target` (ManiSkill2's tasks place `base_camera` and
+/// `render_camera` this way); other cameras unchanged.
+///
+/// ```
+/// use ms2_tasks::sensors::{with_views, CameraConfig, CameraMount};
+/// let cams = with_views(CameraConfig::panda_defaults(), &[("base_camera", [0.0, -0.3, 0.2], [0.0, 0.0, 0.1])]);
+/// assert!(matches!(cams[0].mount, CameraMount::World { .. }));
+/// assert_eq!(cams[1], CameraConfig::hand_camera());
+/// ```
+pub fn with_views(
+    mut cameras: Vec<CameraConfig>,
+    views: &[(&str, [f32; 3], [f32; 3])],
+) -> Vec<CameraConfig> {
+    for cam in &mut cameras {
+        if let Some((_, eye, target)) = views.iter().find(|(uid, ..)| *uid == cam.uid) {
+            cam.mount = CameraMount::World {
+                pose_world_from_camera: look_at_robotics(*eye, *target),
+            };
+        }
+    }
+    cameras
+}
+
 impl CameraConfig {
+    /// A camera fixed in the world: `width`×`height` pixels, vertical field of view `fov_y`
+    /// (radians), clipping planes `near`..`far` (metres), at `pose_world_from_camera` (robotics
+    /// convention: x forward, y left, z up, as ManiSkill2's camera poses).
+    ///
+    /// ```
+    /// use ms2_tasks::sensors::{look_at_robotics, CameraConfig};
+    /// let cam = CameraConfig::in_world("base_camera", 128, 128, 1.57, 0.01, 10.0,
+    ///     look_at_robotics([0.3, 0.0, 0.6], [-0.1, 0.0, 0.1]));
+    /// assert!(cam.validate().is_ok());
+    /// ```
+    pub fn in_world(
+        uid: &str,
+        width: u32,
+        height: u32,
+        fov_y: f32,
+        near: f32,
+        far: f32,
+        pose_world_from_camera: Pose3,
+    ) -> CameraConfig {
+        CameraConfig {
+            uid: uid.to_owned(),
+            width,
+            height,
+            fov_y,
+            near,
+            far,
+            mount: CameraMount::World {
+                pose_world_from_camera,
+            },
+            segmentation: false,
+        }
+    }
+
     /// ManiSkill2's `base_camera`: 128×128, fov π/2, near 0.01, far 10, at (0.3, 0, 0.6) looking
     /// at (-0.1, 0, 0.1).
     pub fn base_camera() -> CameraConfig {

@@ -106,8 +106,8 @@ impl Task for AvoidObstacles {
         MAX_DENSE_REWARD
     }
 
-    fn rebuild_every_episode(&self) -> bool {
-        true
+    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(true)
     }
 
     /// Draws the episode's layout from `rng` and adds its wall and obstacles.
@@ -151,12 +151,14 @@ impl Task for AvoidObstacles {
         Ok(())
     }
 
-    /// Puts the Panda at the layout's start configuration.
+    /// Puts the Panda at the layout's start configuration (after the agent's own reset, whose
+    /// draws keep the episode RNG's sequence).
     fn initialize_agent(
         &mut self,
         scene: &mut TaskScene,
-        _rng: &mut EpisodeRng,
+        rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
+        scene.agent.initialize(scene.world.as_mut(), rng)?;
         let qpos = self
             .layout
             .as_ref()

@@ -532,7 +532,7 @@ fn plan_error(phase: &'static str) -> impl Fn(PlanError) -> SolveError {
 
 impl SolveTimings {
     /// Runs one planning query, adding its wall time.
-    fn time<T>(&mut self, query: impl FnOnce() -> T) -> T {
+    pub(crate) fn time<T>(&mut self, query: impl FnOnce() -> T) -> T {
         let t0 = Instant::now();
         let out = query();
         self.planning_seconds += t0.elapsed().as_secs_f64();

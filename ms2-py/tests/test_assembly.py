@@ -1,0 +1,119 @@
+"""The assembly tasks (PegInsertionSide-v0, PlugCharger-v0) under ManiSkill2's ids and layouts."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import ms2
+import numpy as np
+import pytest
+from conftest import leaves
+
+ASSEMBLY = {
+    "PegInsertionSide-v0": (
+        50,
+        ["/extra/tcp_pose", "/extra/peg_pose", "/extra/peg_half_size", "/extra/box_hole_pose",
+         "/extra/box_hole_radius"],
+        25.0,
+    ),
+    "PlugCharger-v0": (
+        53,
+        ["/extra/tcp_pose", "/extra/charger_pose", "/extra/receptacle_pose", "/extra/goal_pose"],
+        50.0,
+    ),
+}
+
+
+@pytest.mark.parametrize("env_id", sorted(ASSEMBLY))
+def test_registered_with_maniskill2_layout(env_id):
+    size, extra_keys, _ = ASSEMBLY[env_id]
+    assert env_id in ms2.env_ids()
+    assert gym.spec(env_id).max_episode_steps == 200
+    env = gym.make(env_id)
+    assert env.unwrapped.control_mode == "pd_joint_delta_pos"
+    assert env.observation_space.shape == (size,)
+    obs, info = env.reset(seed=0)
+    assert obs.shape == (size,) and obs.dtype == np.float32
+    assert info["success"] is False or info["success"] == np.False_
+    sd = gym.make(env_id, obs_mode="state_dict").reset(seed=0)[0]
+    paths = [p for p, _ in leaves(sd)]
+    assert paths == ["/agent/qpos", "/agent/qvel", "/agent/base_pose", *extra_keys]
+    np.testing.assert_array_equal(obs, np.concatenate([x for _, x in leaves(sd)]))
+
+
+def test_peg_and_hole_are_drawn_per_episode():
+    env = gym.make("PegInsertionSide-v0", obs_mode="state_dict")
+    sizes = []
+    for seed in (0, 1, 2, 0):
+        extra = env.reset(seed=seed)[0]["extra"]
+        half = extra["peg_half_size"]
+        assert 0.075 <= half[0] <= 0.125 and 0.015 <= half[1] <= 0.025
+        assert half[1] == half[2]
+        # The hole is the peg plus 3 mm on each side.
+        np.testing.assert_allclose(extra["box_hole_radius"][0], half[1] + 0.003, atol=1e-6)
+        sizes.append(half.copy())
+    assert not np.allclose(sizes[0], sizes[1]) and not np.allclose(sizes[1], sizes[2])
+    np.testing.assert_array_equal(sizes[0], sizes[3])
+
+
+@pytest.mark.parametrize("env_id", sorted(ASSEMBLY))
+def test_same_seed_same_episode_and_state_round_trip(env_id):
+    a, b = gym.make(env_id), gym.make(env_id)
+    oa, _ = a.reset(seed=3)
+    ob, _ = b.reset(seed=3)
+    np.testing.assert_array_equal(oa, ob)
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        act = rng.uniform(-1, 1, a.action_space.shape).astype(np.float32)
+        oa, ra, *_ = a.step(act)
+        ob, rb, *_ = b.step(act)
+    np.testing.assert_array_equal(oa, ob)
+    assert ra == rb
+    state = a.unwrapped.get_state()
+    a.step(np.zeros(a.action_space.shape, np.float32))
+    a.unwrapped.set_state(state)
+    np.testing.assert_array_equal(a.unwrapped.get_obs(), oa)
+
+
+@pytest.mark.parametrize("env_id", sorted(ASSEMBLY))
+def test_scripted_policy_succeeds_and_rewards_stay_in_range(env_id):
+    _, _, max_dense = ASSEMBLY[env_id]
+    env = gym.make(env_id, control_mode="pd_ee_delta_pose", reward_mode="dense")
+    policy = ms2.ScriptedPolicy(env)
+    env.reset(seed=0)
+    policy.reset()
+    rewards = []
+    for _ in range(200):
+        _, reward, terminated, truncated, info = env.step(policy.act())
+        rewards.append(reward)
+        if terminated or truncated:
+            break
+    assert info["success"], info
+    assert rewards[-1] == max_dense
+    assert all(np.isfinite(rewards)) and max(rewards) <= max_dense
+    # The shaped reward rises as the task progresses.
+    assert np.mean(rewards[-10:]) > np.mean(rewards[:10])
+
+
+@pytest.mark.parametrize("env_id", sorted(ASSEMBLY))
+def test_rgbd_keeps_only_the_tcp_pose(env_id):
+    env = gym.make(env_id, obs_mode="rgbd")
+    obs, _ = env.reset(seed=0)
+    assert list(obs["extra"]) == ["tcp_pose"]
+    for cam in ("base_camera", "hand_camera"):
+        assert obs["image"][cam]["rgb"].shape == (128, 128, 3)
+        assert obs["image"][cam]["depth"].shape == (128, 128, 1)
+    # The task's parts are in view of the base camera: not all one colour.
+    assert obs["image"]["base_camera"]["rgb"].std() > 5
+
+
+def test_make_vec_batches_assembly_envs():
+    envs = ms2.make_vec("PegInsertionSide-v0", num_envs=2)
+    obs, _ = envs.reset(seed=0)
+    assert obs.shape == (2, 50)
+    # Env i is seeded with seed + i: the two pegs differ.
+    assert not np.allclose(obs[0, 39:42], obs[1, 39:42])
+    obs, reward, terminated, truncated, _ = envs.step(
+        np.zeros((2, *envs.single_action_space.shape), np.float32)
+    )
+    assert obs.shape == (2, 50) and reward.shape == (2,)
+    envs.close()

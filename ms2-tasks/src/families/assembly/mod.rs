@@ -1,0 +1,71 @@
+//! Assembly with real clearances: `PegInsertionSide-v0`, `PlugCharger-v0` (AssemblingKits-v0
+//! is to follow in this folder).
+//!
+//! [`common`] holds what the assembly tasks share (box actors whose collision shapes are their
+//! visual shapes, walls around an opening built from convex boxes, the turned-hand Panda start,
+//! grasp-orientation measures); each task is its geometry, hooks and spec; [`scripted`] is the
+//! family's oracle policy and [`solutions`] its motion-planning solutions (feature `demos`).
+
+pub mod common;
+pub mod peg_insertion_side;
+pub mod plug_charger;
+pub mod scripted;
+#[cfg(feature = "demos")]
+pub mod solutions;
+
+pub use peg_insertion_side::PegInsertionSide;
+pub use plug_charger::PlugCharger;
+
+use crate::registry::{Registrar, TaskRegistration};
+use crate::spec::{RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE, RIGID_OBS_MODES};
+
+/// The assembly tasks' robots: the Panda.
+const PANDA_ONLY: &[RobotChoice] = &[RobotChoice::same("panda")];
+
+/// The spec shared by the assembly tasks (ManiSkill2's: 200 steps, the Panda,
+/// `pd_joint_delta_pos` by default, only the TCP pose known in visual modes).
+const fn assembly_spec(env_id: &'static str, summary: &'static str) -> TaskSpec {
+    TaskSpec {
+        env_id,
+        family: "assembly",
+        summary,
+        max_episode_steps: 200,
+        robots: PANDA_ONLY,
+        control_modes: &[],
+        default_control_mode: DEFAULT_CONTROL_MODE,
+        obs_modes: RIGID_OBS_MODES,
+        non_privileged_extra_keys: &["tcp_pose"],
+        goal_marker: None,
+        soft_bodies: false,
+        assets: &[],
+    }
+}
+
+/// `PegInsertionSide-v0`'s spec.
+pub const PEG_INSERTION_SIDE: TaskSpec = assembly_spec(
+    "PegInsertionSide-v0",
+    "insert a peg into the hole in the side of a box (3 mm clearance)",
+);
+
+/// `PlugCharger-v0`'s spec.
+pub const PLUG_CHARGER: TaskSpec = assembly_spec(
+    "PlugCharger-v0",
+    "plug a two-prong charger into its receptacle (0.5 mm clearance)",
+);
+
+/// Registers the family.
+pub fn register(r: &mut Registrar) {
+    let registration = TaskRegistration::new(PEG_INSERTION_SIDE, |_| {
+        Ok(Box::<PegInsertionSide>::default())
+    })
+    .scripted(scripted::peg_insertion_policy);
+    #[cfg(feature = "demos")]
+    let registration = registration.solution(&solutions::PEG_INSERTION_SIDE);
+    r.add(registration);
+
+    let registration = TaskRegistration::new(PLUG_CHARGER, |_| Ok(Box::<PlugCharger>::default()))
+        .scripted(scripted::plug_charger_policy);
+    #[cfg(feature = "demos")]
+    let registration = registration.solution(&solutions::PLUG_CHARGER);
+    r.add(registration);
+}
