@@ -204,13 +204,13 @@ impl CameraConfig {
     /// `base_camera` on `camera_base_link` (fixed in front of the robot, looking back down at
     /// it) and `hand_camera` on `camera_hand_link` (the wrist), both 128×128, fov 1.5707,
     /// near 0.01, far 10, at the link frame.
-    // ManiSkill2's configs write the field of view as the literal 1.5707, not π/2.
-    #[allow(clippy::approx_constant)]
     pub fn xmate3_defaults() -> Vec<CameraConfig> {
         let on_link = |uid: &str, link: &str| CameraConfig {
             uid: uid.to_owned(),
             width: 128,
             height: 128,
+            // ManiSkill2's literal for this robot's cameras (not exactly π/2).
+            #[allow(clippy::approx_constant)]
             fov_y: 1.5707,
             near: 0.01,
             far: 10.0,

@@ -6,10 +6,10 @@
 //!   ([`super::obstacle_layout`]).
 //! - Success: TCP within 2.5 cm and 15° of the goal pose.
 //! - Dense reward (max 10): 10 on success; else 4 × the fraction of obstacles farther from
-//!   the goal than the TCP is; when the TCP is closer to the goal than every obstacle,
-//!   plus 3·(1 − tanh(max(angle − 15°, 0) / 180°)) and, within 25°, plus 2·(1 − tanh(max(dist
-//!   − 2.5 cm, 0) / nearest-obstacle distance)); minus 50 × the largest contact impulse (N·s,
-//!   capped at 2) between the robot and the scene.
+//!   the goal than the TCP is; when the TCP is closer to the goal than every obstacle, plus
+//!   3·(1 − tanh(max(angle − 15°, 0) / 180°)) and, within 25°, plus 2·(1 − tanh(max(dist −
+//!   2.5 cm, 0) / nearest-obstacle distance)); minus 50 times the largest contact impulse
+//!   (N·s, capped at 2) between the robot and the scene.
 //! - `extra`: tcp_pose, goal_pose (`state` = 39 floats). Task state: goal pose (7).
 
 use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, VisualShape};

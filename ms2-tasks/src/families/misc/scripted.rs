@@ -1,9 +1,13 @@
 //! The scripted policy of `PandaAvoidObstacles-v0` (feature `demos`): at reset it plans the
-//! reach with the task's motion-planning solution ([`super::solutions::plan_reach`]), then each
-//! step converts the next planned joint configuration (fingers open) into an action of the
-//! env's control mode with the controller's own conversion
-//! (`CombinedController::action_for_joint_targets`), holding the last one at the end. An
-//! episode whose planning fails holds the start configuration.
+//! reach with the task's motion-planning solution ([`super::solutions::plan_reach`]), then
+//! plays the planned path in time, one configuration per step, but does not move past the
+//! first configuration at least [`LOOKAHEAD`] from the arm's current one (it waits for a
+//! lagging arm; never going back, the last one held at the end), converted into an action of
+//! the env's control mode with the controller's own conversion
+//! (`CombinedController::action_for_joint_targets`), fingers open. Waiting keeps the arm on
+//! the path in the delta modes, whose per-step bound (0.1 rad) would otherwise clip a lagging
+//! arm's commands off the path into the obstacles.
+//! An episode whose planning fails holds the start configuration.
 
 use crate::adapters::snapshot_articulation;
 use crate::demos::solutions::{planning_panda, SolveTimings};
@@ -14,12 +18,19 @@ use crate::scripted::ScriptedPolicy;
 /// Finger opening (m) held while reaching.
 const OPEN_FINGERS: f64 = 0.04;
 
+/// Largest joint distance (rad, over the arm joints) of the commanded configuration ahead of
+/// the current one: below the delta modes' 0.1 rad bound.
+pub const LOOKAHEAD: f64 = 0.08;
+
 /// See the module docs.
 #[derive(Debug, Default)]
 pub struct PlannedReachPolicy {
     /// Planned arm configurations (rad), one per env step.
     plan: Vec<Vec<f64>>,
+    /// Index of the configuration commanded.
     next: usize,
+    /// Steps taken this episode (the index of the configuration due in time).
+    steps: usize,
 }
 
 /// The policy for `env` (any control mode whose controller converts joint targets).
@@ -30,6 +41,7 @@ pub fn policy(_env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
 impl ScriptedPolicy for PlannedReachPolicy {
     fn reset(&mut self, env: &Env) {
         self.next = 0;
+        self.steps = 0;
         self.plan.clear();
         let Some(scene) = env.task_scene() else {
             return;
@@ -54,13 +66,23 @@ impl ScriptedPolicy for PlannedReachPolicy {
         };
         let snap = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation());
         let mut desired = snap.qpos.clone();
-        if let Some(target) = self
-            .plan
-            .get(self.next.min(self.plan.len().saturating_sub(1)))
+        let distance = |target: &[f64]| {
+            target
+                .iter()
+                .zip(&snap.qpos)
+                .map(|(t, q)| (t - q).abs())
+                .fold(0.0, f64::max)
+        };
+        self.steps += 1;
+        while self.next < self.steps
+            && self.next + 1 < self.plan.len()
+            && distance(&self.plan[self.next]) < LOOKAHEAD
         {
+            self.next += 1;
+        }
+        if let Some(target) = self.plan.get(self.next) {
             desired[..target.len()].copy_from_slice(target);
         }
-        self.next += 1;
         for d in desired.iter_mut().skip(7) {
             *d = OPEN_FINGERS;
         }
