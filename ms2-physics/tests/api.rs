@@ -301,6 +301,7 @@ fn stl_mesh_and_convex_decomposition_load() {
         "r.urdf",
         &UrdfLoadOptions {
             mesh_collision: MeshCollision::ConvexDecomposition,
+            ..UrdfLoadOptions::default()
         },
     )
     .unwrap();
