@@ -21,6 +21,7 @@ use crate::rigid_world::RigidEngine;
 #[cfg(feature = "render")]
 use crate::rigid_world::RigidWorld;
 use crate::seeding::{episode_rng, EpisodeRng};
+#[cfg(feature = "render")]
 use crate::sensors::CameraConfig;
 #[cfg(feature = "render")]
 use crate::sensors::{CameraFrame, Sensors};
