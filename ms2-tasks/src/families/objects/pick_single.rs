@@ -3,7 +3,7 @@
 //!
 //! - Models: the `model_ids` keyword (default: every id of the info json, sorted). Each reset
 //!   draws a model id uniformly from them and a scale from the model's `scales` (1 when absent);
-//!   a change of model or scale rebuilds the scene, as does `reset(reconfigure = true)`.
+//!   every reset rebuilds the scene (an episode depends on its seed alone), as ManiSkill2 does on a new model.
 //! - Reset: the object dropped from 5 cm above resting height (`-bbox.min.z · scale + 0.05`) at
 //!   xy uniform in [-0.1, 0.1]², yaw uniform in [0, 2π) and (EGAD) tilted about a random axis
 //!   by up to 0.2 rad, then settled for 0.5 s with its tilt locked, 0.5 s free, and 0.5 s more
@@ -224,10 +224,11 @@ impl Task for PickSingle {
             Some(scales) => *choose(scales, rng),
             None => 1.0,
         };
-        let changed = id != self.model_id || self.model_scale != Some(scale);
         self.model_id = id;
         self.model_scale = Some(scale);
-        Ok(changed)
+        // Always rebuild: a world reused across episodes keeps broad-phase history, so the
+        // same seed would step differently depending on the episode before it.
+        Ok(true)
     }
 
     fn build_scene(
