@@ -11,8 +11,13 @@ from conftest import leaves
 ASSEMBLY = {
     "PegInsertionSide-v0": (
         50,
-        ["/extra/tcp_pose", "/extra/peg_pose", "/extra/peg_half_size", "/extra/box_hole_pose",
-         "/extra/box_hole_radius"],
+        [
+            "/extra/tcp_pose",
+            "/extra/peg_pose",
+            "/extra/peg_half_size",
+            "/extra/box_hole_pose",
+            "/extra/box_hole_radius",
+        ],
         25.0,
     ),
     "PlugCharger-v0": (
