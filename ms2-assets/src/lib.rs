@@ -2,7 +2,8 @@
 //!
 //! Two kinds of assets:
 //! - **written by the ms2 developers** and compiled in: the primitive Panda descriptions
-//!   ([`PANDA_URDF`], [`PANDA_BUCKET_URDF`]), built from URDF primitives (boxes and cylinders for
+//!   ([`PANDA_URDF`], [`PANDA_BUCKET_URDF`]) and the xMate3 with a Robotiq gripper
+//!   ([`XMATE3_ROBOTIQ_URDF`]), built from URDF primitives (boxes and cylinders for
 //!   visuals; boxes and capsules for collision), so they need no mesh files;
 //! - **fetched, never part of the repository**: published files such as Franka's
 //!   `franka_description` meshes, described as [`group::AssetGroup`]s (files, sizes, sha256
@@ -88,3 +89,54 @@ pub const PANDA_BUCKET_INNER_HALF: [f64; 3] = [0.04, 0.035, 0.04];
 
 /// Half thickness (m) of the bucket's plate and walls.
 pub const PANDA_BUCKET_WALL_HALF: f64 = 0.003;
+
+/// URDF of ManiSkill2's second robot, `xmate3_robotiq`: a ROKAE xMate3 7-joint arm with a
+/// Robotiq two-finger gripper, written for ms2 from the arm's published kinematics (joint
+/// origins, axes and limits) with primitive geometry.
+///
+/// Link and joint names follow ManiSkill2 (`joint1..7`, TCP `grasp_convenient_link`, pads
+/// `left_inner_finger_pad` / `right_inner_finger_pad`, drivers
+/// `robotiq_2f_140_left_driver_joint` / `robotiq_2f_140_right_driver_joint`, camera mounts
+/// `camera_base_link` / `camera_hand_link`). The Robotiq's finger linkage is reduced to the
+/// parallel pad motion it produces: one prismatic driver per pad, qpos 0 open (pad faces
+/// 0.14 m apart), + closing; the right driver carries a `<mimic>` of the left as data.
+/// ManiSkill2 fetches its mesh description as a separate download
+/// (`xmate3_robotiq.zip`, not in the wheel), so ms2 builds this one in.
+///
+/// ```
+/// assert!(ms2_assets::XMATE3_ROBOTIQ_URDF.contains("grasp_convenient_link"));
+/// ```
+pub const XMATE3_ROBOTIQ_URDF: &str = include_str!("../robots/xmate3/xmate3_robotiq.urdf");
+
+/// Name of the xMate3's tool-centre-point link (between the pads; x along the approach,
+/// y along the closing direction).
+pub const XMATE3_TCP_LINK: &str = "grasp_convenient_link";
+
+/// Names of the xMate3's 7 arm joints, base to tip.
+pub const XMATE3_ARM_JOINTS: [&str; 7] = [
+    "joint1", "joint2", "joint3", "joint4", "joint5", "joint6", "joint7",
+];
+
+/// Names of the Robotiq gripper's two driver joints (prismatic, metres, + closes).
+pub const XMATE3_GRIPPER_JOINTS: [&str; 2] = [
+    "robotiq_2f_140_left_driver_joint",
+    "robotiq_2f_140_right_driver_joint",
+];
+
+/// Names of the Robotiq gripper's finger-pad links (left, right).
+pub const XMATE3_FINGER_PADS: [&str; 2] = ["left_inner_finger_pad", "right_inner_finger_pad"];
+
+/// ManiSkill2's rest configuration of `xmate3_robotiq` in its tabletop tasks: 7 arm joints
+/// (rad, gripper pointing down with the TCP 0.56 m in front of the base) then the 2 drivers
+/// (m, open).
+pub const XMATE3_REST_QPOS: [f64; 9] = [
+    0.0,
+    std::f64::consts::PI / 6.0,
+    0.0,
+    std::f64::consts::PI / 3.0,
+    0.0,
+    std::f64::consts::PI / 2.0,
+    -std::f64::consts::PI / 2.0,
+    0.0,
+    0.0,
+];

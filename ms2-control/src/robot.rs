@@ -118,6 +118,51 @@ impl RobotConfig {
         })
     }
 
+    /// ManiSkill2's `xmate3_robotiq`: 7-joint xMate3 arm with TCP `grasp_convenient_link`,
+    /// Robotiq mimic gripper over `[0, 0.078]` m (action −1 open, +1 closed, as ManiSkill2's
+    /// `0.068 + 0.01`), gains 1e3/1e2/100, and ManiSkill2's four modes of this robot:
+    /// `pd_joint_pos` (its default), `pd_joint_delta_pos`, `pd_ee_delta_pos`,
+    /// `pd_ee_delta_pose`.
+    ///
+    /// ```
+    /// use ms2_control::{ControlMode, RobotConfig};
+    /// let xmate = RobotConfig::xmate3_robotiq(ms2_assets::XMATE3_ROBOTIQ_URDF).unwrap();
+    /// assert_eq!(xmate.supported_modes[0], ControlMode::PdJointPos);
+    /// assert_eq!(xmate.supported_modes.len(), 4);
+    /// ```
+    pub fn xmate3_robotiq(urdf: &str) -> Result<Self, BuildError> {
+        let model = Arc::new(KinematicModel::from_urdf_str(urdf)?);
+        model.link(ms2_assets::XMATE3_TCP_LINK)?;
+        Ok(Self {
+            name: "xmate3_robotiq".into(),
+            model,
+            arm: ArmSpec {
+                joint_names: owned(&ms2_assets::XMATE3_ARM_JOINTS),
+                ee_link: ms2_assets::XMATE3_TCP_LINK.into(),
+                gains: DriveGains::MANISKILL2_DEFAULT,
+                joint_delta: 0.1,
+                joint_delta_pos_vel: 0.1,
+                ee_delta: 0.1,
+                joint_velocity: 1.0,
+                ee_frame: EeFrame::Ee,
+                ik: EeIkSolver::default(),
+            },
+            gripper: Some(GripperSpec {
+                joint_names: owned(&ms2_assets::XMATE3_GRIPPER_JOINTS),
+                lower: 0.0,
+                upper: 0.068 + 0.01,
+                gains: DriveGains::MANISKILL2_DEFAULT,
+            }),
+            base: None,
+            supported_modes: vec![
+                ControlMode::PdJointPos,
+                ControlMode::PdJointDeltaPos,
+                ControlMode::PdEeDeltaPos,
+                ControlMode::PdEeDeltaPose,
+            ],
+        })
+    }
+
     /// The mode's name as the environment reports it (mobile robots prefix the base controller,
     /// as ManiSkill2 does: `base_pd_joint_vel_arm_pd_ee_delta_pose`).
     pub fn mode_name(&self, mode: ControlMode) -> String {

@@ -34,6 +34,8 @@ pub struct KinematicRobot {
     limits: Vec<JointLimits>,
     links: Vec<CollisionLink>,
     skip: Vec<(usize, usize)>,
+    /// How many of the first `skip` pairs are joint neighbours (the rest overlap always).
+    adjacent_pairs: usize,
     carrier_link: usize,
     ik: DlsIk,
 }
@@ -116,6 +118,7 @@ impl KinematicRobot {
             skip.push((index(&a)?, index(&b)?));
         }
         let carrier_link = index(carrier_link)?;
+        let adjacent_pairs = skip.len();
         let mut robot = Self {
             planned: chain.dof_indices(),
             model,
@@ -124,6 +127,7 @@ impl KinematicRobot {
             limits,
             links,
             skip,
+            adjacent_pairs,
             carrier_link,
             ik: DlsIk::new(IkOptions {
                 max_iterations: 200,
@@ -132,6 +136,24 @@ impl KinematicRobot {
         };
         robot.skip.extend(robot.always_colliding_pairs(200, 0));
         Ok(robot)
+    }
+
+    /// The same robot with other collision shapes for some links, e.g. the real robot's convex
+    /// hulls instead of the URDF's primitives: each entry replaces the shapes of the link of its
+    /// name (shapes in the link frame). Self-collision skips are recomputed: joint neighbours,
+    /// plus the pairs that overlap in every one of 200 seeded random configurations.
+    ///
+    /// # Errors
+    /// [`PlanError::UnknownLink`] for a link the robot does not have.
+    pub fn with_link_shapes(mut self, links: Vec<CollisionLink>) -> Result<Self, PlanError> {
+        for link in links {
+            let i = link_index(&self.links, &link.name)?;
+            self.links[i].shapes = link.shapes;
+        }
+        self.skip.truncate(self.adjacent_pairs);
+        let always = self.always_colliding_pairs(200, 0);
+        self.skip.extend(always);
+        Ok(self)
     }
 
     /// ms2's Panda (`ms2_assets::PANDA_URDF`): planning `panda_joint1..7` to `panda_hand_tcp`,

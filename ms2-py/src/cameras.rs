@@ -126,22 +126,3 @@ pub fn camera_updates_from_py(cfgs: &Bound<'_, PyDict>) -> Result<CameraCfgUpdat
     }
     Ok(updates)
 }
-
-/// The render camera of `render()` with ManiSkill2's `render_camera_cfgs` applied: camera
-/// fields at the top level or under the camera's uid `"render_camera"`.
-pub fn render_camera_from_py(cfgs: &Bound<'_, PyDict>) -> Result<CameraConfig, NativeError> {
-    let updates = camera_updates_from_py(cfgs)?;
-    let mut cams = updates.applied_to(vec![CameraConfig::render_camera()])?;
-    Ok(cams.remove(0))
-}
-
-/// The observation cameras of the robot tasks with `camera_cfgs` applied (`None` = defaults).
-pub fn cameras_from_py(
-    cfgs: Option<&Bound<'_, PyDict>>,
-) -> Result<Option<Vec<CameraConfig>>, NativeError> {
-    let Some(cfgs) = cfgs else {
-        return Ok(None);
-    };
-    let updates = camera_updates_from_py(cfgs)?;
-    Ok(Some(updates.applied_to(CameraConfig::panda_defaults())?))
-}

@@ -6,13 +6,13 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat};
 
-use crate::cameras::{cameras_from_py, render_camera_from_py};
+use crate::cameras::camera_updates_from_py;
 
 /// The keyword arguments every native env constructor and demonstration binding accepts, with
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
 /// (ManiSkill2's `state` obs mode, then [`EnvConfig::new`]'s: the task's control/reward mode, 500 Hz / 20 Hz, the task's
 /// episode limit, no render mode, the task's default robot and cameras, the soft-body task's MPM frequency).
-pub const ENV_KWARGS: [&str; 13] = [
+pub const ENV_KWARGS: [&str; 14] = [
     "obs_mode",
     "robot",
     "control_mode",
@@ -26,6 +26,7 @@ pub const ENV_KWARGS: [&str; 13] = [
     "enable_shadow",
     "render_camera_cfgs",
     "bg_name",
+    "exact_restore",
 ];
 
 /// The obs mode of an env made from Python without `obs_mode` (ManiSkill2's default).
@@ -119,13 +120,13 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                 let dict = value.cast::<PyDict>().map_err(|_| {
                     PyTypeError::new_err(format!("camera_cfgs must be a dict, got {value}"))
                 })?;
-                cfg.camera_cfgs = cameras_from_py(Some(dict))?;
+                cfg.camera_updates = Some(camera_updates_from_py(dict)?);
             }
             "render_camera_cfgs" => {
                 let dict = value.cast::<PyDict>().map_err(|_| {
                     PyTypeError::new_err(format!("render_camera_cfgs must be a dict, got {value}"))
                 })?;
-                cfg.render_camera = Some(render_camera_from_py(dict)?);
+                cfg.render_camera_updates = Some(camera_updates_from_py(dict)?);
             }
             "enable_shadow" => {
                 if !value.is_instance_of::<pyo3::types::PyBool>() {
@@ -134,6 +135,14 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                     )));
                 }
                 cfg.enable_shadow = value.extract()?;
+            }
+            "exact_restore" => {
+                if !value.is_instance_of::<pyo3::types::PyBool>() {
+                    return Err(PyTypeError::new_err(format!(
+                        "exact_restore must be a bool, got {value}"
+                    )));
+                }
+                cfg.exact_restore = value.extract()?;
             }
             "bg_name" => cfg.bg_name = Some(extract_kwarg(&key, &value, "a str")?),
             other => {
@@ -161,5 +170,6 @@ pub fn config_to_py<'py>(py: Python<'py>, cfg: &EnvConfig) -> PyResult<Bound<'py
     dict.set_item("mpm_freq", cfg.mpm_freq)?;
     dict.set_item("enable_shadow", cfg.enable_shadow)?;
     dict.set_item("bg_name", &cfg.bg_name)?;
+    dict.set_item("exact_restore", cfg.exact_restore)?;
     Ok(dict)
 }

@@ -124,7 +124,7 @@ pub fn episode_from_py(env_id: &str, dict: &Bound<'_, PyDict>) -> PyResult<DemoE
 /// The keyword arguments that rebuild env `env_id` made with `env_kwargs`, as a trajectory
 /// file's `env_info` records them, resolved by making the env: `{"obs_mode", "control_mode",
 /// "reward_mode", "sim_freq", "control_freq", "max_episode_steps"}` plus `"mpm_freq"` (Hz) for
-/// soft-body envs. `ValueError` for an unknown id or bad `env_kwargs`.
+/// soft-body envs, and `"exact_restore": True` when set. `ValueError` for an unknown id or bad `env_kwargs`.
 #[pyfunction]
 #[pyo3(signature = (env_id, env_kwargs=None))]
 pub fn recorded_env_kwargs<'py>(
@@ -141,6 +141,10 @@ pub fn recorded_env_kwargs<'py>(
     dict.del_item("render_mode")?;
     if resolved.mpm_freq.is_none() {
         dict.del_item("mpm_freq")?;
+    }
+    // ManiSkill2 has no such keyword: recorded only when on.
+    if !resolved.exact_restore {
+        dict.del_item("exact_restore")?;
     }
     Ok(dict)
 }

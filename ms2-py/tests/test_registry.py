@@ -16,7 +16,9 @@ def test_specs_describe_every_registered_task():
         assert gym.spec(env_id).max_episode_steps == spec["max_episode_steps"]
         assert spec["default_control_mode"]
         assert "state" in spec["obs_modes"]
-    assert specs["PickCube-v0"]["robots"] == ["panda"]
+    assert specs["PickCube-v0"]["robots"] == ["panda", "xmate3_robotiq"]
+    assert specs["Excavate-v0"]["robots"] == ["panda"]
+    assert specs["PandaAvoidObstacles-v0"]["robots"] == ["panda"]
     assert specs["Excavate-v0"]["soft_bodies"] and not specs["PickCube-v0"]["soft_bodies"]
 
 

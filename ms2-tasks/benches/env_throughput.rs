@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use ms2_control::{ControlMode, ControlTiming};
 use ms2_physics::{World, WorldConfig};
-use ms2_tasks::agents::{Agent, PandaAgent};
+use ms2_tasks::agents::{build_panda_from_urdf, Agent};
 use ms2_tasks::families::rigid::common::{add_cube, CUBE_HALF_SIZE};
 use ms2_tasks::seeding::episode_rng;
 use ms2_tasks::{make_env, EnvConfig, VecEnv};
@@ -113,7 +113,7 @@ fn overhead_pair(mode: &str, seed: u64, steps: usize) -> (f64, f64) {
         .into_iter()
         .find(|m| m.name() == mode)
         .expect("mode");
-    let agent = PandaAgent::build_from_urdf(
+    let agent = build_panda_from_urdf(
         &mut world,
         mode_enum,
         ControlTiming::MANISKILL2,

@@ -23,8 +23,8 @@ pub(crate) trait EnvBackend: Send {
     fn action_space(&self) -> &BoxSpace;
     /// Largest dense reward (for `normalized_dense`).
     fn max_dense_reward(&self) -> f64;
-    /// Whether every reset rebuilds the scene (the task draws its geometry per episode).
-    fn reconfigures_every_reset(&self) -> bool {
+    /// Whether every episode starts with [`EnvBackend::reconfigure`] (per-episode scenes).
+    fn rebuild_every_episode(&self) -> bool {
         false
     }
     /// (Re)builds the scene.

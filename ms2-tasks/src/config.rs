@@ -1,7 +1,7 @@
 //! Environment configuration and the observation / reward mode enums.
 
 use crate::error::EnvError;
-use crate::sensors::{CameraConfig, VisualLayout};
+use crate::sensors::{CameraCfgUpdates, CameraConfig, VisualLayout};
 
 /// How an environment is made: which task, which observation, control and reward modes, and the
 /// simulation / control frequencies.
@@ -26,9 +26,13 @@ pub struct EnvConfig {
     pub reward_mode: Option<String>,
     /// Render mode: `None` or `"rgb_array"` ([`crate::Env::render`]: a 512×512 view for people).
     pub render_mode: Option<String>,
-    /// Observation cameras of the visual obs modes; `None` = the task's defaults
-    /// (`base_camera` and `hand_camera`, see [`CameraConfig::panda_defaults`]).
+    /// Observation cameras of the visual obs modes, replacing the task's; `None` = the task's
+    /// defaults ([`crate::Task::sensor_cameras`]; for most tasks `base_camera` and
+    /// `hand_camera`, see [`CameraConfig::panda_defaults`]).
     pub camera_cfgs: Option<Vec<CameraConfig>>,
+    /// ManiSkill2's `camera_cfgs` keyword: field updates applied to the cameras above (the
+    /// task's defaults unless `camera_cfgs` is set) when the env is made.
+    pub camera_updates: Option<CameraCfgUpdates>,
     /// Physics frequency in Hz (default 500). Must be a whole multiple of `control_freq`.
     pub sim_freq: f64,
     /// Control (env step) frequency in Hz (default 20).
@@ -46,10 +50,24 @@ pub struct EnvConfig {
     /// default ([`CameraConfig::render_camera`]). ManiSkill2's `render_camera_cfgs` keyword
     /// changes it field by field.
     pub render_camera: Option<CameraConfig>,
+    /// ManiSkill2's `render_camera_cfgs` keyword: field updates applied to the render camera
+    /// above (the task's default unless `render_camera` is set) when the env is made.
+    pub render_camera_updates: Option<CameraCfgUpdates>,
     /// ManiSkill2's `bg_name` (a visual background scene replacing the default lights);
     /// `None` = the default scene. ms2 ships no background scenes, so any name is refused with
     /// [`EnvError::InvalidConfig`].
     pub bg_name: Option<String>,
+    /// Whether every env step starts from the flat state alone (default `false`).
+    ///
+    /// rapier carries solver history from one substep to the next (warm-start impulses and
+    /// the order of contact pairs). With `exact_restore`, each env step first drops that history
+    /// (as a reset does), so [`crate::Env::set_state`] into *any* env of the same build continues
+    /// bit for bit like the run the state was recorded from. It costs about 20 % of the state
+    /// step rate (PickCube / StackCube, 2026-11-24). Without it a restore into the *same* env is
+    /// still exact (recent states are snapshotted), an episode replayed from its first state is
+    /// exact, and a restore mid-episode into a fresh env drifts once objects touch (see
+    /// docs/trajectory_format.md, "Restoring states").
+    pub exact_restore: bool,
 }
 
 impl Default for EnvConfig {
@@ -62,13 +80,16 @@ impl Default for EnvConfig {
             reward_mode: None,
             render_mode: None,
             camera_cfgs: None,
+            camera_updates: None,
             sim_freq: 500.0,
             control_freq: 20.0,
             max_episode_steps: None,
             mpm_freq: None,
             enable_shadow: false,
             render_camera: None,
+            render_camera_updates: None,
             bg_name: None,
+            exact_restore: false,
         }
     }
 }

@@ -260,7 +260,7 @@ impl Env {
     /// Seeds and samples a new episode; the info of its first state.
     fn start_episode(&mut self, seed: Option<u64>, reconfigure: bool) -> Result<Info, EnvError> {
         let mut rng = self.seeding.start_episode(seed);
-        if reconfigure || self.needs_rebuild || self.backend.reconfigures_every_reset() {
+        if reconfigure || self.needs_rebuild || self.backend.rebuild_every_episode() {
             // A step that failed or went non-finite may have left the world broken: rebuild.
             self.backend.reconfigure(&mut rng)?;
             self.needs_rebuild = false;

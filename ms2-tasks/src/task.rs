@@ -6,8 +6,8 @@
 //! | when | hook |
 //! |---|---|
 //! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
-//! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_agent`] (default: rest qpos + noise), [`Task::initialize_task`] |
-//! | every reset, when [`Task::reconfigure_every_reset`] | [`Task::build_scene`] first |
+//! | every reset, first, when [`Task::rebuild_every_episode`] | [`Task::build_scene`] on a fresh world, with the episode's RNG (per-episode layouts and geometry) |
+//! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_agent`] (default: the robot's reset, rest qpos + noise), [`Task::initialize_task`] |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
@@ -24,6 +24,7 @@ use crate::obs::{DictBuilder, ObsValue};
 use crate::particles::ParticleVisual;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::CameraConfig;
 
 /// What a task's hooks see: the rigid world (through the port) and the robot.
 pub struct TaskScene {
@@ -65,7 +66,7 @@ pub trait Task: Any + Send {
 
     /// Puts the robot at its episode start (after [`Task::initialize_actors`]). The default is
     /// the agent's own reset (rest qpos plus noise); a task with another start posture (e.g.
-    /// PegInsertionSide's turned hand) overrides it.
+    /// PegInsertionSide's turned hand, an obstacle layout's start configuration) overrides it.
     fn initialize_agent(
         &mut self,
         scene: &mut TaskScene,
@@ -75,10 +76,11 @@ pub trait Task: Any + Send {
         agent.initialize(world.as_mut(), rng)
     }
 
-    /// Whether every reset rebuilds the scene ([`Task::build_scene`] with the episode's RNG),
-    /// as ManiSkill2 does for tasks whose geometry is drawn per episode (PegInsertionSide's
-    /// peg and hole sizes). Default: only when the caller asks for it.
-    fn reconfigure_every_reset(&self) -> bool {
+    /// Whether every episode builds a fresh world ([`Task::build_scene`] with the episode's
+    /// RNG), for tasks whose actors or geometry differ per episode (ManiSkill2 reconfigures on
+    /// a new episode layout; PegInsertionSide draws its peg and hole per episode). Default:
+    /// `false` (the world is built at make and on `reconfigure`).
+    fn rebuild_every_episode(&self) -> bool {
         false
     }
 
@@ -87,13 +89,6 @@ pub trait Task: Any + Send {
     /// prediction distance, changes them here). Read once when the env is made.
     fn solver_config(&self, defaults: SolverConfig) -> SolverConfig {
         defaults
-    }
-
-    /// The task's own world-fixed camera views, `(uid, eye, target)` (m, world): ManiSkill2
-    /// places `base_camera` and `render_camera` per task. Each replaces the pose of the default
-    /// camera of that uid (looking from `eye` at `target`) when the user configures none.
-    fn camera_views(&self) -> Vec<(&'static str, [f32; 3], [f32; 3])> {
-        Vec::new()
     }
 
     /// Samples task data (e.g. the goal) after actors and robot are placed.
@@ -136,6 +131,22 @@ pub trait Task: Any + Send {
     /// [`Task::soft`], mutably (the runtime steps it).
     fn soft_mut(&mut self) -> Option<&mut dyn SoftComponent> {
         None
+    }
+
+    /// The observation cameras of the visual obs modes, given the robot's
+    /// ([`crate::agents::RobotSpec::cameras`]: the Panda's `base_camera` and `hand_camera`).
+    /// ManiSkill2 places `base_camera` per task (its `_register_cameras`): a task that does
+    /// returns the list with that camera changed. The user's `camera_cfgs` updates are applied
+    /// to the result. Default: the robot's cameras.
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        robot_cameras
+    }
+
+    /// The camera of `render()`, given the robot's default
+    /// ([`crate::agents::RobotSpec::render_camera`]); ManiSkill2's `_register_render_cameras`
+    /// of the task. `render_camera_cfgs` updates the result. Default: the robot's.
+    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
+        robot_default
     }
 }
 

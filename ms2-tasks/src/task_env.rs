@@ -10,7 +10,7 @@ use ms2_physics::WorldConfig;
 
 #[cfg(feature = "render")]
 use crate::adapters::RenderContext;
-use crate::agents::{robot_spec, RobotSpec};
+use crate::agents::{robot_spec, RobotSpec, CONTROL_MODE_ALIASES};
 use crate::backend::EnvBackend;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
@@ -51,6 +51,8 @@ pub(crate) struct TaskEnv {
     /// Whether the first directional light casts shadows (`enable_shadow`).
     #[cfg(feature = "render")]
     enable_shadow: bool,
+    /// [`crate::EnvConfig::exact_restore`].
+    exact_restore: bool,
     /// Cameras and render scene, built on the first render (state-only envs never render).
     #[cfg(feature = "render")]
     sensors: Mutex<Option<Sensors>>,
@@ -81,14 +83,25 @@ impl TaskEnv {
             .filter(|m| spec.control_modes.is_empty() || spec.control_modes.contains(&m.name()))
             .collect();
         let control_modes: Vec<String> = supported.iter().map(|m| m.name().to_owned()).collect();
-        let mode_name = cfg
-            .control_mode
-            .as_deref()
-            .unwrap_or(spec.default_control_mode);
+        // The task's default for its default robot, else the robot's own first mode
+        // (ManiSkill2: the agent's first mode; `xmate3_robotiq` starts with `pd_joint_pos`).
+        let default_mode = if robot_uid == Some(spec.default_robot()) {
+            spec.default_control_mode
+        } else {
+            control_modes
+                .first()
+                .map_or(spec.default_control_mode, String::as_str)
+        };
+        let mode_name = cfg.control_mode.as_deref().unwrap_or(default_mode);
         let mode = supported
             .iter()
             .copied()
-            .find(|m| m.name() == mode_name)
+            .find(|m| {
+                m.name() == mode_name
+                    || CONTROL_MODE_ALIASES
+                        .iter()
+                        .any(|(alias, aliased)| *alias == mode_name && aliased == m)
+            })
             .ok_or_else(|| EnvError::UnknownControlMode {
                 got: mode_name.to_owned(),
                 valid: control_modes.clone(),
@@ -118,20 +131,23 @@ impl TaskEnv {
             ctrl.action_low().iter().map(|&v| v as f32).collect(),
             ctrl.action_high().iter().map(|&v| v as f32).collect(),
         );
-        let views = task.camera_views();
-        let camera_cfgs = cfg.camera_cfgs.clone().unwrap_or_else(|| {
-            CameraConfig::panda_defaults()
-                .into_iter()
-                .map(|cam| with_task_view(cam, &views))
-                .collect()
-        });
+        let mut camera_cfgs = cfg
+            .camera_cfgs
+            .clone()
+            .unwrap_or_else(|| task.sensor_cameras((robot.cameras)()));
+        if let Some(updates) = &cfg.camera_updates {
+            camera_cfgs = updates.applied_to(camera_cfgs)?;
+        }
         for cam in &camera_cfgs {
             cam.validate()?;
         }
-        let render_camera = cfg
+        let mut render_camera = cfg
             .render_camera
             .clone()
-            .unwrap_or_else(|| with_task_view(CameraConfig::render_camera(), &views));
+            .unwrap_or_else(|| task.render_camera((robot.render_camera)()));
+        if let Some(updates) = &cfg.render_camera_updates {
+            render_camera = updates.applied_to(vec![render_camera])?.remove(0);
+        }
         render_camera.validate()?;
         #[cfg(not(feature = "render"))]
         let _ = render_camera;
@@ -151,6 +167,7 @@ impl TaskEnv {
             render_camera,
             #[cfg(feature = "render")]
             enable_shadow: cfg.enable_shadow,
+            exact_restore: cfg.exact_restore,
             #[cfg(feature = "render")]
             sensors: Mutex::new(None),
         })
@@ -236,20 +253,6 @@ fn poisoned<T>(_: std::sync::PoisonError<T>) -> EnvError {
     EnvError::Render("sensor lock poisoned by an earlier panic".to_owned())
 }
 
-/// `cam` looking from the task's view of its uid, if the task has one
-/// ([`Task::camera_views`]).
-fn with_task_view(
-    mut cam: CameraConfig,
-    views: &[(&'static str, [f32; 3], [f32; 3])],
-) -> CameraConfig {
-    if let Some((_, eye, target)) = views.iter().find(|(uid, ..)| *uid == cam.uid) {
-        cam.mount = crate::sensors::camera::CameraMount::World {
-            pose_world_from_camera: crate::sensors::camera::look_at_robotics(*eye, *target),
-        };
-    }
-    cam
-}
-
 /// A fresh world with the ground, the robot and the task's actors.
 fn build_scene(
     engine: &dyn RigidEngine,
@@ -283,8 +286,8 @@ impl EnvBackend for TaskEnv {
         self.task.max_dense_reward()
     }
 
-    fn reconfigures_every_reset(&self) -> bool {
-        self.task.reconfigure_every_reset()
+    fn rebuild_every_episode(&self) -> bool {
+        self.task.rebuild_every_episode()
     }
 
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {
@@ -319,6 +322,12 @@ impl EnvBackend for TaskEnv {
     fn apply_action(&mut self, action: &[f32]) -> Result<(), EnvError> {
         let TaskScene { world, agent } = &mut self.scene;
         let world = world.as_mut();
+        // With `exact_restore`, every env step starts from the flat state alone (no warm-start
+        // impulses or contact pairs carried over from the previous step), so a state restored
+        // into any env of the same build continues exactly as the run it was recorded from.
+        if self.exact_restore {
+            world.forget_solver_history()?;
+        }
         agent.set_action(world, action)?;
         let mut soft = self.task.soft_mut();
         for _ in 0..self.substeps {

@@ -3,7 +3,7 @@
 
 use ms2_control::{ControlMode, ControlTiming};
 use ms2_physics::{World, WorldConfig};
-use ms2_tasks::agents::{Agent, PandaAgent};
+use ms2_tasks::agents::{build_panda_from_urdf, Agent, PandaAgent};
 use ms2_tasks::geometry::Pose3;
 use ms2_tasks::seeding::episode_rng;
 
@@ -24,7 +24,7 @@ impl Rig {
         let mut world = World::new(WorldConfig::default()).expect("world");
         let timing = ControlTiming::MANISKILL2;
         let mut agent =
-            PandaAgent::build_from_urdf(&mut world, mode, timing, ms2_assets::PANDA_URDF)
+            build_panda_from_urdf(&mut world, mode, timing, ms2_assets::PANDA_URDF)
                 .expect("agent");
         agent
             .initialize(&mut world, &mut episode_rng(seed))

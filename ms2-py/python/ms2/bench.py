@@ -221,10 +221,8 @@ def _soak(args: argparse.Namespace) -> int:
         f"{os.getloadavg()[0]:.1f}",
         flush=True,
     )
-    total = run_soak(steps)
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(total, f, indent=2)
+    total = run_soak(steps, jobs=args.jobs)
+    _write_json(args.json, total)
     return 0 if total["non_finite"] == 0 and total["errors"] == 0 else 1
 
 
@@ -360,7 +358,7 @@ def _print_render_cost(rows: list[dict]) -> None:
         )
 
 
-def _write_json(path: str | None, rows: list[dict]) -> None:
+def _write_json(path: str | None, rows: list[dict] | dict) -> None:
     if path:
         tmp = f"{path}.tmp"
         with open(tmp, "w") as f:
@@ -412,6 +410,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="robustness soak instead: --steps (default 1,000,000) env steps over every task and "
         "obs mode with resets and set_state of recorded states; reports RSS, NaN and errors",
+    )
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=1,
+        help="--soak: worker processes soaking (task, obs mode) pairs in parallel",
     )
     p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     p.add_argument("--worker", default=None, help=argparse.SUPPRESS)

@@ -426,7 +426,7 @@ def replay(
         out_mode = target_control_mode or next(iter(source_modes))
         native_kwargs = {
             key: env_kwargs[key]
-            for key in ("reward_mode", "sim_freq", "control_freq", "mpm_freq")
+            for key in ("reward_mode", "sim_freq", "control_freq", "mpm_freq", "exact_restore")
             if key in env_kwargs
         }
         if obs_mode is None:

@@ -26,7 +26,8 @@ UNLIMITED_EPISODE_STEPS = 2**31 - 1
 
 def adopt_config(env: Any, config: dict[str, Any]) -> None:
     """Sets ``env_id``, ``obs_mode``, ``control_mode``, ``reward_mode``, ``render_mode``,
-    ``sim_freq``, ``control_freq`` and ``mpm_freq`` (``None`` without soft bodies) on ``env``
+    ``sim_freq``, ``control_freq``, ``mpm_freq`` (``None`` without soft bodies) and
+    ``exact_restore`` on ``env``
     from a native env's resolved ``config()`` (task defaults filled in)."""
     for key in (
         "env_id",
@@ -38,6 +39,7 @@ def adopt_config(env: Any, config: dict[str, Any]) -> None:
         "sim_freq",
         "control_freq",
         "mpm_freq",
+        "exact_restore",
     ):
         setattr(env, key, config[key])
 
@@ -139,6 +141,11 @@ class Ms2Env(gym.Env):
             the key ``"render_camera"``).
         bg_name: ManiSkill2's visual background; only ``None`` (ms2 ships no background
             scenes: any name raises ``ValueError``).
+        exact_restore: when ``True``, every step starts from the flat state alone (rapier's
+            warm-start history is dropped first, as at a reset), so ``set_state`` into *any*
+            env of the same build continues bit for bit like the recorded run; costs about
+            20 % of the state step rate. Off by default (then a restore into the same env,
+            or of an episode's first state, is still exact; see docs/trajectory_format.md).
 
     Unknown ids or modes raise ``ValueError`` listing the valid ones.
     """
@@ -161,6 +168,7 @@ class Ms2Env(gym.Env):
         enable_shadow: bool = False,
         render_camera_cfgs: dict[str, Any] | None = None,
         bg_name: str | None = None,
+        exact_restore: bool = False,
     ) -> None:
         _assets.register_installed_packages()
         self._native = _native.NativeEnv(
@@ -178,6 +186,7 @@ class Ms2Env(gym.Env):
             enable_shadow=enable_shadow,
             render_camera_cfgs=render_camera_cfgs,
             bg_name=bg_name,
+            exact_restore=exact_restore,
         )
         adopt_config(self, self._native.config())
         _assets.warn_if_primitive_panda()

@@ -104,6 +104,7 @@ def _env_info(env: gym.Env) -> dict[str, Any]:
             "sim_freq": unwrapped.sim_freq,
             "control_freq": unwrapped.control_freq,
             **({"mpm_freq": unwrapped.mpm_freq} if unwrapped.mpm_freq is not None else {}),
+            **({"exact_restore": True} if getattr(unwrapped, "exact_restore", False) else {}),
         },
     }
 

@@ -9,13 +9,19 @@ most steps and the rendering and soft-body pairs fewer (``WEIGHTS``); every pair
 ``MIN_STEPS``. Printed per pair and in total: steps, steps/s, resident memory (RSS) at the start
 and end, NaN/inf observations or rewards handed out (must be 0), and errors by type with the
 first messages.
+
+``--jobs N`` runs the pairs in N worker processes (each worker soaks pair after pair, so its
+memory at the end of its last pair still shows a leak across pairs); rows are printed as pairs
+finish.
 """
 
 from __future__ import annotations
 
 import math
+import multiprocessing
 import time
 from collections import Counter
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any
 
 import numpy as np
@@ -30,7 +36,7 @@ WEIGHTS = {"rigid_state": 1.0, "rigid_visual": 0.05, "soft_state": 0.05, "soft_v
 MIN_STEPS = 20
 #: Small cameras for the visual modes (the soak is about robustness, not images).
 SOAK_CAMERAS = {"width": 32, "height": 32}
-VISUAL_MODES = ("rgbd", "pointcloud", "rgbd_robot_seg", "pointcloud_robot_seg")
+VISUAL_MODES = ("image", "rgbd", "pointcloud", "rgbd_robot_seg", "pointcloud_robot_seg")
 
 
 def rss_mb() -> float:
@@ -132,26 +138,44 @@ def soak_pair(env_id: str, obs_mode: str, steps: int, seed: int) -> dict[str, An
     }
 
 
-def run_soak(total_steps: int, seed: int = 0, env_ids: list[str] | None = None) -> dict[str, Any]:
-    """Soaks every (task, obs mode) pair (or those of ``env_ids``), printing a row per pair;
-    returns the totals and rows."""
+def _print_row(row: dict[str, Any]) -> None:
+    print(
+        f"{row['env_id']:<14} {row['obs_mode']:<21} {row['steps']:>8} steps "
+        f"{row['steps_per_s']:>7.0f}/s resets {row['resets']:>5} set_state {row['set_states']:>5} "
+        f"NaN {row['non_finite']} errors {row['errors'] or 0} "
+        f"RSS {row['rss_start_mb']:.0f} -> {row['rss_end_mb']:.0f} MB",
+        flush=True,
+    )
+    for msg in row["error_messages"]:
+        print(f"    {msg}")
+
+
+def run_soak(
+    total_steps: int, seed: int = 0, env_ids: list[str] | None = None, jobs: int = 1
+) -> dict[str, Any]:
+    """Soaks every (task, obs mode) pair (or those of ``env_ids``), in this process or in
+    ``jobs`` worker processes, printing a row per pair; returns the totals and rows."""
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= 64:
+        raise ValueError(f"jobs must be an int in [1, 64], got {jobs!r}")
     rss_start = rss_mb()
     rows = []
     started = time.perf_counter()
-    for i, (env_id, mode, steps) in enumerate(plan(total_steps)):
-        if env_ids and env_id not in env_ids:
-            continue
-        row = soak_pair(env_id, mode, steps, seed + i)
-        rows.append(row)
-        print(
-            f"{env_id:<14} {mode:<21} {row['steps']:>8} steps {row['steps_per_s']:>7.0f}/s "
-            f"resets {row['resets']:>5} set_state {row['set_states']:>5} "
-            f"NaN {row['non_finite']} errors {row['errors'] or 0} "
-            f"RSS {row['rss_start_mb']:.0f} -> {row['rss_end_mb']:.0f} MB",
-            flush=True,
-        )
-        for msg in row["error_messages"]:
-            print(f"    {msg}")
+    work = [
+        (env_id, mode, steps, seed + i)
+        for i, (env_id, mode, steps) in enumerate(plan(total_steps))
+        if not env_ids or env_id in env_ids
+    ]
+    if jobs == 1:
+        for item in work:
+            rows.append(soak_pair(*item))
+            _print_row(rows[-1])
+    else:
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=min(jobs, len(work)), mp_context=context) as ex:
+            futures = [ex.submit(soak_pair, *item) for item in work]
+            for future in as_completed(futures):
+                rows.append(future.result())
+                _print_row(rows[-1])
     total = {
         "steps": sum(r["steps"] for r in rows),
         "seconds": time.perf_counter() - started,

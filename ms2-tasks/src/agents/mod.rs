@@ -10,12 +10,19 @@
 //! |---|---|---|
 //! | `panda` | Franka Panda, two-finger gripper, ManiSkill2's base pose | every mode of [`ms2_control::RobotConfig::panda`] |
 //! | `panda_bucket` | the Panda with a bucket fixed to its hand (soft-body tasks) | the same |
+//! | `panda_avoid_obstacles` | the Panda at the world origin with PandaAvoidObstacles' cameras (ManiSkill2's `PandaRealSensed435Config`) | the same as `panda` |
+//! | `xmate3_robotiq` | ROKAE xMate3 arm with a Robotiq two-finger gripper (ManiSkill2's second robot) | `pd_joint_pos` (default), `pd_joint_delta_pos` (also by ManiSkill2's name `arm_pd_joint_delta_pos`), `pd_ee_delta_pos`, `pd_ee_delta_pose` |
+//!
+//! Both robots are [`GripperArmAgent`]s: one agent type over the data of a
+//! [`GripperArmModel`] (base, rest pose, TCP, fingers, drives).
 //!
 //! A new robot is one module here implementing [`Agent`] plus one [`RobotSpec`] in
 //! [`ROBOTS`]; see docs/architecture.md, "How to add a robot".
 
+pub mod gripper_arm;
 pub mod panda;
 pub mod panda_model;
+pub mod xmate3;
 
 use std::any::Any;
 use std::fmt::Debug;
@@ -28,8 +35,15 @@ use crate::geometry::Pose3;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
 
-pub use panda::{PandaAgent, ARM_DOF, ARM_QPOS_NOISE_STD, GRASP_MIN_IMPULSE, ROBOT_STATIC_QVEL};
-pub use panda_model::{panda_model, PandaModel, PandaModelSource, PANDA_DESCRIPTION_ENV};
+pub use gripper_arm::{GripperArmAgent, GripperArmModel, ARM_QPOS_NOISE_STD, GRASP_MIN_IMPULSE};
+pub use panda::{
+    build_panda_from_desc, build_panda_from_urdf, PandaAgent, ARM_DOF, PANDA_MODEL,
+    ROBOT_STATIC_QVEL,
+};
+pub use panda_model::{
+    panda_bucket_model, panda_model, PandaModel, PandaModelSource, PANDA_DESCRIPTION_ENV,
+};
+pub use xmate3::{XMATE3_MODEL, XMATE3_ROBOTIQ};
 
 /// A robot in a rigid world with the controller of one control mode.
 ///
@@ -100,12 +114,26 @@ pub struct RobotSpec {
     pub description: &'static str,
     /// The control modes it supports, default first.
     pub control_modes: fn() -> Vec<ControlMode>,
+    /// Its observation cameras (`base_camera`, `hand_camera` as ManiSkill2 mounts them).
+    pub cameras: fn() -> Vec<crate::sensors::CameraConfig>,
+    /// The camera of human renders (`render_mode="rgb_array"`).
+    pub render_camera: fn() -> crate::sensors::CameraConfig,
     /// Builds it.
     pub build: BuildAgent,
 }
 
 /// The registered robots.
-pub const ROBOTS: &[RobotSpec] = &[panda::PANDA, panda::PANDA_BUCKET];
+pub const ROBOTS: &[RobotSpec] = &[
+    panda::PANDA,
+    panda::PANDA_BUCKET,
+    panda::PANDA_AVOID_OBSTACLES,
+    xmate3::XMATE3_ROBOTIQ,
+];
+
+/// ManiSkill2's other names of control modes: `xmate3_robotiq` registers its joint-delta mode
+/// as `arm_pd_joint_delta_pos`.
+pub const CONTROL_MODE_ALIASES: &[(&str, ControlMode)] =
+    &[("arm_pd_joint_delta_pos", ControlMode::PdJointDeltaPos)];
 
 /// The registered robot `name`; an error lists the registered ones.
 ///

@@ -128,6 +128,58 @@ fn load_panda_model() -> Result<PandaModel, EnvError> {
     }
 }
 
+/// Links of the bucket Panda whose collision shapes come from the real Panda when it is in use:
+/// the arm up to the wrist. `panda_link7`, the hand and the fingers keep the bucket
+/// description's primitive shapes: link 7, link 8, the hand and the bucket are fixed together
+/// into the one rigid body the MPM coupling carries, and the coupling reads primitive shapes only.
+const BUCKET_PANDA_REAL_COLLISION_LINKS: [&str; 7] = [
+    "panda_link0",
+    "panda_link1",
+    "panda_link2",
+    "panda_link3",
+    "panda_link4",
+    "panda_link5",
+    "panda_link6",
+];
+
+/// The Panda carrying a bucket (`panda_bucket`, the soft-body tasks' robot), parsed once per
+/// process: [`ms2_assets::PANDA_BUCKET_URDF`], with the real Panda's visual meshes on every
+/// Panda link and its collision hulls on the arm links (`panda_link0`..`panda_link6`) when
+/// [`panda_model`] is the real one. The bucket, and the hand's and fingers' collision shapes,
+/// stay the description's primitives. Links, joints and inertias are the same either way.
+pub fn panda_bucket_model() -> Result<&'static PandaModel, EnvError> {
+    static MODEL: OnceLock<Result<PandaModel, String>> = OnceLock::new();
+    MODEL
+        .get_or_init(|| load_panda_bucket_model().map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|e| EnvError::Asset(e.clone()))
+}
+
+fn load_panda_bucket_model() -> Result<PandaModel, EnvError> {
+    let mut desc = parse_urdf_str(
+        ms2_assets::PANDA_BUCKET_URDF,
+        std::path::Path::new("."),
+        "ms2-assets/robots/panda/panda_bucket.urdf",
+        &UrdfLoadOptions::default(),
+    )?;
+    let panda = panda_model()?;
+    if panda.is_real() {
+        for link in &mut desc.links {
+            let Some(real) = panda.desc.links.iter().find(|l| l.name == link.name) else {
+                continue;
+            };
+            link.visuals = real.visuals.clone();
+            if BUCKET_PANDA_REAL_COLLISION_LINKS.contains(&link.name.as_str()) {
+                link.collisions = real.collisions.clone();
+            }
+        }
+    }
+    Ok(PandaModel {
+        desc: Arc::new(desc),
+        source: panda.source.clone(),
+    })
+}
+
 /// The sources of the real Panda, in the order they are tried (for messages and docs).
 pub fn panda_sources() -> Vec<String> {
     ms2_assets::find_group(ms2_assets::FRANKA_DESCRIPTION)

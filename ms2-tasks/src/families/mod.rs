@@ -9,10 +9,12 @@
 //! | [`rigid`] | `PickCube-v0`, `LiftCube-v0`, `StackCube-v0` | — |
 //! | [`assembly`] | `PegInsertionSide-v0`, `PlugCharger-v0` | — |
 //! | [`soft`] | `Excavate-v0`, `Fill-v0` | `soft` |
+//! | [`misc`] | `PandaAvoidObstacles-v0` | — |
 //! | [`dummy`] | `Dummy-v0` (physics-free test env) | — |
 
 pub mod assembly;
 pub mod dummy;
+pub mod misc;
 pub mod rigid;
 #[cfg(feature = "soft")]
 pub mod soft;
@@ -25,5 +27,6 @@ pub(crate) fn register_builtin(r: &mut Registrar) {
     assembly::register(r);
     #[cfg(feature = "soft")]
     soft::register(r);
+    misc::register(r);
     dummy::register(r);
 }

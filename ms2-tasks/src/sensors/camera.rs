@@ -76,7 +76,64 @@ pub fn look_at_robotics(eye: [f32; 3], target: [f32; 3]) -> Pose3 {
     )
 }
 
+/// `cameras` with those named in `views` — `(uid, eye, target)`, metres, world frame — fixed
+/// in the world looking from `eye` at `target` (ManiSkill2's tasks place `base_camera` and
+/// `render_camera` this way); other cameras unchanged.
+///
+/// ```
+/// use ms2_tasks::sensors::{with_views, CameraConfig, CameraMount};
+/// let cams = with_views(CameraConfig::panda_defaults(), &[("base_camera", [0.0, -0.3, 0.2], [0.0, 0.0, 0.1])]);
+/// assert!(matches!(cams[0].mount, CameraMount::World { .. }));
+/// assert_eq!(cams[1], CameraConfig::hand_camera());
+/// ```
+pub fn with_views(
+    mut cameras: Vec<CameraConfig>,
+    views: &[(&str, [f32; 3], [f32; 3])],
+) -> Vec<CameraConfig> {
+    for cam in &mut cameras {
+        if let Some((_, eye, target)) = views.iter().find(|(uid, ..)| *uid == cam.uid) {
+            cam.mount = CameraMount::World {
+                pose_world_from_camera: look_at_robotics(*eye, *target),
+            };
+        }
+    }
+    cameras
+}
+
 impl CameraConfig {
+    /// A camera fixed in the world: `width`×`height` pixels, vertical field of view `fov_y`
+    /// (radians), clipping planes `near`..`far` (metres), at `pose_world_from_camera` (robotics
+    /// convention: x forward, y left, z up, as ManiSkill2's camera poses).
+    ///
+    /// ```
+    /// use ms2_tasks::sensors::{look_at_robotics, CameraConfig};
+    /// let cam = CameraConfig::in_world("base_camera", 128, 128, 1.57, 0.01, 10.0,
+    ///     look_at_robotics([0.3, 0.0, 0.6], [-0.1, 0.0, 0.1]));
+    /// assert!(cam.validate().is_ok());
+    /// ```
+    pub fn in_world(
+        uid: &str,
+        width: u32,
+        height: u32,
+        fov_y: f32,
+        near: f32,
+        far: f32,
+        pose_world_from_camera: Pose3,
+    ) -> CameraConfig {
+        CameraConfig {
+            uid: uid.to_owned(),
+            width,
+            height,
+            fov_y,
+            near,
+            far,
+            mount: CameraMount::World {
+                pose_world_from_camera,
+            },
+            segmentation: false,
+        }
+    }
+
     /// ManiSkill2's `base_camera`: 128×128, fov π/2, near 0.01, far 10, at (0.3, 0, 0.6) looking
     /// at (-0.1, 0, 0.1).
     pub fn base_camera() -> CameraConfig {
@@ -141,6 +198,65 @@ impl CameraConfig {
     /// The observation cameras of the Panda tasks: `base_camera`, `hand_camera`.
     pub fn panda_defaults() -> Vec<CameraConfig> {
         vec![Self::base_camera(), Self::hand_camera()]
+    }
+
+    /// The observation cameras of `xmate3_robotiq` (ManiSkill2's, mounted on the robot):
+    /// `base_camera` on `camera_base_link` (fixed in front of the robot, looking back down at
+    /// it) and `hand_camera` on `camera_hand_link` (the wrist), both 128×128, fov 1.5707,
+    /// near 0.01, far 10, at the link frame.
+    pub fn xmate3_defaults() -> Vec<CameraConfig> {
+        let on_link = |uid: &str, link: &str| CameraConfig {
+            uid: uid.to_owned(),
+            width: 128,
+            height: 128,
+            fov_y: 1.5707,
+            near: 0.01,
+            far: 10.0,
+            mount: CameraMount::RobotLink {
+                link: link.to_owned(),
+                pose_link_from_camera: Pose3::identity(),
+            },
+            segmentation: false,
+        };
+        vec![
+            on_link("base_camera", "camera_base_link"),
+            on_link("hand_camera", "camera_hand_link"),
+        ]
+    }
+
+    /// The human render camera of the `xmate3_robotiq` tasks: as [`Self::render_camera`] but
+    /// at (0.5, 0.5, 1.0) looking at (0, 0, 0.5) (ManiSkill2's, for the taller robot).
+    pub fn xmate3_render_camera() -> CameraConfig {
+        CameraConfig {
+            mount: CameraMount::World {
+                pose_world_from_camera: look_at_robotics([0.5, 0.5, 1.0], [0.0, 0.0, 0.5]),
+            },
+            ..Self::render_camera()
+        }
+    }
+
+    /// The observation cameras of `PandaAvoidObstacles-v0` (ManiSkill2's): `base_camera` at
+    /// (-0.25, 0, 1.2) looking at (0.6, 0, 0.6) (128×128, fov π/2), and the Panda's
+    /// `hand_camera`.
+    pub fn avoid_obstacles_defaults() -> Vec<CameraConfig> {
+        let base = CameraConfig {
+            mount: CameraMount::World {
+                pose_world_from_camera: look_at_robotics([-0.25, 0.0, 1.2], [0.6, 0.0, 0.6]),
+            },
+            ..Self::base_camera()
+        };
+        vec![base, Self::hand_camera()]
+    }
+
+    /// The human render camera of `PandaAvoidObstacles-v0`: at (1.5, 0, 1.5) looking at
+    /// (0, 0, 0.5), facing the robot over the wall.
+    pub fn avoid_obstacles_render_camera() -> CameraConfig {
+        CameraConfig {
+            mount: CameraMount::World {
+                pose_world_from_camera: look_at_robotics([1.5, 0.0, 1.5], [0.0, 0.0, 0.5]),
+            },
+            ..Self::render_camera()
+        }
     }
 
     /// Checks the size, field of view and clipping distances (the mount is checked when the

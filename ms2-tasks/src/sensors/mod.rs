@@ -25,7 +25,7 @@ pub mod visual_obs;
 
 #[cfg(feature = "render")]
 pub use batch::capture_batch;
-pub use camera::{look_at_robotics, CameraConfig, CameraMount};
+pub use camera::{look_at_robotics, with_views, CameraConfig, CameraMount};
 pub use camera_update::{CameraCfgUpdates, CameraUpdate, CAMERA_UPDATE_KEYS};
 #[cfg(feature = "render")]
 pub use sensor_scene::{SceneView, Sensors};

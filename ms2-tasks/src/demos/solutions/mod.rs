@@ -17,6 +17,7 @@
 //! ```
 
 pub mod driver;
+pub mod planning_geometry;
 pub mod scene;
 
 use std::sync::OnceLock;
@@ -93,11 +94,12 @@ pub fn solution_env_ids() -> Vec<&'static str> {
         .collect()
 }
 
-/// ms2's Panda for planning, built once.
-fn planning_panda() -> Result<&'static KinematicRobot, PlanError> {
+/// ms2's Panda for planning with the simulated Panda's collision shapes
+/// ([`planning_geometry`]), built once.
+pub fn planning_panda() -> Result<&'static KinematicRobot, PlanError> {
     static PANDA: OnceLock<Result<KinematicRobot, PlanError>> = OnceLock::new();
     PANDA
-        .get_or_init(KinematicRobot::panda)
+        .get_or_init(planning_geometry::planning_panda_for_simulated_robot)
         .as_ref()
         .map_err(Clone::clone)
 }

@@ -30,6 +30,7 @@ use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::{with_views, CameraConfig};
 use crate::task::{Task, TaskScene};
 
 /// Clearance (m) between the peg and each side of the hole.
@@ -209,20 +210,27 @@ fn yz_distance(goal: &Pose3, pose: &Pose3) -> f32 {
     (goal.inverse() * pose).translation.vector.yz().norm()
 }
 
+/// ManiSkill2's camera placements of this task, `(uid, eye, target)` (m, world).
+const CAMERA_VIEWS: [(&str, [f32; 3], [f32; 3]); 2] = [
+            ("base_camera", [0.0, -0.3, 0.2], [0.0, 0.0, 0.1]),
+            ("render_camera", [0.5, -0.5, 0.8], [0.05, -0.1, 0.4]),
+];
+
 impl Task for PegInsertionSide {
     fn max_dense_reward(&self) -> f64 {
         MAX_DENSE_REWARD
     }
 
-    fn reconfigure_every_reset(&self) -> bool {
+    fn rebuild_every_episode(&self) -> bool {
         true
     }
 
-    fn camera_views(&self) -> Vec<(&'static str, [f32; 3], [f32; 3])> {
-        vec![
-            ("base_camera", [0.0, -0.3, 0.2], [0.0, 0.0, 0.1]),
-            ("render_camera", [0.5, -0.5, 0.8], [0.05, -0.1, 0.4]),
-        ]
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        with_views(robot_cameras, &CAMERA_VIEWS)
+    }
+
+    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
+        with_views(vec![robot_default], &CAMERA_VIEWS).remove(0)
     }
 
     fn build_scene(

@@ -6,7 +6,7 @@
 //!   `[0.01, 0.05, 0.05]` (its frame at its front face, the plate behind it) with two slots cut
 //!   through it, each 0.5 mm wider than a prong on every side, built from five convex boxes
 //!   (the gold slot linings are drawn only).
-//! - Reset (the scene is rebuilt at every reset, see `reconfigure_every_reset`): charger on
+//! - Reset (the scene is rebuilt at every reset, see `rebuild_every_episode`): charger on
 //!   the ground at xy ~ U([−0.1, −0.2], [−0.026, 0.2]), yaw ~ U(−π/3, π/3);
 //!   receptacle at xy ~ U([0.01, −0.1], [0.1, 0.1]), z = 0.1, yaw π + U(−π/8, π/8).
 //! - Goal: the receptacle's frame turned by π about z (the charger's pose when plugged in).
@@ -27,6 +27,7 @@ use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::{with_views, CameraConfig};
 use crate::task::{Task, TaskScene};
 
 /// Half size (m) of the charger's base.
@@ -162,6 +163,12 @@ impl PlugCharger {
     }
 }
 
+/// ManiSkill2's camera placements of this task, `(uid, eye, target)` (m, world).
+const CAMERA_VIEWS: [(&str, [f32; 3], [f32; 3]); 2] = [
+            ("base_camera", [-0.3, 0.0, 0.1], [0.0, 0.0, 0.1]),
+            ("render_camera", [-0.3, -0.4, 0.2], [0.0, 0.0, 0.1]),
+];
+
 impl Task for PlugCharger {
     fn max_dense_reward(&self) -> f64 {
         MAX_DENSE_REWARD
@@ -171,7 +178,7 @@ impl Task for PlugCharger {
     /// leaves rapier's broad phase in a state that depends on earlier episodes (the first
     /// episode after a rebuild differs from later ones with the same seed by ~1e-8), and an
     /// episode must depend on its seed alone. A rebuild costs ~15 ms.
-    fn reconfigure_every_reset(&self) -> bool {
+    fn rebuild_every_episode(&self) -> bool {
         true
     }
 
@@ -182,11 +189,12 @@ impl Task for PlugCharger {
         }
     }
 
-    fn camera_views(&self) -> Vec<(&'static str, [f32; 3], [f32; 3])> {
-        vec![
-            ("base_camera", [-0.3, 0.0, 0.1], [0.0, 0.0, 0.1]),
-            ("render_camera", [-0.3, -0.4, 0.2], [0.0, 0.0, 0.1]),
-        ]
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        with_views(robot_cameras, &CAMERA_VIEWS)
+    }
+
+    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
+        with_views(vec![robot_default], &CAMERA_VIEWS).remove(0)
     }
 
     fn build_scene(

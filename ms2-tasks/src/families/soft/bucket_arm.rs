@@ -20,6 +20,7 @@ use crate::geometry::{vectorize_pose, Pose3};
 use crate::obs::{Array, ArrayData, DictBuilder, ObsValue};
 use crate::particles::ParticleVisual;
 use crate::rigid_world::RigidWorld;
+use crate::sensors::CameraConfig;
 use crate::soft::{SoftConfig, SoftWorld};
 use crate::task::{SoftComponent, TaskScene};
 
@@ -40,6 +41,43 @@ pub const CLAY_COLOR: [f32; 3] = [0.45, 0.2, 0.08];
 
 /// Name of the clay's segmentation object (channel-1 id) in visual observations.
 pub const CLAY_SEGMENTATION_NAME: &str = "clay";
+
+/// A world camera of the bucket tasks at `position` (m), pitched down by π/6 and turned by
+/// `yaw` (rad) about the vertical, as ManiSkill2 places them (near plane 1 mm).
+fn pitched_camera(uid: &str, size: u32, fov_y: f32, position: [f32; 3], yaw: f32) -> CameraConfig {
+    let pose = Pose3::from_parts(
+        Translation3::from(position),
+        UnitQuaternion::from_euler_angles(0.0, std::f32::consts::FRAC_PI_6, yaw),
+    );
+    CameraConfig::in_world(uid, size, size, fov_y, 0.001, 10.0, pose)
+}
+
+/// The robot's cameras with ManiSkill2's `base_camera` of a bucket task (128×128, fov π/2) at
+/// `base_position` (m) looking along +x, pitched down by π/6, in place of the robot's.
+pub fn bucket_task_cameras(
+    robot_cameras: Vec<CameraConfig>,
+    base_position: [f32; 3],
+) -> Vec<CameraConfig> {
+    let base = pitched_camera(
+        "base_camera",
+        128,
+        std::f32::consts::FRAC_PI_2,
+        base_position,
+        0.0,
+    );
+    let mut cameras: Vec<CameraConfig> = robot_cameras
+        .into_iter()
+        .filter(|c| c.uid != base.uid)
+        .collect();
+    cameras.insert(0, base);
+    cameras
+}
+
+/// ManiSkill2's `render()` camera of a bucket task: 512×512, fov 1 rad, at `position` (m),
+/// turned by `yaw` (rad) and pitched down by π/6.
+pub fn bucket_render_camera(position: [f32; 3], yaw: f32) -> CameraConfig {
+    pitched_camera("render_camera", 512, 1.0, position, yaw)
+}
 
 /// Pose of the bucket frame in the hand frame (`ms2_assets::PANDA_BUCKET_IN_HAND`).
 pub fn hand_from_bucket() -> Isometry3<f32> {

@@ -21,7 +21,7 @@
 use glam::Vec3;
 use rand::Rng;
 
-use super::bucket_arm::BucketArm;
+use super::bucket_arm::{bucket_render_camera, bucket_task_cameras, BucketArm};
 use super::excavate_scene::{
     excavate_soft_config, in_bucket_local, ExcavateBed, ExcavateEvaluation,
 };
@@ -32,6 +32,7 @@ use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::CameraConfig;
 use crate::task::{SoftComponent, Task, TaskScene};
 
 /// World position (m) of the soft grid's node (0, 0, 0): the bed's footprint is then centred
@@ -82,6 +83,16 @@ impl Excavate {
 impl Task for Excavate {
     fn max_dense_reward(&self) -> f64 {
         1.0
+    }
+
+    /// ManiSkill2's Excavate cameras: `base_camera` at (-0.2, 0, 0.4).
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        bucket_task_cameras(robot_cameras, [-0.2, 0.0, 0.4])
+    }
+
+    /// ManiSkill2's Excavate render camera: at (-0.35, 0, 0.4), looking along +x.
+    fn render_camera(&self, _robot_default: CameraConfig) -> CameraConfig {
+        bucket_render_camera([-0.35, 0.0, 0.4], 0.0)
     }
 
     fn build_scene(

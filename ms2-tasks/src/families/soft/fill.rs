@@ -20,7 +20,7 @@ use ms2_physics::{ActorDesc, ActorKind, BodyId, Pose3, ShapeDesc, ShapeSpec, Vis
 use nalgebra::Vector3;
 use rand::Rng;
 
-use super::bucket_arm::BucketArm;
+use super::bucket_arm::{bucket_render_camera, bucket_task_cameras, BucketArm};
 use super::excavate_scene::{BUCKET_INNER_HALF, BUCKET_WALL_HALF, MAX_SOFT_SPEED};
 use crate::adapters::mpm_rigid::pose_to_glam;
 use crate::config::EnvConfig;
@@ -29,6 +29,7 @@ use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::CameraConfig;
 use crate::soft::{SoftConfig, SoftSceneError, SoftWorld};
 use crate::task::{SoftComponent, Task, TaskScene};
 
@@ -156,6 +157,19 @@ fn beaker_shape() -> ShapeDesc {
 impl Task for Fill {
     fn max_dense_reward(&self) -> f64 {
         1.0
+    }
+
+    /// ManiSkill2's Fill cameras: `base_camera` at (-0.4, 0, 0.4).
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        bucket_task_cameras(robot_cameras, [-0.4, 0.0, 0.4])
+    }
+
+    /// ManiSkill2's Fill render camera: at (-0.5, -0.4, 0.6), turned by π/2 − π/5.
+    fn render_camera(&self, _robot_default: CameraConfig) -> CameraConfig {
+        bucket_render_camera(
+            [-0.5, -0.4, 0.6],
+            std::f32::consts::FRAC_PI_2 - std::f32::consts::PI / 5.0,
+        )
     }
 
     fn build_scene(
