@@ -112,16 +112,16 @@ fn the_same_seed_gives_the_same_episode_on_a_reused_solver() {
 
 #[test]
 fn bad_requests_are_typed_errors() {
-    assert_eq!(
-        solution_env_ids(),
-        vec![
-            "PickCube-v0",
-            "LiftCube-v0",
-            "StackCube-v0",
-            "PegInsertionSide-v0",
-            "PlugCharger-v0"
-        ]
-    );
+    let ids = solution_env_ids();
+    for id in [
+        "PickCube-v0",
+        "LiftCube-v0",
+        "StackCube-v0",
+        "PegInsertionSide-v0",
+        "PlugCharger-v0",
+    ] {
+        assert!(ids.contains(&id), "{id} has no solution: {ids:?}");
+    }
     match solve_episode(&EnvConfig::new("Dummy-v0"), 0) {
         Err(DemoError::NoSolution { env_id, valid }) => {
             assert_eq!(env_id, "Dummy-v0");

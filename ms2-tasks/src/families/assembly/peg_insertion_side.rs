@@ -212,8 +212,8 @@ fn yz_distance(goal: &Pose3, pose: &Pose3) -> f32 {
 
 /// ManiSkill2's camera placements of this task, `(uid, eye, target)` (m, world).
 const CAMERA_VIEWS: [(&str, [f32; 3], [f32; 3]); 2] = [
-            ("base_camera", [0.0, -0.3, 0.2], [0.0, 0.0, 0.1]),
-            ("render_camera", [0.5, -0.5, 0.8], [0.05, -0.1, 0.4]),
+    ("base_camera", [0.0, -0.3, 0.2], [0.0, 0.0, 0.1]),
+    ("render_camera", [0.5, -0.5, 0.8], [0.05, -0.1, 0.4]),
 ];
 
 impl Task for PegInsertionSide {

@@ -165,8 +165,8 @@ impl PlugCharger {
 
 /// ManiSkill2's camera placements of this task, `(uid, eye, target)` (m, world).
 const CAMERA_VIEWS: [(&str, [f32; 3], [f32; 3]); 2] = [
-            ("base_camera", [-0.3, 0.0, 0.1], [0.0, 0.0, 0.1]),
-            ("render_camera", [-0.3, -0.4, 0.2], [0.0, 0.0, 0.1]),
+    ("base_camera", [-0.3, 0.0, 0.1], [0.0, 0.0, 0.1]),
+    ("render_camera", [-0.3, -0.4, 0.2], [0.0, 0.0, 0.1]),
 ];
 
 impl Task for PlugCharger {
