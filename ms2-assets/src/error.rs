@@ -81,4 +81,42 @@ pub enum AssetError {
         /// Each place looked at and why it did not serve.
         tried: Vec<String>,
     },
+    /// A model database (`info_*.json`) is missing, unreadable or malformed.
+    #[error("model database {file}: {reason}")]
+    BadModelDb {
+        /// The json file.
+        file: PathBuf,
+        /// What is wrong (parse error, bad key, bad value).
+        reason: String,
+    },
+    /// A model id is not in the model database.
+    #[error("model id \"{id}\" is not in {file} ({count} models there, e.g. {examples:?})")]
+    UnknownModel {
+        /// The id asked for.
+        id: String,
+        /// The model database.
+        file: PathBuf,
+        /// How many models the database has.
+        count: usize,
+        /// A few ids that exist.
+        examples: Vec<String>,
+    },
+    /// A model's mesh file is missing or does not parse as a triangle mesh.
+    #[error("mesh {file} of model \"{id}\": {reason}")]
+    BadMesh {
+        /// The model id.
+        id: String,
+        /// The mesh file.
+        file: PathBuf,
+        /// What is wrong (missing, parse error, no triangles, non-finite vertex).
+        reason: String,
+    },
+    /// Generating a procedural object family failed.
+    #[error("generating the procedural object family \"{family}\" failed: {reason}")]
+    Generation {
+        /// The family's folder name.
+        family: String,
+        /// What went wrong.
+        reason: String,
+    },
 }

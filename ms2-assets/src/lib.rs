@@ -14,6 +14,7 @@
 
 pub mod error;
 pub mod group;
+pub mod objects;
 pub mod store;
 
 pub use error::AssetError;

@@ -195,3 +195,94 @@ pub fn mesh_collision_shape(
         }
     }
 }
+
+/// Largest number of vertices of a convex face that rapier's (parry's) contact generation uses:
+/// a face with more is reduced to its first 4 vertices, so a convex piece resting on such a
+/// face (a can's round bottom) is supported by a sliver of it and tips over.
+pub const CONTACT_FACE_VERTICES: usize = 4;
+
+/// Splits a convex piece (its points, m) whose hull has a face of more than
+/// [`CONTACT_FACE_VERTICES`] vertices into the (up to 8) octants about its centroid, so that
+/// every large face is shared by several pieces whose contact features together cover it. The
+/// union of the returned pieces is the original hull (same volume, same mass at one density).
+/// Pieces with small faces, or whose hull cannot be built, are returned unchanged.
+pub fn split_convex_for_contact(points: &[Point3<f32>]) -> Vec<Vec<Point3<f32>>> {
+    let pts: Vec<_> = points.iter().map(|p| vec_from_na(&p.coords)).collect();
+    let Some(poly) = parry3d::shape::ConvexPolyhedron::from_convex_hull(&pts) else {
+        return vec![points.to_vec()];
+    };
+    if poly
+        .faces()
+        .iter()
+        .all(|f| f.num_vertices_or_edges as usize <= CONTACT_FACE_VERTICES)
+    {
+        return vec![points.to_vec()];
+    }
+    let (hull_pts, tris) = parry3d::transformation::convex_hull(&pts);
+    let hull: Vec<Vector3<f32>> = hull_pts.iter().map(|v| vec_to_na(*v)).collect();
+    let centroid = hull.iter().sum::<Vector3<f32>>() / hull.len() as f32;
+    let mut out = Vec::new();
+    for octant in 0..8u32 {
+        let signs = Vector3::new(
+            if octant & 1 == 0 { 1.0 } else { -1.0 },
+            if octant & 2 == 0 { 1.0 } else { -1.0 },
+            if octant & 4 == 0 { 1.0 } else { -1.0 },
+        );
+        let mut piece = Vec::new();
+        for t in &tris {
+            let mut poly: Vec<Vector3<f32>> = t.iter().map(|&i| hull[i as usize]).collect();
+            for axis in 0..3 {
+                poly = clip_polygon(&poly, axis, centroid[axis], signs[axis]);
+            }
+            piece.extend(poly.into_iter().map(Point3::from));
+        }
+        if piece.len() >= 4 && spans_volume(&piece) {
+            out.push(piece);
+        }
+    }
+    if out.is_empty() {
+        vec![points.to_vec()]
+    } else {
+        out
+    }
+}
+
+/// Sutherland–Hodgman clip of a polygon to the half-space `sign · (p[axis] − at) ≥ 0`.
+fn clip_polygon(poly: &[Vector3<f32>], axis: usize, at: f32, sign: f32) -> Vec<Vector3<f32>> {
+    let side = |p: &Vector3<f32>| sign * (p[axis] - at);
+    let mut out = Vec::with_capacity(poly.len() + 2);
+    for (i, a) in poly.iter().enumerate() {
+        let b = &poly[(i + 1) % poly.len()];
+        let (da, db) = (side(a), side(b));
+        if da >= 0.0 {
+            out.push(*a);
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            let t = da / (da - db);
+            out.push(a + (b - a) * t);
+        }
+    }
+    out
+}
+
+/// Whether points span a volume (not all within 1e-7 m of a plane through three of them).
+fn spans_volume(points: &[Point3<f32>]) -> bool {
+    let a = points[0];
+    let Some(b) = points
+        .iter()
+        .max_by(|p, q| (*p - a).norm_squared().total_cmp(&(*q - a).norm_squared()))
+    else {
+        return false;
+    };
+    let ab = b - a;
+    let Some(c) = points.iter().max_by(|p, q| {
+        ab.cross(&(*p - a))
+            .norm()
+            .total_cmp(&ab.cross(&(*q - a)).norm())
+    }) else {
+        return false;
+    };
+    let n = ab.cross(&(c - a));
+    let len = n.norm();
+    len > 0.0 && points.iter().any(|p| (n.dot(&(p - a)) / len).abs() > 1e-7)
+}

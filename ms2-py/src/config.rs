@@ -12,7 +12,7 @@ use crate::cameras::camera_updates_from_py;
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
 /// (ManiSkill2's `state` obs mode, then [`EnvConfig::new`]'s: the task's control/reward mode, 500 Hz / 20 Hz, the task's
 /// episode limit, no render mode, the task's default robot and cameras, the soft-body task's MPM frequency).
-pub const ENV_KWARGS: [&str; 14] = [
+pub const ENV_KWARGS: [&str; 15] = [
     "obs_mode",
     "robot",
     "control_mode",
@@ -27,6 +27,7 @@ pub const ENV_KWARGS: [&str; 14] = [
     "render_camera_cfgs",
     "bg_name",
     "exact_restore",
+    "model_ids",
 ];
 
 /// The obs mode of an env made from Python without `obs_mode` (ManiSkill2's default).
@@ -74,6 +75,14 @@ fn extract_real(key: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
         )));
     }
     extract_kwarg(key, value, "a real number (Hz)")
+}
+
+/// ManiSkill2's `model_ids`: one id (a str) or a sequence of str.
+fn extract_model_ids(value: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+    if let Ok(one) = value.extract::<String>() {
+        return Ok(vec![one]);
+    }
+    extract_kwarg("model_ids", value, "a str or a list of str")
 }
 
 /// The config of env `env_id` made with `kwargs` (keys from [`ENV_KWARGS`]). An unknown key
@@ -145,6 +154,7 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                 cfg.exact_restore = value.extract()?;
             }
             "bg_name" => cfg.bg_name = Some(extract_kwarg(&key, &value, "a str")?),
+            "model_ids" => cfg.model_ids = Some(extract_model_ids(&value)?),
             other => {
                 return Err(PyTypeError::new_err(format!(
                     "unexpected keyword argument {other:?}; valid keywords: {ENV_KWARGS:?}"
@@ -171,5 +181,6 @@ pub fn config_to_py<'py>(py: Python<'py>, cfg: &EnvConfig) -> PyResult<Bound<'py
     dict.set_item("enable_shadow", cfg.enable_shadow)?;
     dict.set_item("bg_name", &cfg.bg_name)?;
     dict.set_item("exact_restore", cfg.exact_restore)?;
+    dict.set_item("model_ids", &cfg.model_ids)?;
     Ok(dict)
 }

@@ -23,9 +23,10 @@ pub(crate) trait EnvBackend: Send {
     fn action_space(&self) -> &BoxSpace;
     /// Largest dense reward (for `normalized_dense`).
     fn max_dense_reward(&self) -> f64;
-    /// Whether every episode starts with [`EnvBackend::reconfigure`] (per-episode scenes).
-    fn rebuild_every_episode(&self) -> bool {
-        false
+    /// Makes the episode's scene-level choices (the task's [`crate::task::Task::prepare_episode`]);
+    /// `true` when the scene must be rebuilt for them. Default: none.
+    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(false)
     }
     /// (Re)builds the scene.
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError>;

@@ -68,6 +68,11 @@ pub struct EnvConfig {
     /// exact, and a restore mid-episode into a fresh env drifts once objects touch (see
     /// docs/trajectory_format.md, "Restoring states").
     pub exact_restore: bool,
+    /// ManiSkill2's `model_ids` of the object-variation tasks (`PickSingleYCB-v0`,
+    /// `PickSingleEGAD-v0`, `PickClutterYCB-v0`): the model ids episodes draw from; `None` (or
+    /// empty) = every model of the task's info json. An id not in the json is an error naming
+    /// it; setting it on a task without object models is an error.
+    pub model_ids: Option<Vec<String>>,
 }
 
 impl Default for EnvConfig {
@@ -90,6 +95,7 @@ impl Default for EnvConfig {
             render_camera_updates: None,
             bg_name: None,
             exact_restore: false,
+            model_ids: None,
         }
     }
 }

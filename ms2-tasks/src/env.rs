@@ -145,6 +145,13 @@ impl Env {
                 cfg.env_id
             )));
         }
+        if let (Some(ids), false) = (&cfg.model_ids, spec.takes_model_ids()) {
+            return Err(EnvError::InvalidConfig(format!(
+                "model_ids {ids:?} apply only to envs with object model sets (families {:?}); {} has none",
+                crate::spec::MODEL_ID_FAMILIES,
+                cfg.env_id
+            )));
+        }
         let substeps = cfg.substeps()?;
         let backend: Box<dyn EnvBackend> = match registration.simulation {
             Simulation::Task(make) => {
@@ -260,7 +267,8 @@ impl Env {
     /// Seeds and samples a new episode; the info of its first state.
     fn start_episode(&mut self, seed: Option<u64>, reconfigure: bool) -> Result<Info, EnvError> {
         let mut rng = self.seeding.start_episode(seed);
-        if reconfigure || self.needs_rebuild || self.backend.rebuild_every_episode() {
+        let changed = self.backend.prepare_episode(&mut rng)?;
+        if reconfigure || changed || self.needs_rebuild {
             // A step that failed or went non-finite may have left the world broken: rebuild.
             self.backend.reconfigure(&mut rng)?;
             self.needs_rebuild = false;

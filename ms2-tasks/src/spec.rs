@@ -69,7 +69,15 @@ pub const RIGID_OBS_MODES: &[ObsMode] = &[
     ObsMode::PointCloudRobotSeg,
 ];
 
+/// Families whose tasks draw their objects from model sets and take `model_ids`.
+pub const MODEL_ID_FAMILIES: &[&str] = &["objects"];
+
 impl TaskSpec {
+    /// Whether the task takes the `model_ids` keyword ([`MODEL_ID_FAMILIES`]).
+    pub fn takes_model_ids(&self) -> bool {
+        MODEL_ID_FAMILIES.contains(&self.family)
+    }
+
     /// The default `robot=` uid.
     pub fn default_robot(&self) -> &'static str {
         self.robots.first().map_or("panda", |r| r.uid)

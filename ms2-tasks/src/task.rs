@@ -5,8 +5,8 @@
 //!
 //! | when | hook |
 //! |---|---|
-//! | make / `reset(reconfigure = true)` | [`Task::build_scene`] (add actors to the world) |
-//! | every reset, first, when [`Task::rebuild_every_episode`] | [`Task::build_scene`] on a fresh world, with the episode's RNG (per-episode layouts and geometry) |
+//! | every reset, first | [`Task::prepare_episode`] (per-episode scene choices, e.g. the object model or an obstacle layout; returns whether the scene must be rebuilt) |
+//! | make / `reset(reconfigure = true)` / a rebuild asked for | [`Task::build_scene`] on a fresh world, with the episode's RNG (add actors to the world) |
 //! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_agent`] (default: the robot's reset, rest qpos + noise), [`Task::initialize_task`] |
 //! | every observation | [`Task::extra_obs`] (the `extra` dict) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
@@ -50,6 +50,13 @@ pub trait Task: Any + Send {
     /// Largest value of [`Task::dense_reward`] (divides it in `normalized_dense` mode).
     fn max_dense_reward(&self) -> f64;
 
+    /// Makes the episode's scene-level choices (e.g. which object model, at which scale) before
+    /// the scene is (re)built; returns `true` when they differ from the current scene's, so
+    /// that the runtime rebuilds it ([`Task::build_scene`]). Default: no choices.
+    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(false)
+    }
+
     /// Adds the task's actors to a fresh world (which has the ground and the robot already).
     fn build_scene(
         &mut self,
@@ -74,14 +81,6 @@ pub trait Task: Any + Send {
     ) -> Result<(), EnvError> {
         let TaskScene { world, agent } = scene;
         agent.initialize(world.as_mut(), rng)
-    }
-
-    /// Whether every episode builds a fresh world ([`Task::build_scene`] with the episode's
-    /// RNG), for tasks whose actors or geometry differ per episode (ManiSkill2 reconfigures on
-    /// a new episode layout; PegInsertionSide draws its peg and hole per episode). Default:
-    /// `false` (the world is built at make and on `reconfigure`).
-    fn rebuild_every_episode(&self) -> bool {
-        false
     }
 
     /// The physics solver settings of the task's worlds, given ms2's defaults (a task whose

@@ -286,8 +286,8 @@ impl EnvBackend for TaskEnv {
         self.task.max_dense_reward()
     }
 
-    fn rebuild_every_episode(&self) -> bool {
-        self.task.rebuild_every_episode()
+    fn prepare_episode(&mut self, rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        self.task.prepare_episode(rng)
     }
 
     fn reconfigure(&mut self, rng: &mut EpisodeRng) -> Result<(), EnvError> {

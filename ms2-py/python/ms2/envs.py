@@ -146,6 +146,10 @@ class Ms2Env(gym.Env):
             env of the same build continues bit for bit like the recorded run; costs about
             20 % of the state step rate. Off by default (then a restore into the same env,
             or of an episode's first state, is still exact; see docs/trajectory_format.md).
+        model_ids: the object models episodes draw from in the object-variation tasks
+            (``PickSingleYCB-v0``, ``PickSingleEGAD-v0``), ManiSkill2's keyword: one id or a
+            list; ``None`` = every model of the task's info json. An unknown id raises
+            ``ValueError`` naming it; other tasks refuse the keyword.
 
     Unknown ids or modes raise ``ValueError`` listing the valid ones.
     """
@@ -169,6 +173,7 @@ class Ms2Env(gym.Env):
         render_camera_cfgs: dict[str, Any] | None = None,
         bg_name: str | None = None,
         exact_restore: bool = False,
+        model_ids: str | list[str] | None = None,
     ) -> None:
         _assets.register_installed_packages()
         self._native = _native.NativeEnv(
@@ -187,6 +192,7 @@ class Ms2Env(gym.Env):
             render_camera_cfgs=render_camera_cfgs,
             bg_name=bg_name,
             exact_restore=exact_restore,
+            model_ids=model_ids,
         )
         adopt_config(self, self._native.config())
         _assets.warn_if_primitive_panda()

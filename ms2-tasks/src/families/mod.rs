@@ -15,6 +15,7 @@
 pub mod assembly;
 pub mod dummy;
 pub mod misc;
+pub mod objects;
 pub mod rigid;
 #[cfg(feature = "soft")]
 pub mod soft;
@@ -25,6 +26,7 @@ use crate::registry::Registrar;
 pub(crate) fn register_builtin(r: &mut Registrar) {
     rigid::register(r);
     assembly::register(r);
+    objects::register(r);
     #[cfg(feature = "soft")]
     soft::register(r);
     misc::register(r);

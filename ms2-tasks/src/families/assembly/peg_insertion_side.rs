@@ -221,8 +221,8 @@ impl Task for PegInsertionSide {
         MAX_DENSE_REWARD
     }
 
-    fn rebuild_every_episode(&self) -> bool {
-        true
+    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(true)
     }
 
     fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {

@@ -6,7 +6,7 @@
 //!   `[0.01, 0.05, 0.05]` (its frame at its front face, the plate behind it) with two slots cut
 //!   through it, each 0.5 mm wider than a prong on every side, built from five convex boxes
 //!   (the gold slot linings are drawn only).
-//! - Reset (the scene is rebuilt at every reset, see `rebuild_every_episode`): charger on
+//! - Reset (the scene is rebuilt at every reset, see `prepare_episode`): charger on
 //!   the ground at xy ~ U([−0.1, −0.2], [−0.026, 0.2]), yaw ~ U(−π/3, π/3);
 //!   receptacle at xy ~ U([0.01, −0.1], [0.1, 0.1]), z = 0.1, yaw π + U(−π/8, π/8).
 //! - Goal: the receptacle's frame turned by π about z (the charger's pose when plugged in).
@@ -178,8 +178,8 @@ impl Task for PlugCharger {
     /// leaves rapier's broad phase in a state that depends on earlier episodes (the first
     /// episode after a rebuild differs from later ones with the same seed by ~1e-8), and an
     /// episode must depend on its seed alone. A rebuild costs ~15 ms.
-    fn rebuild_every_episode(&self) -> bool {
-        true
+    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(true)
     }
 
     fn solver_config(&self, defaults: SolverConfig) -> SolverConfig {

@@ -106,8 +106,8 @@ impl Task for AvoidObstacles {
         MAX_DENSE_REWARD
     }
 
-    fn rebuild_every_episode(&self) -> bool {
-        true
+    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(true)
     }
 
     /// Draws the episode's layout from `rng` and adds its wall and obstacles.
