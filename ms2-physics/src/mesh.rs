@@ -349,9 +349,12 @@ fn clip_polygon(poly: &[Vector3<f32>], axis: usize, at: f32, sign: f32) -> Vec<V
     out
 }
 
-/// Whether points span a volume (not all within 1e-7 m of a plane through three of them).
-fn spans_volume(points: &[Point3<f32>]) -> bool {
-    let a = points[0];
+/// Whether `points` (metres) span a volume: not all within 1e-7 m of a plane through three of
+/// them. Degenerate (flat, collinear or too few) point sets give `false`.
+pub fn spans_volume(points: &[Point3<f32>]) -> bool {
+    let Some(&a) = points.first() else {
+        return false;
+    };
     let Some(b) = points
         .iter()
         .max_by(|p, q| (*p - a).norm_squared().total_cmp(&(*q - a).norm_squared()))

@@ -360,7 +360,7 @@ impl ObjectModel {
             .map_err(mesh_err)?
             .iter()
             .map(|p| p.vertices.iter().map(scaled).collect::<Vec<_>>())
-            .filter(|v| has_volume(v))
+            .filter(|v| ms2_physics::mesh::spans_volume(v))
             .flat_map(|v| split_convex_for_contact(&v))
             .collect();
         if pieces.is_empty() {
@@ -421,27 +421,4 @@ impl ObjectModel {
     pub fn collision_points(&self) -> impl Iterator<Item = &Point3<f32>> {
         self.pieces.iter().flatten()
     }
-}
-
-/// Whether points span a volume (4 points not coplanar, up to 1e-9 m³).
-fn has_volume(points: &[Point3<f32>]) -> bool {
-    let Some(a) = points.first() else {
-        return false;
-    };
-    let Some(b) = points
-        .iter()
-        .max_by(|p, q| (*p - a).norm_squared().total_cmp(&(*q - a).norm_squared()))
-    else {
-        return false;
-    };
-    let ab = b - a;
-    let Some(c) = points.iter().max_by(|p, q| {
-        ab.cross(&(*p - a))
-            .norm()
-            .total_cmp(&ab.cross(&(*q - a)).norm())
-    }) else {
-        return false;
-    };
-    let n = ab.cross(&(c - a));
-    points.iter().any(|p| n.dot(&(p - a)).abs() > 1e-9)
 }
