@@ -4,7 +4,8 @@ errors rather than speed.
 Each (task, obs mode) pair gets a share of ``--steps`` env steps (default 1,000,000) in one env:
 random actions, resets when an episode ends (every tenth with ``reconfigure``), and with
 probability ``SET_STATE_PROBABILITY`` per step a ``set_state`` of a state recorded earlier in the
-run (any episode of that env). Shares are weighted by cost, so the rigid-body state modes take
+run in the env's current model (any episode since the last reconfigure: a state recorded on one
+asset, such as a faucet with two handles, is not a state of another). Shares are weighted by cost, so the rigid-body state modes take
 most steps and the rendering and soft-body pairs fewer (``WEIGHTS``); every pair runs at least
 ``MIN_STEPS``. Printed per pair and in total: steps, steps/s, resident memory (RSS) at the start
 and end, NaN/inf observations or rewards handed out (must be 0), and errors by type with the
@@ -112,7 +113,10 @@ def soak_pair(env_id: str, obs_mode: str, steps: int, seed: int) -> dict[str, An
                 pool[int(rng.integers(STATE_POOL))] = state
             if terminated or truncated:
                 resets += 1
-                env.reset(seed=int(rng.integers(2**32)), options={"reconfigure": resets % 10 == 0})
+                reconfigure = resets % 10 == 0
+                env.reset(seed=int(rng.integers(2**32)), options={"reconfigure": reconfigure})
+                if reconfigure:
+                    pool.clear()  # the recorded states belong to the model just replaced
         except (ValueError, TypeError, RuntimeError) as err:
             error(err)
             done_steps += 1
