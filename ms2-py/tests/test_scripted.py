@@ -15,8 +15,8 @@ MIN_SUCCESS_RATE = 0.8
 #: Tasks whose scripted policy is measured in another mode than the preferred one: the
 #: obstacle reach replays a joint-space plan (pd_ee_delta_pose: 23/30, docs/tasks.md).
 SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
-#: Known failures, documented in docs/tasks.md: PickSingleYCB-v0 (6/10 on seeds 0-9 since every reset
-#: rebuilds the scene: wide bowls, long tools; issue #16).
+#: Known failures, documented in docs/tasks.md: PickSingleYCB-v0 (6/10 on seeds 0-9 since
+#: every reset rebuilds the scene: wide bowls, long tools; issue #16).
 KNOWN_FAILING = {"PickSingleYCB-v0"}
 
 
