@@ -1,7 +1,7 @@
 //! Reading and writing articulation state: joint positions and velocities, drives, link poses.
 
 use nalgebra::{DVector, Vector3};
-use rapier3d::dynamics::{MotorModel, Multibody};
+use rapier3d::dynamics::{JointAxesMask, JointAxis, MotorModel, Multibody};
 
 use crate::articulation::{ArticulationId, DriveParams, JointInfo};
 use crate::error::{check_finite, check_len, check_pose_finite, PhysicsError, Result};
@@ -291,23 +291,20 @@ impl World {
             .get_multibody_mut(mbi)
             .expect("multibody");
         let data = &mut mb.link_mut(d.mb_link).expect("link").joint.data;
-        if let Some(m) = data.motor(d.axis) {
-            if m.stiffness == drive.stiffness
-                && m.damping == drive.damping
-                && m.max_force == drive.force_limit
-                && m.model == MotorModel::ForceBased
-            {
-                // Unchanged: not a configuration change, exact snapshots stay valid.
-                return Ok(());
-            }
+        let m = &mut data.motors[d.axis as usize];
+        if m.stiffness == drive.stiffness
+            && m.damping == drive.damping
+            && m.max_force == drive.force_limit
+            && m.model == MotorModel::ForceBased
+        {
+            // Unchanged: not a configuration change, exact snapshots stay valid.
+            return Ok(());
         }
-        let (pos, vel) = data
-            .motor(d.axis)
-            .map(|m| (m.target_pos, m.target_vel))
-            .unwrap_or((0.0, 0.0));
-        data.set_motor(d.axis, pos, vel, drive.stiffness, drive.damping);
-        data.set_motor_max_force(d.axis, drive.force_limit);
-        data.set_motor_model(d.axis, MotorModel::ForceBased);
+        m.stiffness = drive.stiffness;
+        m.damping = drive.damping;
+        m.max_force = drive.force_limit;
+        m.model = MotorModel::ForceBased;
+        enable_motor_if_driven(data, d.axis);
         self.generation += 1;
         Ok(())
     }
@@ -326,18 +323,12 @@ impl World {
         let d = *a.dofs.get(dof).ok_or_else(|| bad_dof(dof))?;
         let mb = self.multibody(art)?;
         let data = &mb.link(d.mb_link).expect("link").joint.data;
-        Ok(data
-            .motor(d.axis)
-            .map(|m| DriveParams {
-                stiffness: m.stiffness,
-                damping: m.damping,
-                force_limit: m.max_force,
-            })
-            .unwrap_or(DriveParams {
-                stiffness: 0.0,
-                damping: 0.0,
-                force_limit: f32::MAX,
-            }))
+        let m = &data.motors[d.axis as usize];
+        Ok(DriveParams {
+            stiffness: m.stiffness,
+            damping: m.damping,
+            force_limit: m.max_force,
+        })
     }
 
     /// Writes position or velocity targets of `dofs` (all dofs in order when `None`).
@@ -372,13 +363,13 @@ impl World {
         for (&i, &v) in indices.iter().zip(values) {
             let d = art_dofs[i];
             let data = &mut mb.link_mut(d.mb_link).expect("link").joint.data;
-            let m = data.motor(d.axis).copied().unwrap_or_default();
-            let (pos, vel) = if velocity {
-                (m.target_pos, v)
+            // Stored whether or not the drive is on (see `enable_motor_if_driven`).
+            let m = &mut data.motors[d.axis as usize];
+            if velocity {
+                m.target_vel = v;
             } else {
-                (v, m.target_vel)
-            };
-            data.set_motor(d.axis, pos, vel, m.stiffness, m.damping);
+                m.target_pos = v;
+            }
         }
         Ok(())
     }
@@ -429,10 +420,12 @@ impl World {
         Ok(a.dofs
             .iter()
             .map(|d| {
-                let data = &mb.link(d.mb_link).expect("link").joint.data;
-                data.motor(d.axis)
-                    .map(|m| if velocity { m.target_vel } else { m.target_pos })
-                    .unwrap_or(0.0)
+                let m = &mb.link(d.mb_link).expect("link").joint.data.motors[d.axis as usize];
+                if velocity {
+                    m.target_vel
+                } else {
+                    m.target_pos
+                }
             })
             .collect())
     }
@@ -445,6 +438,22 @@ impl World {
     /// The drives' velocity targets (dof order).
     pub fn drive_velocity_targets(&self, art: ArticulationId) -> Result<Vec<f32>> {
         self.read_targets(art, true)
+    }
+}
+
+/// Turns the rapier motor of `axis` on only if its drive has a stiffness or a damping.
+///
+/// The drive's gains and targets always live in `data.motors`; rapier solves a motor whose gains
+/// are both zero as a rigid velocity constraint (up to its force limit), which would lock an
+/// undriven joint (e.g. a faucet handle whose targets a state restore wrote), whereas a PD drive
+/// without gains exerts no force.
+fn enable_motor_if_driven(data: &mut rapier3d::dynamics::GenericJoint, axis: JointAxis) {
+    let m = &data.motors[axis as usize];
+    let bit = JointAxesMask::from(axis);
+    if m.stiffness != 0.0 || m.damping != 0.0 {
+        data.motor_axes |= bit;
+    } else {
+        data.motor_axes &= !bit;
     }
 }
 

@@ -15,10 +15,9 @@ MIN_SUCCESS_RATE = 0.8
 #: Tasks whose scripted policy is measured in another mode than the preferred one: the
 #: obstacle reach replays a joint-space plan (pd_ee_delta_pose: 23/30, docs/tasks.md).
 SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
-#: Known failures, documented in docs/tasks.md: TurnFaucet-v0 ("Known problem": the pushed
-#: handle barely turns; issue #18) and PickSingleYCB-v0 (6/10 on seeds 0-9 since every reset
-#: rebuilds the scene: wide bowls, long tools; issue #16).
-KNOWN_FAILING = {"TurnFaucet-v0", "PickSingleYCB-v0"}
+#: Known failures, documented in docs/tasks.md: PickSingleYCB-v0 (6/10 on seeds 0-9 since
+#: every reset rebuilds the scene: wide bowls, long tools; issue #16).
+KNOWN_FAILING = {"PickSingleYCB-v0"}
 
 
 def test_scripted_policy_success_rate(env_id):

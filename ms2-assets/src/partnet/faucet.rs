@@ -1,6 +1,7 @@
 //! Procedural faucets in the PartNet-Mobility layout: a base (plinth, column, spout) and one or
 //! two handles on revolute joints about the vertical axis (levers, knobs with a fin, cross
-//! handles), labelled `switch` like ManiSkill2's faucets.
+//! handles), labelled `switch` like ManiSkill2's faucets. Side handles turn away from the
+//! column (like hot and cold taps): the one at −y about +z, the one at +y about −z.
 //!
 //! [`FAUCET_VARIANTS`] models, deterministic (variant `i` is drawn from a ChaCha8 stream seeded
 //! with `i`), split into train (`i % 4 != 3`, 30 models) and test (`i % 4 == 3`, 10 models).
@@ -27,7 +28,7 @@ pub const FAUCET_VARIANTS: usize = 40;
 /// Category name of the faucets in info file names (`info_faucet_<split>.json`).
 pub const CATEGORY: &str = "faucet";
 /// Version of the generator; a change regenerates the models (it is part of the info files).
-pub const GENERATOR_VERSION: u32 = 2;
+pub const GENERATOR_VERSION: u32 = 3;
 
 /// Segments of the prisms that approximate cylinders.
 const SEGMENTS: usize = 16;
@@ -195,6 +196,17 @@ fn handle_pieces(h: &HandleParams) -> Vec<Piece> {
     }
 }
 
+/// The sign of a handle's joint axis along z: −1 for a side handle at +y, so that turning it
+/// (positive angles, its arm starting towards −x) swings the arm away from the column, whose
+/// direction from that handle is −y; +1 otherwise.
+fn turn_sign(h: &HandleParams) -> i32 {
+    if h.pivot[1] > 1e-9 {
+        -1
+    } else {
+        1
+    }
+}
+
 /// The URDF text of a faucet whose link meshes are `meshes/<link>.obj`.
 fn urdf_text(p: &FaucetParams) -> String {
     let mut u = String::new();
@@ -239,9 +251,13 @@ fn urdf_text(p: &FaucetParams) -> String {
         let _ = writeln!(
             u,
             "  <joint name=\"joint_{i}\" type=\"revolute\"><parent link=\"{body}\"/><child link=\"{name}\"/>\
-<origin xyz=\"{:.6} {:.6} {:.6}\" rpy=\"0 0 0\"/><axis xyz=\"0 0 1\"/>\
+<origin xyz=\"{:.6} {:.6} {:.6}\" rpy=\"0 0 0\"/><axis xyz=\"0 0 {}\"/>\
 <limit lower=\"0\" upper=\"{:.6}\" effort=\"10\" velocity=\"3\"/><dynamics damping=\"0.5\" friction=\"0.05\"/></joint>",
-            h.pivot[0], h.pivot[1], h.pivot[2], h.range
+            h.pivot[0],
+            h.pivot[1],
+            h.pivot[2],
+            turn_sign(h),
+            h.range
         );
     }
     let _ = writeln!(u, "</robot>");

@@ -175,6 +175,11 @@ impl<'e> JointTargetDriver<'e> {
         }
     }
 
+    /// Whether the task reported success at the last recorded step.
+    pub fn succeeded(&self) -> bool {
+        self.recorder.episode().success.last() == Some(&true)
+    }
+
     /// Largest distance (rad) of an arm joint from its target.
     pub fn tracking_error(&self) -> f64 {
         let Some(scene) = self.env.task_scene() else {

@@ -3,11 +3,14 @@
 //! [`model`] reads articulated models in ManiSkill2's PartNet-Mobility layout (ManiSkill2's
 //! models, or ms2's procedural ones from [`ms2_assets::partnet`]); [`common`] adds them to a
 //! world with the task's joint dynamics and samples link surfaces; each task is its hooks and
-//! spec; [`scripted`] is the family's oracle policy.
+//! spec; [`scripted`] is the family's oracle policy, [`solutions`] (feature `demos`) plays it
+//! in `pd_joint_pos` as the demonstration solution.
 
 pub mod common;
 pub mod model;
 pub mod scripted;
+#[cfg(feature = "demos")]
+pub mod solutions;
 pub mod turn_faucet;
 
 pub use turn_faucet::TurnFaucet;
@@ -38,8 +41,9 @@ pub const TURN_FAUCET: TaskSpec = TaskSpec {
 
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
-    r.add(
-        TaskRegistration::new(TURN_FAUCET, |_| Ok(Box::new(TurnFaucet::new()?)))
-            .scripted(scripted::policy),
-    );
+    let registration = TaskRegistration::new(TURN_FAUCET, |_| Ok(Box::new(TurnFaucet::new()?)))
+        .scripted(scripted::policy);
+    #[cfg(feature = "demos")]
+    let registration = registration.solution(&solutions::TURN_FAUCET);
+    r.add(registration);
 }
