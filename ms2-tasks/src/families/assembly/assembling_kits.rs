@@ -18,7 +18,7 @@
 
 use std::f32::consts::{PI, TAU};
 
-use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, VisualShape};
+use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, SolverConfig, VisualShape};
 use nalgebra::{UnitQuaternion, Vector2, Vector3};
 use rand::seq::SliceRandom;
 use rand::Rng;
@@ -56,6 +56,10 @@ pub const GOAL_HEIGHT: f32 = 0.003;
 pub const MAX_DENSE_REWARD: f64 = 10.0;
 /// Grasp angle (degrees) of the reward's grasp check.
 pub const REWARD_GRASP_ANGLE_DEG: f32 = 30.0;
+/// Contact prediction distance (m) of the task's worlds: below the clearance. With ms2's
+/// default (2 mm) a shape falling into its slot makes speculative contacts between its bottom
+/// edges and the slot's rim and comes to rest on the board.
+pub const PREDICTION_DISTANCE: f32 = 0.001;
 /// The Panda's widest finger opening (both fingers, m): the reward's release term divides by it.
 const GRIPPER_WIDTH: f64 = 0.08;
 
@@ -81,13 +85,43 @@ pub fn shapes() -> Vec<KitShape> {
         rgba: hex_rgba(hex),
     };
     vec![
-        shape("triangle", Outline::regular(3, 0.024, 0.0), TAU / 3.0, 0xD62728),
-        shape("square", Outline::rectangle(0.017, 0.017), TAU / 4.0, 0x1F77B4),
-        shape("pentagon", Outline::regular(5, 0.023, 0.0), TAU / 5.0, 0x2CA02C),
-        shape("hexagon", Outline::regular(6, 0.022, 0.0), TAU / 6.0, 0xFF7F0E),
-        shape("octagon", Outline::regular(8, 0.022, 0.0), TAU / 8.0, 0x9467BD),
+        shape(
+            "triangle",
+            Outline::regular(3, 0.024, 0.0),
+            TAU / 3.0,
+            0xD62728,
+        ),
+        shape(
+            "square",
+            Outline::rectangle(0.017, 0.017),
+            TAU / 4.0,
+            0x1F77B4,
+        ),
+        shape(
+            "pentagon",
+            Outline::regular(5, 0.023, 0.0),
+            TAU / 5.0,
+            0x2CA02C,
+        ),
+        shape(
+            "hexagon",
+            Outline::regular(6, 0.022, 0.0),
+            TAU / 6.0,
+            0xFF7F0E,
+        ),
+        shape(
+            "octagon",
+            Outline::regular(8, 0.022, 0.0),
+            TAU / 8.0,
+            0x9467BD,
+        ),
         shape("rectangle", Outline::rectangle(0.022, 0.012), PI, 0x8C564B),
-        shape("trapezoid", Outline::trapezoid(0.022, 0.011, 0.015), TAU, 0xE377C2),
+        shape(
+            "trapezoid",
+            Outline::trapezoid(0.022, 0.011, 0.015),
+            TAU,
+            0xE377C2,
+        ),
         shape("parallelogram", parallelogram(), PI, 0x17BECF),
     ]
 }
@@ -174,8 +208,14 @@ pub fn pose_yaw(pose: &Pose3) -> f32 {
     pose.rotation.euler_angles().2
 }
 
-/// A prism actor desc: `outline` extruded between `z0` and `z1`, colliding exactly where drawn.
-fn prism_desc(desc: ActorDesc, outline: &Outline, z0: f32, z1: f32, rgba: [f32; 4]) -> ActorDesc {
+/// A prism actor desc: `outline` extruded between `z0` and `z1` (m), colliding exactly where
+/// drawn (its convex hull and its closed triangle mesh have the same corners).
+fn prism_desc(
+    desc: ActorDesc,
+    outline: &Outline,
+    (z0, z1): (f32, f32),
+    rgba: [f32; 4],
+) -> ActorDesc {
     let (vertices, indices) = prism_mesh(outline, z0, z1);
     desc.with_shape(ShapeSpec::new(ShapeDesc::ConvexHull {
         points: prism_points(outline, z0, z1),
@@ -248,15 +288,27 @@ impl AssemblyParts for AssemblingKits {
     const CAMERA_VIEWS: &'static [CameraView] = &CAMERA_VIEWS;
     const HAND_TURNED: bool = false;
 
+    fn solver_config(defaults: SolverConfig) -> SolverConfig {
+        SolverConfig {
+            prediction_distance: PREDICTION_DISTANCE,
+            ..defaults
+        }
+    }
+
     fn build(&mut self, world: &mut dyn RigidWorld, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let kit = Kit::sample(rng);
         let shapes = shapes();
         let pieces = kit_shapes::carve_board(BOARD_HALF_SIZE, &kit.slot_outlines(&shapes))
             .map_err(|e| EnvError::InvalidConfig(format!("kit board: {e}")))?;
         let brown = [0.278, 0.209, 0.169, 1.0];
-        let mut board = ActorDesc::new("kit", ActorKind::Static);
+        // Built where it stays (the static board is never moved).
+        let mut board = ActorDesc::new("kit", ActorKind::Static).with_pose(Pose3::translation(
+            0.0,
+            0.0,
+            BOARD_HALF_HEIGHT,
+        ));
         for piece in &pieces {
-            board = prism_desc(board, piece, -BOARD_HALF_HEIGHT, BOARD_HALF_HEIGHT, brown);
+            board = prism_desc(board, piece, (-BOARD_HALF_HEIGHT, BOARD_HALF_HEIGHT), brown);
         }
         self.board = Some(world.add_actor(board)?);
         let mut bodies = Vec::with_capacity(SLOTS);
@@ -266,8 +318,7 @@ impl AssemblyParts for AssemblingKits {
             bodies.push(world.add_actor(prism_desc(
                 desc,
                 &shape.outline,
-                0.0,
-                SHAPE_HEIGHT,
+                (0.0, SHAPE_HEIGHT),
                 shape.rgba,
             ))?);
         }
@@ -280,8 +331,6 @@ impl AssemblyParts for AssemblingKits {
 
     fn place(&mut self, scene: &mut TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let world = scene.world.as_mut();
-        let board = self.board.expect("build ran before use");
-        world.set_body_pose(board, &Pose3::translation(0.0, 0.0, BOARD_HALF_HEIGHT))?;
         let kit = self.kit().clone();
         let mut others = self.others.iter();
         for i in (0..SLOTS).filter(|&i| i != kit.target) {
@@ -351,8 +400,7 @@ impl AssemblyParts for AssemblingKits {
         if grasped || well_positioned {
             // The object's z axis against world z: 1 when it lies flat.
             let up = (obj.rotation * Vector3::z()).z;
-            let rot_reward =
-                1.0 - f64::from(0.4 * yaw).tanh() + 1.0 - f64::from(1.0 - up).tanh();
+            let rot_reward = 1.0 - f64::from(0.4 * yaw).tanh() + 1.0 - f64::from(1.0 - up).tanh();
             reward += 2.0 + 1.0 - f64::from(4.0 * distance).tanh() + rot_reward;
             if well_positioned && rot_reward > 0.98 {
                 if grasped {
@@ -395,7 +443,30 @@ mod tests {
             let mut rng = EpisodeRng::seed_from_u64(seed);
             let kit = Kit::sample(&mut rng);
             let slots = kit.slot_outlines(&shapes);
-            kit_shapes::carve_board(BOARD_HALF_SIZE, &slots).unwrap();
+            let pieces = kit_shapes::carve_board(BOARD_HALF_SIZE, &slots).unwrap();
+            let board = 4.0 * BOARD_HALF_SIZE[0] * BOARD_HALF_SIZE[1];
+            let holes: f32 = slots.iter().map(kit_shapes::area).sum();
+            let carved: f32 = pieces.iter().map(kit_shapes::area).sum();
+            assert!(
+                (carved - (board - holes)).abs() < 1e-6,
+                "seed {seed}: {carved}"
+            );
+            // No piece reaches into a slot: the slot's centre and its vertices pulled 0.1 mm
+            // inward are free.
+            for slot in &slots {
+                let c = slot.vertices.iter().sum::<Vector2<f32>>() / slot.vertices.len() as f32;
+                for p in slot
+                    .vertices
+                    .iter()
+                    .map(|v| v + (c - v).normalize() * 1e-4)
+                    .chain([c])
+                {
+                    assert!(
+                        !pieces.iter().any(|piece| piece.contains(p, -1e-6)),
+                        "seed {seed}: {p:?} of a slot is covered"
+                    );
+                }
+            }
             for (i, slot) in slots.iter().enumerate() {
                 let shape = &shapes[kit.slot_shapes[i]].outline;
                 let placed = shape.placed(kit.slot_centers[i], kit.slot_yaws[i]);

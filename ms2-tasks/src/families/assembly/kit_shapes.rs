@@ -9,7 +9,11 @@ use nalgebra::{Point3, Vector2};
 
 /// Smallest extent (m) a carved piece must have along x to be kept (thinner slabs are gaps
 /// between coinciding vertices).
-const MIN_PIECE_WIDTH: f32 = 1e-5;
+const MIN_PIECE_WIDTH: f32 = 5e-4;
+
+/// A slot crossing a slab: its lower and upper boundary lines as their y (m) at the slab's two
+/// ends, and its lower y at the slab's middle (the order of slots across the slab).
+type SlabCrossing = ((f32, f32), (f32, f32), f32);
 
 /// A convex outline: counter-clockwise vertices (m) around the origin of its shape's frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -103,10 +107,13 @@ impl Outline {
             // For a convex polygon the narrowest width is across one of its edges.
             let e = self.vertices[(i + 1) % n] - self.vertices[i];
             let normal = Vector2::new(e.y, -e.x).normalize();
-            let (lo, hi) = self.vertices.iter().fold((f32::MAX, f32::MIN), |(lo, hi), v| {
-                let d = normal.dot(v);
-                (lo.min(d), hi.max(d))
-            });
+            let (lo, hi) = self
+                .vertices
+                .iter()
+                .fold((f32::MAX, f32::MIN), |(lo, hi), v| {
+                    let d = normal.dot(v);
+                    (lo.min(d), hi.max(d))
+                });
             if hi - lo < best.0 {
                 best = (hi - lo, normal.y.atan2(normal.x));
             }
@@ -151,7 +158,9 @@ impl Outline {
     fn x_range(&self) -> (f32, f32) {
         self.vertices
             .iter()
-            .fold((f32::MAX, f32::MIN), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)))
+            .fold((f32::MAX, f32::MIN), |(lo, hi), v| {
+                (lo.min(v.x), hi.max(v.x))
+            })
     }
 }
 
@@ -160,7 +169,12 @@ impl Outline {
 pub fn prism_points(outline: &Outline, z0: f32, z1: f32) -> Vec<Point3<f32>> {
     [z0, z1]
         .iter()
-        .flat_map(|&z| outline.vertices.iter().map(move |v| Point3::new(v.x, v.y, z)))
+        .flat_map(|&z| {
+            outline
+                .vertices
+                .iter()
+                .map(move |v| Point3::new(v.x, v.y, z))
+        })
         .collect()
 }
 
@@ -232,14 +246,16 @@ pub fn carve_board(half: [f32; 2], slots: &[Outline]) -> Result<Vec<Outline>, Ca
         let xm = 0.5 * (x0 + x1);
         // The slots crossing this slab, bottom to top, as (lower, upper) lines given by their
         // values at x0 and x1.
-        let mut crossing: Vec<((f32, f32), (f32, f32), f32)> = Vec::new();
+        let mut crossing: Vec<SlabCrossing> = Vec::new();
         for s in slots {
             let (lo, hi) = s.x_range();
             if xm <= lo || xm >= hi {
                 continue;
             }
-            let (Some(r0), Some(r1), Some(rm)) = (s.y_range_at(x0), s.y_range_at(x1), s.y_range_at(xm))
-            else {
+            // The slab's ends may lie a hair outside the slot's x range (merged cuts): its
+            // boundary lines are extended to them.
+            let at = |x: f32| s.y_range_at(x.clamp(lo, hi));
+            let (Some(r0), Some(r1), Some(rm)) = (at(x0), at(x1), at(xm)) else {
                 continue;
             };
             crossing.push(((r0.0, r1.0), (r0.1, r1.1), rm.0));
@@ -304,7 +320,11 @@ mod tests {
         let board = 4.0 * half[0] * half[1];
         let holes: f32 = slots.iter().map(area).sum();
         let carved: f32 = pieces.iter().map(area).sum();
-        assert!((carved - (board - holes)).abs() < 1e-6, "{carved} vs {}", board - holes);
+        assert!(
+            (carved - (board - holes)).abs() < 1e-6,
+            "{carved} vs {}",
+            board - holes
+        );
         // Sample points: every point is in exactly one of (a slot, a piece).
         let mut rng = 12345u32;
         let mut next = || {

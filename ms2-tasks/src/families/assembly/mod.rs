@@ -1,5 +1,5 @@
-//! Assembly with real clearances: `PegInsertionSide-v0`, `PlugCharger-v0`,
-//! `AssemblingKits-v0`.
+//! Assembly with real clearances: `PegInsertionSide-v0`, `PlugCharger-v0`, and
+//! `AssemblingKits-v0` (built and tested here, not registered yet: see [`register`]).
 //!
 //! [`common`] holds what the assembly tasks share (the task base [`AssemblyTask`] around each
 //! task's [`common::AssemblyParts`], box actors whose collision shapes are their visual shapes,
@@ -65,7 +65,7 @@ pub const PLUG_CHARGER: TaskSpec = assembly_spec(
     &["tcp_pose"],
 );
 
-/// `AssemblingKits-v0`'s spec.
+/// `AssemblingKits-v0`'s spec (not registered yet, see [`register`]).
 pub const ASSEMBLING_KITS: TaskSpec = assembly_spec(
     "AssemblingKits-v0",
     "put a shape into the slot carved for it in a kit board",
@@ -85,13 +85,11 @@ pub fn register(r: &mut Registrar) {
     let registration = TaskRegistration::new(PLUG_CHARGER, |_| {
         Ok(Box::<AssemblyTask<PlugCharger>>::default())
     })
-        .scripted(scripted::plug_charger_policy);
+    .scripted(scripted::plug_charger_policy);
     #[cfg(feature = "demos")]
     let registration = registration.solution(&solutions::PLUG_CHARGER);
     r.add(registration);
-
-    let registration = TaskRegistration::new(ASSEMBLING_KITS, |_| {
-        Ok(Box::<AssemblyTask<AssemblingKits>>::default())
-    });
-    r.add(registration);
+    // AssemblingKits-v0 (`AssemblyTask<AssemblingKits>`, spec `ASSEMBLING_KITS`) is not
+    // registered yet: its shapes do not drop into their carved slots in simulation (a known
+    // failure, docs/tasks.md), so the env could not be solved.
 }
