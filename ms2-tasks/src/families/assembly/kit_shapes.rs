@@ -9,7 +9,7 @@ use nalgebra::{Point3, Vector2};
 
 /// Smallest extent (m) a carved piece must have along x to be kept (thinner slabs are gaps
 /// between coinciding vertices).
-const MIN_PIECE_WIDTH: f32 = 5e-4;
+const MIN_PIECE_WIDTH: f32 = 1e-5;
 
 /// A slot crossing a slab: its lower and upper boundary lines as their y (m) at the slab's two
 /// ends, and its lower y at the slab's middle (the order of slots across the slab).
