@@ -18,7 +18,7 @@
 
 use std::f32::consts::{PI, TAU};
 
-use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, SolverConfig, VisualShape};
+use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, VisualShape};
 use nalgebra::{UnitQuaternion, Vector2, Vector3};
 use rand::seq::SliceRandom;
 use rand::Rng;
@@ -287,13 +287,7 @@ impl AssemblyParts for AssemblingKits {
     const MAX_DENSE_REWARD: f64 = MAX_DENSE_REWARD;
     const CAMERA_VIEWS: &'static [CameraView] = &CAMERA_VIEWS;
     const HAND_TURNED: bool = false;
-
-    fn solver_config(defaults: SolverConfig) -> SolverConfig {
-        SolverConfig {
-            prediction_distance: PREDICTION_DISTANCE,
-            ..defaults
-        }
-    }
+    const PREDICTION_DISTANCE: Option<f32> = Some(PREDICTION_DISTANCE);
 
     fn build(&mut self, world: &mut dyn RigidWorld, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let kit = Kit::sample(rng);

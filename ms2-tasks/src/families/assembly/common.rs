@@ -35,9 +35,20 @@ pub trait AssemblyParts: std::fmt::Debug + Clone + Default + Send + 'static {
     /// Whether the Panda starts with its hand turned ([`initialize_panda_hand_turned`]).
     const HAND_TURNED: bool;
 
-    /// The solver settings of the task's worlds, given ms2's defaults.
+    /// Contact prediction distance (m) of the task's worlds, when its clearance needs one
+    /// below ms2's default (speculative contacts across a narrower gap hold parts at its rim).
+    const PREDICTION_DISTANCE: Option<f32> = None;
+
+    /// The solver settings of the task's worlds, given ms2's defaults: the defaults with
+    /// [`AssemblyParts::PREDICTION_DISTANCE`].
     fn solver_config(defaults: SolverConfig) -> SolverConfig {
-        defaults
+        match Self::PREDICTION_DISTANCE {
+            Some(prediction_distance) => SolverConfig {
+                prediction_distance,
+                ..defaults
+            },
+            None => defaults,
+        }
     }
 
     /// Adds the parts to a fresh world (see [`Task::build_scene`]).

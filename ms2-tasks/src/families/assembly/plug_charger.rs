@@ -15,7 +15,7 @@
 //! - `extra`: tcp_pose, charger_pose, receptacle_pose, goal_pose (`state` = 53 floats). No task
 //!   state.
 
-use ms2_physics::{ActorKind, BodyId, SolverConfig};
+use ms2_physics::{ActorKind, BodyId};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rand::Rng;
 
@@ -174,13 +174,7 @@ impl AssemblyParts for PlugCharger {
     const MAX_DENSE_REWARD: f64 = MAX_DENSE_REWARD;
     const CAMERA_VIEWS: &'static [CameraView] = &CAMERA_VIEWS;
     const HAND_TURNED: bool = false;
-
-    fn solver_config(defaults: SolverConfig) -> SolverConfig {
-        SolverConfig {
-            prediction_distance: PREDICTION_DISTANCE,
-            ..defaults
-        }
-    }
+    const PREDICTION_DISTANCE: Option<f32> = Some(PREDICTION_DISTANCE);
 
     fn build(&mut self, world: &mut dyn RigidWorld, _rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let (charger, receptacle) = add_plug_and_socket(world)?;
