@@ -1,19 +1,171 @@
-//! What the assembly tasks share: boxes whose collision shape is exactly their visual shape,
-//! walls around a rectangular opening (a hole or a receptacle) built from convex boxes, the
-//! Panda's start posture with the hand turned, and the grasp-orientation measures of their
-//! rewards.
+//! What the assembly tasks share: the task base [`AssemblyTask`] (the hooks every assembly
+//! task implements alike, around a task's own [`AssemblyParts`]), boxes whose collision shape
+//! is exactly their visual shape, walls around a rectangular opening (a hole or a receptacle)
+//! built from convex boxes, the Panda's start posture with the hand turned, and the
+//! grasp-orientation measures of their rewards.
 //!
 //! Frames: an opening's frame has its x axis along the opening's axis (the insertion
 //! direction) and its origin at the opening's centre; lengths are in metres.
 
-use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, VisualShape};
+use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, SolverConfig, VisualShape};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::error::EnvError;
 use crate::geometry::Pose3;
+use crate::info::Evaluation;
+use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
-use crate::task::TaskScene;
+use crate::sensors::{with_views, CameraConfig};
+use crate::task::{Task, TaskScene};
+
+/// A camera placement `(uid, eye, target)` (m, world), as ManiSkill2's `look_at`.
+pub type CameraView = (&'static str, [f32; 3], [f32; 3]);
+
+/// What an assembly task has of its own; [`AssemblyTask`] adds the hooks they share. Every
+/// assembly task draws its scene anew at every reset (ManiSkill2's reconfigure per episode,
+/// or a static body moved between episodes, whose broad-phase state would otherwise depend on
+/// earlier episodes), places ManiSkill2's per-task cameras and gives its largest dense reward
+/// on success.
+pub trait AssemblyParts: std::fmt::Debug + Clone + Default + Send + 'static {
+    /// Largest dense reward, given on success.
+    const MAX_DENSE_REWARD: f64;
+    /// ManiSkill2's camera placements of the task (`base_camera`, `render_camera`).
+    const CAMERA_VIEWS: &'static [CameraView];
+    /// Whether the Panda starts with its hand turned ([`initialize_panda_hand_turned`]).
+    const HAND_TURNED: bool;
+
+    /// Contact prediction distance (m) of the task's worlds, when its clearance needs one
+    /// below ms2's default (speculative contacts across a narrower gap hold parts at its rim).
+    const PREDICTION_DISTANCE: Option<f32> = None;
+
+    /// The solver settings of the task's worlds, given ms2's defaults: the defaults with
+    /// [`AssemblyParts::PREDICTION_DISTANCE`].
+    fn solver_config(defaults: SolverConfig) -> SolverConfig {
+        match Self::PREDICTION_DISTANCE {
+            Some(prediction_distance) => SolverConfig {
+                prediction_distance,
+                ..defaults
+            },
+            None => defaults,
+        }
+    }
+
+    /// Adds the parts to a fresh world (see [`Task::build_scene`]).
+    fn build(&mut self, world: &mut dyn RigidWorld, rng: &mut EpisodeRng) -> Result<(), EnvError>;
+
+    /// Places the parts for an episode (see [`Task::initialize_actors`]).
+    fn place(&mut self, scene: &mut TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError>;
+
+    /// The task's `extra` observation entries.
+    fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder);
+
+    /// Success and evaluation terms.
+    fn evaluate(&self, scene: &TaskScene) -> Evaluation;
+
+    /// The dense reward of a state that is not a success (success gives
+    /// [`AssemblyParts::MAX_DENSE_REWARD`]).
+    fn unsolved_reward(&self, scene: &TaskScene) -> f64;
+
+    /// Task state appended to the simulation state. Default: none.
+    fn task_state(&self) -> Vec<f32> {
+        Vec::new()
+    }
+
+    /// Restores [`AssemblyParts::task_state`] (length already checked).
+    fn set_task_state(&mut self, _state: &[f32]) {}
+
+    /// Length of [`AssemblyParts::task_state`].
+    fn task_state_len(&self) -> usize {
+        0
+    }
+}
+
+/// An assembly task: its [`AssemblyParts`] plus the hooks all assembly tasks share.
+#[derive(Debug, Clone, Default)]
+pub struct AssemblyTask<P> {
+    /// The task's own parts and hooks.
+    pub parts: P,
+}
+
+impl<P: AssemblyParts> Task for AssemblyTask<P> {
+    fn max_dense_reward(&self) -> f64 {
+        P::MAX_DENSE_REWARD
+    }
+
+    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
+        Ok(true)
+    }
+
+    fn build_scene(
+        &mut self,
+        world: &mut dyn RigidWorld,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
+        self.parts.build(world, rng)
+    }
+
+    fn initialize_actors(
+        &mut self,
+        scene: &mut TaskScene,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
+        self.parts.place(scene, rng)
+    }
+
+    fn initialize_agent(
+        &mut self,
+        scene: &mut TaskScene,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
+        if P::HAND_TURNED {
+            initialize_panda_hand_turned(scene, rng)
+        } else {
+            let TaskScene { world, agent } = scene;
+            agent.initialize(world.as_mut(), rng)
+        }
+    }
+
+    fn solver_config(&self, defaults: SolverConfig) -> SolverConfig {
+        P::solver_config(defaults)
+    }
+
+    fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
+        self.parts.extra_obs(scene, extra);
+    }
+
+    fn evaluate(&self, scene: &TaskScene) -> Evaluation {
+        self.parts.evaluate(scene)
+    }
+
+    fn dense_reward(&self, scene: &TaskScene, eval: &Evaluation) -> f64 {
+        if eval.success {
+            P::MAX_DENSE_REWARD
+        } else {
+            self.parts.unsolved_reward(scene)
+        }
+    }
+
+    fn task_state(&self) -> Vec<f32> {
+        self.parts.task_state()
+    }
+
+    fn set_task_state(&mut self, state: &[f32]) {
+        self.parts.set_task_state(state);
+    }
+
+    fn task_state_len(&self) -> usize {
+        self.parts.task_state_len()
+    }
+
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        with_views(robot_cameras, P::CAMERA_VIEWS)
+    }
+
+    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
+        with_views(vec![robot_default], P::CAMERA_VIEWS).remove(0)
+    }
+}
 
 /// Index of the Panda's last arm joint (the hand's turn about its axis).
 const HAND_JOINT: usize = 6;

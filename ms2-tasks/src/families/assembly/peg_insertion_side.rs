@@ -20,8 +20,8 @@ use nalgebra::{Matrix3, Vector3};
 use rand::Rng;
 
 use super::common::{
-    add_box_actor, bar_grasp_rotation_distance, hex_rgba, initialize_panda_hand_turned,
-    walls_around_opening, BoxPart,
+    add_box_actor, bar_grasp_rotation_distance, hex_rgba, walls_around_opening, AssemblyParts,
+    BoxPart, CameraView,
 };
 use crate::error::EnvError;
 use crate::families::rigid::common::{body_pose, place_at_rest};
@@ -30,8 +30,7 @@ use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
-use crate::sensors::{with_views, CameraConfig};
-use crate::task::{Task, TaskScene};
+use crate::task::TaskScene;
 
 /// Clearance (m) between the peg and each side of the hole.
 pub const CLEARANCE: f32 = 0.003;
@@ -211,33 +210,17 @@ fn yz_distance(goal: &Pose3, pose: &Pose3) -> f32 {
 }
 
 /// ManiSkill2's camera placements of this task, `(uid, eye, target)` (m, world).
-const CAMERA_VIEWS: [(&str, [f32; 3], [f32; 3]); 2] = [
+const CAMERA_VIEWS: [CameraView; 2] = [
     ("base_camera", [0.0, -0.3, 0.2], [0.0, 0.0, 0.1]),
     ("render_camera", [0.5, -0.5, 0.8], [0.05, -0.1, 0.4]),
 ];
 
-impl Task for PegInsertionSide {
-    fn max_dense_reward(&self) -> f64 {
-        MAX_DENSE_REWARD
-    }
+impl AssemblyParts for PegInsertionSide {
+    const MAX_DENSE_REWARD: f64 = MAX_DENSE_REWARD;
+    const CAMERA_VIEWS: &'static [CameraView] = &CAMERA_VIEWS;
+    const HAND_TURNED: bool = true;
 
-    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
-        Ok(true)
-    }
-
-    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
-        with_views(robot_cameras, &CAMERA_VIEWS)
-    }
-
-    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
-        with_views(vec![robot_default], &CAMERA_VIEWS).remove(0)
-    }
-
-    fn build_scene(
-        &mut self,
-        world: &mut dyn RigidWorld,
-        rng: &mut EpisodeRng,
-    ) -> Result<(), EnvError> {
+    fn build(&mut self, world: &mut dyn RigidWorld, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let geometry = PegGeometry::sample(rng);
         let (peg, block) = geometry.add_to_world(world)?;
         self.peg = Some(peg);
@@ -246,11 +229,7 @@ impl Task for PegInsertionSide {
         Ok(())
     }
 
-    fn initialize_actors(
-        &mut self,
-        scene: &mut TaskScene,
-        rng: &mut EpisodeRng,
-    ) -> Result<(), EnvError> {
+    fn place(&mut self, scene: &mut TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         use std::f32::consts::{FRAC_PI_2, PI};
         let g = *self.geometry();
         let world = scene.world.as_mut();
@@ -267,14 +246,6 @@ impl Task for PegInsertionSide {
         let yaw = FRAC_PI_2 + rng.random_range(-PI / 8.0..PI / 8.0);
         world.set_body_pose(self.block(), &pose_xyz_yaw([x, y, g.length()], yaw))?;
         Ok(())
-    }
-
-    fn initialize_agent(
-        &mut self,
-        scene: &mut TaskScene,
-        rng: &mut EpisodeRng,
-    ) -> Result<(), EnvError> {
-        initialize_panda_hand_turned(scene, rng)
     }
 
     fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
@@ -302,10 +273,7 @@ impl Task for PegInsertionSide {
         }
     }
 
-    fn dense_reward(&self, scene: &TaskScene, eval: &Evaluation) -> f64 {
-        if eval.success {
-            return MAX_DENSE_REWARD;
-        }
+    fn unsolved_reward(&self, scene: &TaskScene) -> f64 {
         let world = scene.world.as_ref();
         let g = self.geometry();
         let tcp = scene.agent.tcp_pose(world);

@@ -15,11 +15,13 @@
 //! - `extra`: tcp_pose, charger_pose, receptacle_pose, goal_pose (`state` = 53 floats). No task
 //!   state.
 
-use ms2_physics::{ActorKind, BodyId, SolverConfig};
+use ms2_physics::{ActorKind, BodyId};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rand::Rng;
 
-use super::common::{add_box_actor, bar_grasp_rotation_distance, hex_rgba, BoxPart};
+use super::common::{
+    add_box_actor, bar_grasp_rotation_distance, hex_rgba, AssemblyParts, BoxPart, CameraView,
+};
 use crate::error::EnvError;
 use crate::families::rigid::common::{body_pose, place_at_rest};
 use crate::geometry::{pose_xyz_yaw, vectorize_pose, Pose3};
@@ -27,8 +29,7 @@ use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
-use crate::sensors::{with_views, CameraConfig};
-use crate::task::{Task, TaskScene};
+use crate::task::TaskScene;
 
 /// Half size (m) of the charger's base.
 pub const BASE_HALF_SIZE: [f32; 3] = [0.02, 0.015, 0.012];
@@ -164,55 +165,25 @@ impl PlugCharger {
 }
 
 /// ManiSkill2's camera placements of this task, `(uid, eye, target)` (m, world).
-const CAMERA_VIEWS: [(&str, [f32; 3], [f32; 3]); 2] = [
+const CAMERA_VIEWS: [CameraView; 2] = [
     ("base_camera", [-0.3, 0.0, 0.1], [0.0, 0.0, 0.1]),
     ("render_camera", [-0.3, -0.4, 0.2], [0.0, 0.0, 0.1]),
 ];
 
-impl Task for PlugCharger {
-    fn max_dense_reward(&self) -> f64 {
-        MAX_DENSE_REWARD
-    }
+impl AssemblyParts for PlugCharger {
+    const MAX_DENSE_REWARD: f64 = MAX_DENSE_REWARD;
+    const CAMERA_VIEWS: &'static [CameraView] = &CAMERA_VIEWS;
+    const HAND_TURNED: bool = false;
+    const PREDICTION_DISTANCE: Option<f32> = Some(PREDICTION_DISTANCE);
 
-    /// ManiSkill2 keeps the scene between resets; ms2 rebuilds it: moving the static receptacle
-    /// leaves rapier's broad phase in a state that depends on earlier episodes (the first
-    /// episode after a rebuild differs from later ones with the same seed by ~1e-8), and an
-    /// episode must depend on its seed alone. A rebuild costs ~15 ms.
-    fn prepare_episode(&mut self, _rng: &mut EpisodeRng) -> Result<bool, EnvError> {
-        Ok(true)
-    }
-
-    fn solver_config(&self, defaults: SolverConfig) -> SolverConfig {
-        SolverConfig {
-            prediction_distance: PREDICTION_DISTANCE,
-            ..defaults
-        }
-    }
-
-    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
-        with_views(robot_cameras, &CAMERA_VIEWS)
-    }
-
-    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
-        with_views(vec![robot_default], &CAMERA_VIEWS).remove(0)
-    }
-
-    fn build_scene(
-        &mut self,
-        world: &mut dyn RigidWorld,
-        _rng: &mut EpisodeRng,
-    ) -> Result<(), EnvError> {
+    fn build(&mut self, world: &mut dyn RigidWorld, _rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let (charger, receptacle) = add_plug_and_socket(world)?;
         self.charger = Some(charger);
         self.receptacle = Some(receptacle);
         Ok(())
     }
 
-    fn initialize_actors(
-        &mut self,
-        scene: &mut TaskScene,
-        rng: &mut EpisodeRng,
-    ) -> Result<(), EnvError> {
+    fn place(&mut self, scene: &mut TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         use std::f32::consts::PI;
         let world = scene.world.as_mut();
         let x = rng.random_range(-0.1..-0.01 - 2.0 * PRONG_HALF_SIZE[0]);
@@ -261,10 +232,7 @@ impl Task for PlugCharger {
         }
     }
 
-    fn dense_reward(&self, scene: &TaskScene, eval: &Evaluation) -> f64 {
-        if eval.success {
-            return MAX_DENSE_REWARD;
-        }
+    fn unsolved_reward(&self, scene: &TaskScene) -> f64 {
         let world = scene.world.as_ref();
         let tcp = scene.agent.tcp_pose(world);
         let charger = body_pose(world, self.charger());
