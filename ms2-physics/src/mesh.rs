@@ -312,7 +312,9 @@ pub fn split_convex_for_contact(points: &[Point3<f32>]) -> Vec<Vec<Point3<f32>>>
             if octant & 2 == 0 { 1.0 } else { -1.0 },
             if octant & 4 == 0 { 1.0 } else { -1.0 },
         );
-        let mut piece = Vec::new();
+        // The centroid is inside the hull and is the corner every octant piece shares: without
+        // it a piece is only the hull of its share of the surface, a corner short.
+        let mut piece = vec![Point3::from(centroid)];
         for t in &tris {
             let mut poly: Vec<Vector3<f32>> = t.iter().map(|&i| hull[i as usize]).collect();
             for axis in 0..3 {
@@ -320,7 +322,7 @@ pub fn split_convex_for_contact(points: &[Point3<f32>]) -> Vec<Vec<Point3<f32>>>
             }
             piece.extend(poly.into_iter().map(Point3::from));
         }
-        if piece.len() >= 4 && spans_volume(&piece) {
+        if piece.len() >= 5 && spans_volume(&piece) {
             out.push(piece);
         }
     }
