@@ -7,7 +7,8 @@
 //!   their json scales, dropped at separate spots of a 24 × 30 cm area (stacked when no free
 //!   spot is found) with random yaw, deterministic per seed.
 //! - Reset: objects placed at their episode poses with the robot out of the way and settled
-//!   (0.5 s, and up to 1 s more until still). The target is a random object; its start point
+//!   (0.5 s, and up to 1 s more until still, their velocities damped by 2 % per physics step so
+//!   nothing rolls away; then stopped and settled 0.2 s undamped). The target is a random object; its start point
 //!   `obj_start_pos` is one of the episode's representative points, or (procedural) a vertex of
 //!   its collision pieces on its top surface with no other object above it: a point a camera
 //!   looking down sees.
@@ -61,6 +62,11 @@ pub const CLUTTER_REST_QPOS: [f32; 9] = [
     0.04,
     0.04,
 ];
+/// Settling time (s) after every object was stopped at the end of the reset.
+pub const FINAL_SETTLE_TIME: f32 = 0.2;
+/// Fraction of their velocity the objects keep per physics step while the clutter settles
+/// (at 500 Hz, a damping rate of about 10 /s).
+pub const SETTLE_VELOCITY_KEEP: f32 = 0.98;
 /// Robot base position (m, world).
 pub const CLUTTER_BASE_X: f32 = -0.544;
 
@@ -181,6 +187,28 @@ pub fn generate_clutter(
         .collect()
 }
 
+/// Steps `world` for `seconds` (s), scaling the velocities of `bodies` by
+/// [`SETTLE_VELOCITY_KEEP`] every physics step: falling objects come to rest near where they
+/// land instead of rolling across the floor.
+fn settle_damped(world: &mut dyn RigidWorld, bodies: &[ms2_physics::BodyId], seconds: f32) {
+    let steps = (seconds / world.timestep()).round() as usize;
+    for _ in 0..steps {
+        for &b in bodies {
+            if let (Ok(v), Ok(w)) = (
+                world.body_linear_velocity(b),
+                world.body_angular_velocity(b),
+            ) {
+                let _ = world.set_body_velocity(
+                    b,
+                    &(v * SETTLE_VELOCITY_KEEP),
+                    &(w * SETTLE_VELOCITY_KEEP),
+                );
+            }
+        }
+        world.step();
+    }
+}
+
 /// The clutter task (see the [module docs](self)).
 #[derive(Debug, Clone)]
 pub struct PickClutter {
@@ -219,10 +247,15 @@ impl PickClutter {
         } else {
             None
         };
+        // The first scene is built before any reset chose an episode: seed 0's clutter.
+        let actors = match &episodes {
+            Some(eps) => eps[0].clone(),
+            None => generate_clutter(&set, &mut crate::seeding::episode_rng(0))?,
+        };
         Ok(Self {
             set,
             episodes,
-            actors: Vec::new(),
+            actors,
             objects: Vec::new(),
             target: 0,
             obj_start_pos: Vector3::zeros(),
@@ -374,6 +407,9 @@ impl Task for PickClutter {
         scene: &mut TaskScene,
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
+        if self.objects.is_empty() {
+            return Ok(());
+        }
         if self.actors.iter().any(|a| a.pose.is_none()) {
             self.drop_poses(rng);
         }
@@ -388,13 +424,18 @@ impl Task for PickClutter {
             world.set_body_velocity(object.body, &Vector3::zeros(), &Vector3::zeros())?;
         }
         let bodies: Vec<_> = self.objects.iter().map(|o| o.body).collect();
-        settle_body(world, bodies[0], SETTLE_TIME, false);
+        settle_damped(world, &bodies, SETTLE_TIME);
         for _ in 0..2 {
             if bodies.iter().all(|&b| is_actor_static(world, b)) {
                 break;
             }
-            settle_body(world, bodies[0], SETTLE_TIME, false);
+            settle_damped(world, &bodies, SETTLE_TIME);
         }
+        // Whatever still rolls is stopped and settles once more from rest.
+        for &b in &bodies {
+            world.set_body_velocity(b, &Vector3::zeros(), &Vector3::zeros())?;
+        }
+        settle_body(world, bodies[0], FINAL_SETTLE_TIME, false);
         self.target = rng.random_range(0..self.objects.len());
         self.obj_start_pos = self.choose_start_point(world, rng);
         Ok(())

@@ -64,16 +64,19 @@ pub struct ObjectPickSolution {
 
 /// Antipodal lines sampled per episode.
 const GRASP_SAMPLES: usize = 160;
-/// Widest object (m) between the contacts: the Panda opens 8 cm, minus 4 mm per side.
-const MAX_GRASP_WIDTH: f64 = 0.072;
+/// Widest object (m) between the contacts: the Panda opens 8 cm, minus 2.5 mm per side.
+const MAX_GRASP_WIDTH: f64 = 0.075;
 /// Friction cone half angle (rad) the contact normals must lie in.
-const CONE_ANGLE: f64 = 0.35;
+const CONE_ANGLE: f64 = 0.45;
 /// Grasp poses IK-checked per batch (the first batch with a reachable pose wins).
 const GRASP_BATCH: usize = 24;
 /// Most grasp poses tried.
 const MAX_GRASP_POSES: usize = 480;
 /// Pre-grasp distance (m) back along the approach.
 const PRE_GRASP_DISTANCE: f64 = 0.05;
+/// Height (m) above the ground of the lifted object's lowest point before it is carried (the
+/// carried object may not touch the ground in the planner).
+const LIFT_GROUND_CLEARANCE: f64 = 0.02;
 /// Height (m) the hand rises first when it starts touching an object.
 const START_CLEARANCE: f64 = 0.15;
 /// Height (m) the hand lifts the object straight up after closing.
@@ -82,6 +85,17 @@ const LIFT_HEIGHT: f64 = 0.06;
 const GOAL_TOLERANCE: f64 = 0.012;
 /// Distance (m) from the goal above which one corrective move is made after the carry.
 const CORRECTION_THRESHOLD: f64 = 0.008;
+/// Grasp attempts per episode (a missed grasp or a dropped object is grasped again).
+const PICK_ATTEMPTS: u64 = 3;
+/// Distance (m) from the goal beyond which a carried object counts as dropped.
+const DROPPED_DISTANCE: f64 = 0.08;
+/// Env steps the gripper is given to open after a missed grasp.
+const OPEN_STEPS: u32 = 6;
+/// Finger position (m) below which the closed gripper holds nothing.
+const EMPTY_FINGER: f64 = 0.001;
+/// Smallest finger opening (m) the planning robot is given (closed fingers touch each other,
+/// which the planner would count as a self-collision).
+const MIN_PLANNED_FINGER: f32 = 0.004;
 /// Env steps the gripper is given to close.
 const CLOSE_STEPS: u32 = 8;
 /// Arm tracking tolerance (rad) and most steps waited for it.
@@ -119,11 +133,26 @@ impl Solution for ObjectPickSolution {
             base_from_world: base_pose(driver.env())?.inverse(),
             sense: self.sense,
         };
-        let sensed = (self.sense)(driver.env())?;
-        run.pick(driver, &sensed, timings)?;
-        run.lift(driver, timings)?;
-        let goal = run.base_from_world * nalgebra::Point3::from(sensed.goal_world);
-        run.carry(driver, &goal.coords, timings)?;
+        for attempt in 0..PICK_ATTEMPTS {
+            let last = attempt + 1 == PICK_ATTEMPTS;
+            let sensed = (self.sense)(driver.env())?;
+            run.pick(driver, &sensed, attempt, timings)?;
+            run.lift(driver, timings)?;
+            if !last && !run.holds(driver.env(), &sensed)? {
+                // Missed or slipped: let go and grasp again from where the object lies now.
+                driver.hold(OPEN_STEPS, Gripper::Open)?;
+                continue;
+            }
+            let goal = run.base_from_world * nalgebra::Point3::from(sensed.goal_world);
+            run.carry(driver, &goal.coords, timings)?;
+            let now = (self.sense)(driver.env())?;
+            if !last && (now.target.com_world - sensed.goal_world).norm() > DROPPED_DISTANCE {
+                // Dropped on the way: start over from where it fell.
+                driver.hold(OPEN_STEPS, Gripper::Open)?;
+                continue;
+            }
+            break;
+        }
         driver.hold_until_success(SUCCESS_STEPS, Gripper::Closed)
     }
 }
@@ -191,6 +220,7 @@ impl Run<'_> {
         &self,
         driver: &mut JointTargetDriver<'_>,
         sensed: &ObjectScene,
+        attempt: u64,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
         let mut objects = vec![&sensed.target];
@@ -200,7 +230,9 @@ impl Run<'_> {
         let start = driver.arm_target().to_vec();
         let target = &sensed.target;
         let grasp = timings.time(|| {
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(self.seed);
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(
+                self.seed.wrapping_mul(31).wrapping_add(attempt),
+            );
             let lines = sample_antipodal(
                 &target.model.pieces,
                 GRASP_SAMPLES,
@@ -259,6 +291,13 @@ impl Run<'_> {
                     driver.arm_target(),
                     &grasp.grasp.pose_base_from_tcp,
                 )
+                .or_else(|_| {
+                    planner.plan_to_configuration(
+                        &approach_scene,
+                        driver.arm_target(),
+                        &grasp.configuration,
+                    )
+                })
                 .map_err(plan_error("descend"))
         })?;
         driver.follow(&descend.trajectory, Gripper::Open)?;
@@ -299,7 +338,11 @@ impl Run<'_> {
             .task_scene()
             .ok_or_else(|| SolveError::Sensing("the env has no robot".to_owned()))?;
         let qpos = scene.agent.qpos(scene.world.as_ref());
-        let finger = qpos.get(ARM_DOF).copied().unwrap_or(0.0).clamp(0.0, 0.04);
+        let finger = qpos
+            .get(ARM_DOF)
+            .copied()
+            .unwrap_or(0.0)
+            .clamp(MIN_PLANNED_FINGER, 0.04);
         let mut holding = self.panda.clone();
         holding
             .set_panda_finger_opening(f64::from(finger))
@@ -307,8 +350,26 @@ impl Run<'_> {
         Ok(holding)
     }
 
+    /// Whether the target rose with the hand after [`Run::lift`] (its centre of mass at least
+    /// half the lift above where `before` saw it) with something between the fingers.
+    fn holds(&self, env: &Env, before: &ObjectScene) -> Result<bool, SolveError> {
+        let now = (self.sense)(env)?;
+        let scene = env
+            .task_scene()
+            .ok_or_else(|| SolveError::Sensing("the env has no robot".to_owned()))?;
+        let finger = scene
+            .agent
+            .qpos(scene.world.as_ref())
+            .get(ARM_DOF)
+            .copied()
+            .unwrap_or(0.0);
+        let rose = now.target.com_world.z - before.target.com_world.z;
+        Ok(f64::from(finger) > EMPTY_FINGER && rose > 0.5 * LIFT_HEIGHT)
+    }
+
     /// Lifts the hand straight up by [`LIFT_HEIGHT`] (the held object rides along; the
-    /// ground is the only obstacle below).
+    /// ground is the only obstacle below), by less where that is out of reach, then more until
+    /// the object's lowest point is [`LIFT_GROUND_CLEARANCE`] above the ground.
     fn lift(
         &self,
         driver: &mut JointTargetDriver<'_>,
@@ -316,12 +377,33 @@ impl Run<'_> {
     ) -> Result<(), SolveError> {
         let holding = self.holding_robot(driver.env())?;
         let scene = self.scene(&[])?;
-        let start = driver.arm_target().to_vec();
-        let up = Translation3::new(0.0, 0.0, LIFT_HEIGHT) * holding.tcp_pose(&start);
         let mut planner = self.planner(&holding, 1)?;
-        let lift = timings
-            .time(|| move_to_pose(&mut planner, &scene, &start, &up).map_err(plan_error("lift")))?;
-        driver.follow(&lift.trajectory, Gripper::Closed)
+        let mut rise = |driver: &mut JointTargetDriver<'_>, height: f64| {
+            let start = driver.arm_target().to_vec();
+            let up = Translation3::new(0.0, 0.0, height) * holding.tcp_pose(&start);
+            match timings.time(|| move_to_pose(&mut planner, &scene, &start, &up)) {
+                Ok(motion) => driver
+                    .follow(&motion.trajectory, Gripper::Closed)
+                    .map(|()| true),
+                Err(_) => Ok(false),
+            }
+        };
+        for height in [LIFT_HEIGHT, 0.5 * LIFT_HEIGHT] {
+            if rise(driver, height)? {
+                break;
+            }
+        }
+        let sensed = (self.sense)(driver.env())?;
+        let lowest = sensed
+            .target
+            .model
+            .collision_points()
+            .map(|p| (sensed.target.pose_world_from_object * p.cast::<f64>()).z)
+            .fold(f64::INFINITY, f64::min);
+        if lowest < LIFT_GROUND_CLEARANCE {
+            rise(driver, LIFT_GROUND_CLEARANCE + 0.01 - lowest)?;
+        }
+        Ok(())
     }
 
     /// Carries the held object's centre of mass to `goal` (base frame): the object attached
