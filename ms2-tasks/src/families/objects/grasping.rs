@@ -294,7 +294,7 @@ mod tests {
         for g in &grasps {
             for side in [-0.5, 0.5] {
                 let contact = g.centre + g.closing * (side * g.width);
-                let outside = contact - g.closing * (side.signum() * 0.002);
+                let outside = contact + g.closing * (side.signum() * 0.002);
                 let p = Vector::new(outside.x as f32, outside.y as f32, outside.z as f32);
                 assert!(
                     !shape.contains_point(&ms2_plan::parry3d::math::Pose::IDENTITY, p),
