@@ -258,3 +258,20 @@ fn scripted_policy_picks_objects_to_their_goals() {
     let solved = (0..4).filter(|&s| solve(&mut env, s)).count();
     assert!(solved >= 3, "solved {solved}/4");
 }
+
+#[cfg(feature = "demos")]
+#[test]
+fn motion_planning_solutions_pick_objects_to_their_goals() {
+    use ms2_tasks::demos::solutions::DemoSolver;
+    fixture();
+    for id in ["PickSingleYCB-v0", "PickSingleEGAD-v0"] {
+        let mut solver = DemoSolver::new(&EnvConfig::new(id)).unwrap();
+        let mut solved = 0;
+        for seed in 0..5 {
+            let (episode, _) = solver.solve(seed).unwrap();
+            assert_eq!(episode.env_states.len(), episode.actions.len() + 1);
+            solved += usize::from(episode.success.last() == Some(&true));
+        }
+        assert!(solved >= 4, "{id}: solved {solved}/5");
+    }
+}

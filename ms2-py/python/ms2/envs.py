@@ -147,8 +147,9 @@ class Ms2Env(gym.Env):
             20 % of the state step rate. Off by default (then a restore into the same env,
             or of an episode's first state, is still exact; see docs/trajectory_format.md).
         model_ids: the object models episodes draw from in the object-variation tasks
-            (``PickSingleYCB-v0``, ``PickSingleEGAD-v0``), ManiSkill2's keyword: one id or a
-            list; ``None`` = every model of the task's info json. An unknown id raises
+            (``PickSingleYCB-v0``, ``PickSingleEGAD-v0``; ``PickClutterYCB-v0``'s procedural
+            clutters), ManiSkill2's keyword: one id or a list; ``None`` = every model of the
+            task's info json. An unknown id raises
             ``ValueError`` naming it; other tasks refuse the keyword.
 
     Unknown ids or modes raise ``ValueError`` listing the valid ones.

@@ -193,19 +193,42 @@ impl PickSingle {
             _ => -self.placed().model.collision_bounds().0.z,
         }
     }
+}
 
-    fn settle(world: &mut dyn RigidWorld, body: BodyId, seconds: f32, lock_tilt: bool) {
-        let steps = (seconds / world.timestep()).round() as usize;
-        for _ in 0..steps {
-            if lock_tilt {
-                if let Ok(w) = world.body_angular_velocity(body) {
-                    let v = world.body_linear_velocity(body).unwrap_or_default();
-                    let _ = world.set_body_velocity(body, &v, &Vector3::new(0.0, 0.0, w.z));
-                }
+/// Steps `world` for `seconds` (s); with `lock_tilt`, `body` may only turn about z.
+pub fn settle_body(world: &mut dyn RigidWorld, body: BodyId, seconds: f32, lock_tilt: bool) {
+    let steps = (seconds / world.timestep()).round() as usize;
+    for _ in 0..steps {
+        if lock_tilt {
+            if let Ok(w) = world.body_angular_velocity(body) {
+                let v = world.body_linear_velocity(body).unwrap_or_default();
+                let _ = world.set_body_velocity(body, &v, &Vector3::new(0.0, 0.0, w.z));
             }
-            world.step();
         }
+        world.step();
     }
+}
+
+/// ManiSkill2's pick dense reward short of success (max [`MAX_DENSE_REWARD`] on success):
+/// reaching `1 − tanh(3·max(|tcp − com| − bbox_diagonal, 0))` (tcp in the object's frame at
+/// `obj`), + 3 if grasped within `grasp_angle_deg`, + `3·(1 − tanh(3·|com − goal|))` if grasped.
+pub fn pick_dense_reward(
+    scene: &TaskScene,
+    body: BodyId,
+    obj: &Pose3,
+    bbox_diagonal: f32,
+    goal: &Vector3<f32>,
+    grasp_angle_deg: f32,
+) -> f64 {
+    let world = scene.world.as_ref();
+    let tcp = scene.agent.tcp_pose(world);
+    let tcp_to_obj = (obj.inverse() * tcp).translation.vector.norm();
+    let mut reward = closeness((tcp_to_obj - bbox_diagonal).max(0.0), 3.0);
+    if scene.agent.is_grasping(world, body, grasp_angle_deg) {
+        reward += 3.0;
+        reward += 3.0 * closeness((goal - obj.translation.vector).norm(), 3.0);
+    }
+    reward
 }
 
 /// Draws `ids[i]` with `i` uniform.
@@ -276,13 +299,13 @@ impl Task for PickSingle {
             scene.agent.articulation(),
             &Pose3::translation(-10.0, 0.0, 0.0),
         )?;
-        Self::settle(world, body, SETTLE_TIME, true);
+        settle_body(world, body, SETTLE_TIME, true);
         let settled = world.body_pose(body)?;
         world.set_body_pose(body, &settled)?;
         world.set_body_velocity(body, &Vector3::zeros(), &Vector3::zeros())?;
-        Self::settle(world, body, SETTLE_TIME, false);
+        settle_body(world, body, SETTLE_TIME, false);
         if !crate::families::rigid::common::is_actor_static(world, body) {
-            Self::settle(world, body, SETTLE_TIME, false);
+            settle_body(world, body, SETTLE_TIME, false);
         }
         Ok(())
     }
@@ -347,19 +370,14 @@ impl Task for PickSingle {
         if eval.success {
             return MAX_DENSE_REWARD;
         }
-        let world = scene.world.as_ref();
-        let obj = self.obj_pose(world);
-        let tcp = scene.agent.tcp_pose(world);
-        let tcp_to_obj = (obj.inverse() * tcp).translation.vector.norm();
-        let mut reward = closeness((tcp_to_obj - self.bbox_size().norm()).max(0.0), 3.0);
-        if scene
-            .agent
-            .is_grasping(world, self.body(), REWARD_GRASP_ANGLE_DEG)
-        {
-            reward += 3.0;
-            reward += 3.0 * closeness((self.goal_pos - obj.translation.vector).norm(), 3.0);
-        }
-        reward
+        pick_dense_reward(
+            scene,
+            self.body(),
+            &self.obj_pose(scene.world.as_ref()),
+            self.bbox_size().norm(),
+            &self.goal_pos,
+            REWARD_GRASP_ANGLE_DEG,
+        )
     }
 
     fn task_state(&self) -> Vec<f32> {

@@ -1,9 +1,11 @@
-//! The oracle policy of the single-object pick tasks: a top-down grasp chosen from the object's
+//! The oracle policy of the object pick tasks (PickSingle*, PickClutterYCB): a top-down grasp chosen from the object's
 //! collision vertices (yaw across the narrowest width of its top part, depth a few centimetres
 //! below its top), then a closed-loop carry of the object's centre of mass to the goal.
 
 use nalgebra::{Point3, Vector3};
 
+use super::model_db::ObjectModel;
+use super::pick_clutter::PickClutter;
 use super::pick_single::PickSingle;
 use crate::env::Env;
 use crate::error::EnvError;
@@ -21,6 +23,37 @@ pub fn policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
         steps: 0,
         grasp: None,
     }))
+}
+
+/// The object a policy moves: its body, model, centre of mass and goal (world, m), from a
+/// PickSingle or PickClutter task.
+struct TargetView<'a> {
+    body: ms2_physics::BodyId,
+    model: &'a ObjectModel,
+    com: Vector3<f32>,
+    goal: Vector3<f32>,
+}
+
+impl<'a> TargetView<'a> {
+    fn of(env: &'a Env) -> Option<Self> {
+        let world = env.task_scene()?.world.as_ref();
+        let task = env.task()?;
+        if let Some(t) = task.downcast_ref::<PickSingle>() {
+            return Some(Self {
+                body: t.body(),
+                model: t.placed_model(),
+                com: t.obj_pose(world).translation.vector,
+                goal: t.goal_pos,
+            });
+        }
+        let t = task.downcast_ref::<PickClutter>()?;
+        Some(Self {
+            body: t.target_object().body,
+            model: &t.target_object().model,
+            com: t.obj_pose(world).translation.vector,
+            goal: t.goal_pos,
+        })
+    }
 }
 
 /// Height (m) above the grasp point from which the TCP descends.
@@ -137,24 +170,21 @@ impl ScriptedPolicy for PickObjectPolicy {
 
     fn act(&mut self, env: &Env) -> Vec<f32> {
         let zero = vec![0.0; env.action_space().size()];
-        let (Some(scene), Some(task)) = (
-            env.task_scene(),
-            env.task().and_then(|t| t.downcast_ref::<PickSingle>()),
-        ) else {
+        let Some(scene) = env.task_scene() else {
+            return zero;
+        };
+        let Some(target) = TargetView::of(env) else {
             return zero;
         };
         let world = scene.world.as_ref();
         let tcp_pose = scene.agent.tcp_pose(world);
         let tcp = tcp_pose.translation.vector;
         let hand_yaw = tcp_yaw(&tcp_pose);
-        let com = task.obj_pose(world).translation.vector;
+        let com = target.com;
         let grasp = *self.grasp.get_or_insert_with(|| {
-            let pose = crate::families::rigid::common::body_pose(world, task.body());
-            let points: Vec<Point3<f32>> = task
-                .placed_model()
-                .collision_points()
-                .map(|p| pose * p)
-                .collect();
+            let pose = crate::families::rigid::common::body_pose(world, target.body);
+            let points: Vec<Point3<f32>> =
+                target.model.collision_points().map(|p| pose * p).collect();
             plan_grasp(&points, com, hand_yaw)
         });
         let grasp_point = com + grasp.com_to_tcp;
@@ -211,7 +241,7 @@ impl ScriptedPolicy for PickObjectPolicy {
                         GRIPPER_OPEN,
                     );
                 }
-                let goal = tcp + (task.goal_pos - com);
+                let goal = tcp + (target.goal - com);
                 (limited(&tcp, &goal), GRIPPER_CLOSED)
             }
         };

@@ -456,7 +456,7 @@ fn top_down_grasps(
 }
 
 /// Screw motion to `pose_base_from_tcp`, else RRT-Connect to a collision-free IK solution.
-fn move_to_pose(
+pub(crate) fn move_to_pose(
     planner: &mut MotionPlanner<'_, KinematicRobot>,
     scene: &CollisionScene,
     start: &[f64],
@@ -468,10 +468,10 @@ fn move_to_pose(
 }
 
 /// Height (m) of the Panda's shoulder (joint 2) above its base: the centre of its reach.
-const SHOULDER_HEIGHT: f64 = 0.333;
+pub(crate) const SHOULDER_HEIGHT: f64 = 0.333;
 /// Fractions of [`CubeTaskSolution::goal_tolerance`] by which the carried cube's target is
 /// moved toward the shoulder, tried in order with an upright hand (0 = the goal itself).
-const GOAL_SLACK_FRACTIONS: [f64; 4] = [0.0, 0.4, 0.7, 1.0];
+pub(crate) const GOAL_SLACK_FRACTIONS: [f64; 4] = [0.0, 0.4, 0.7, 1.0];
 
 /// Tilts (rad) of the carrying hand's approach axis away from the robot, tried in order when
 /// the cube's goal cannot be reached with the grasp orientation (high, far goals are reachable
@@ -481,7 +481,7 @@ const CARRY_TILTS: [f64; 5] = [0.0, 0.35, 0.7, 1.05, 1.4];
 /// `pose_base_from_tcp` turned about `pivot` (base frame, m) by each of [`CARRY_TILTS`] about
 /// the horizontal axis across the direction from the robot base to the pivot: the pivot (the
 /// carried cube's centre) stays put.
-fn tilted_about(
+pub(crate) fn tilted_about(
     pose_base_from_tcp: &Isometry3<f64>,
     pivot: &Vector3<f64>,
 ) -> impl Iterator<Item = Isometry3<f64>> {
@@ -526,7 +526,7 @@ fn scene_carrying(
 }
 
 /// Wraps a planner error with the phase it stopped.
-fn plan_error(phase: &'static str) -> impl Fn(PlanError) -> SolveError {
+pub(crate) fn plan_error(phase: &'static str) -> impl Fn(PlanError) -> SolveError {
     move |source| SolveError::Plan { phase, source }
 }
 

@@ -1,0 +1,331 @@
+//! Antipodal grasps of an object from its convex collision pieces, and the gripper poses that
+//! realise them.
+//!
+//! [`sample_antipodal`] draws points on the surface of the pieces (area-weighted), and for each
+//! looks along its normal for the two outermost surface points the closing fingers would touch
+//! (ray casts from outside the object on both sides). A line is kept when both contacts'
+//! normals lie within a friction cone of the closing direction and the object is narrower there
+//! than the open gripper. [`grasp_poses`] turns each line into TCP poses (closing axis along
+//! the line, approach axis across it, from above where possible), best first.
+//!
+//! Frames: the sampler works in the object's model frame (m); poses are in the robot base
+//! frame. The TCP convention is ms2-plan's: +z approaches, y closes.
+
+use ms2_plan::parry3d::math::Vector;
+use ms2_plan::parry3d::query::Ray;
+use ms2_plan::parry3d::shape::SharedShape;
+use ms2_plan::{GraspKind, GraspPose};
+use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use rand::Rng;
+
+/// An antipodal contact pair on an object (model frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AntipodalGrasp {
+    /// Midpoint of the two contacts (m, model frame).
+    pub centre: Vector3<f64>,
+    /// Unit direction from one contact to the other (the fingers close along it).
+    pub closing: Vector3<f64>,
+    /// Distance between the contacts (m).
+    pub width: f64,
+    /// Largest angle (rad) between a contact's inward normal and the closing line.
+    pub cone_angle: f64,
+}
+
+/// The object's collision pieces as one parry compound (model frame), `None` when no piece has
+/// a hull with volume.
+pub fn object_shape(pieces: &[Vec<Point3<f32>>]) -> Option<SharedShape> {
+    let parts: Vec<_> = pieces
+        .iter()
+        .filter_map(|piece| {
+            let pts: Vec<Vector> = piece.iter().map(|p| Vector::new(p.x, p.y, p.z)).collect();
+            SharedShape::convex_hull(&pts)
+                .map(|hull| (ms2_plan::parry3d::math::Pose::IDENTITY, hull))
+        })
+        .collect();
+    (!parts.is_empty()).then(|| SharedShape::compound(parts))
+}
+
+/// Surface triangles (model frame) of the pieces' hulls with their areas.
+fn hull_triangles(pieces: &[Vec<Point3<f32>>]) -> Vec<([Vector3<f64>; 3], f64)> {
+    let mut out = Vec::new();
+    for piece in pieces {
+        let pts: Vec<Vector> = piece.iter().map(|p| Vector::new(p.x, p.y, p.z)).collect();
+        let Some(hull) = SharedShape::convex_hull(&pts) else {
+            continue;
+        };
+        let Some(poly) = hull.as_convex_polyhedron() else {
+            continue;
+        };
+        let (vertices, indices) = poly.to_trimesh();
+        let v = |i: u32| {
+            let p = vertices[i as usize];
+            Vector3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z))
+        };
+        for [a, b, c] in indices {
+            let tri = [v(a), v(b), v(c)];
+            let area = 0.5 * (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).norm();
+            if area > 1e-10 {
+                out.push((tri, area));
+            }
+        }
+    }
+    out
+}
+
+/// Up to `count` antipodal grasps of the object made of `pieces`, from `3 · count` surface
+/// samples drawn with `rng`: contacts at most `max_width` (m) apart whose inward normals are
+/// within `cone_angle` (rad) of the closing line. Deterministic for a given `rng` state.
+pub fn sample_antipodal(
+    pieces: &[Vec<Point3<f32>>],
+    count: usize,
+    max_width: f64,
+    cone_angle: f64,
+    rng: &mut impl Rng,
+) -> Vec<AntipodalGrasp> {
+    let (Some(shape), triangles) = (object_shape(pieces), hull_triangles(pieces)) else {
+        return Vec::new();
+    };
+    let total: f64 = triangles.iter().map(|t| t.1).sum();
+    if triangles.is_empty() || total <= 0.0 {
+        return Vec::new();
+    }
+    let reach = (max_width + 0.05) as f32;
+    let to_parry = |v: &Vector3<f64>| Vector::new(v.x as f32, v.y as f32, v.z as f32);
+    let identity = ms2_plan::parry3d::math::Pose::IDENTITY;
+    // The outermost surface point along `dir` through `through`, seen from outside, and the
+    // outward normal there.
+    let outermost = |through: &Vector3<f64>, dir: &Vector3<f64>| {
+        let origin = to_parry(&(through - dir * f64::from(reach)));
+        if shape.contains_point(&identity, origin) {
+            return None;
+        }
+        let ray = Ray::new(origin, to_parry(dir));
+        let hit = shape.cast_ray_and_get_normal(&identity, &ray, 2.0 * reach, true)?;
+        let p = ray.point_at(hit.time_of_impact);
+        let n = Vector3::new(hit.normal.x, hit.normal.y, hit.normal.z).cast::<f64>();
+        Some((
+            Vector3::new(p.x, p.y, p.z).cast::<f64>(),
+            n.try_normalize(1e-9)?,
+        ))
+    };
+    let mut grasps = Vec::new();
+    for _ in 0..3 * count {
+        if grasps.len() >= count {
+            break;
+        }
+        let mut pick = rng.random_range(0.0..total);
+        let (tri, _) = triangles
+            .iter()
+            .find(|t| {
+                pick -= t.1;
+                pick <= 0.0
+            })
+            .unwrap_or(&triangles[triangles.len() - 1]);
+        let (mut u, mut v) = (rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        let point = tri[0] + (tri[1] - tri[0]) * u + (tri[2] - tri[0]) * v;
+        let Some(normal) = (tri[1] - tri[0])
+            .cross(&(tri[2] - tri[0]))
+            .try_normalize(1e-12)
+        else {
+            continue;
+        };
+        // Fingers close along −normal: one meets the surface on the normal's side, the
+        // other on the far side.
+        let closing = -normal;
+        let (Some((near, n_near)), Some((far, n_far))) =
+            (outermost(&point, &closing), outermost(&point, &-closing))
+        else {
+            continue;
+        };
+        let width = (far - near).dot(&closing);
+        if !(width > 1e-3 && width <= max_width) {
+            continue;
+        }
+        let angle =
+            |n: &Vector3<f64>, inward: &Vector3<f64>| (-n).dot(inward).clamp(-1.0, 1.0).acos();
+        let worst = angle(&n_near, &closing).max(angle(&n_far, &-closing));
+        if worst > cone_angle {
+            continue;
+        }
+        grasps.push(AntipodalGrasp {
+            centre: 0.5 * (near + far),
+            closing,
+            width,
+            cone_angle: worst,
+        });
+    }
+    grasps
+}
+
+/// How [`grasp_poses`] turns contact lines into hand poses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PoseOptions {
+    /// Turns (rad) of the approach axis about the closing line away from the most downward
+    /// approach, tried for every line.
+    pub approach_turns: &'static [f64],
+    /// How far (m) the TCP goes past the contact line along the approach, so the contacts sit
+    /// on the finger pads rather than at their tips.
+    pub pad_depth: f64,
+    /// Weight (1/m) of the contact line's horizontal distance from the centre of mass in the
+    /// score (rad-equivalent per metre).
+    pub com_weight: f64,
+}
+
+/// The default: upright first, then tilted up to a side grasp; contacts 1 cm up the pads.
+pub const DEFAULT_POSE_OPTIONS: PoseOptions = PoseOptions {
+    approach_turns: &[0.0, 0.35, -0.35, 0.7, -0.7, 1.05, -1.05, 1.4, -1.4],
+    pad_depth: 0.01,
+    com_weight: 8.0,
+};
+
+/// TCP poses (base frame) realising `grasps` on an object at `pose_base_from_object` whose
+/// centre of mass is `com_base`, best first: the approach closest to straight down, the line
+/// closest to the centre of mass, the hand turned least from `tcp_now`, the tightest cone.
+pub fn grasp_poses(
+    grasps: &[AntipodalGrasp],
+    pose_base_from_object: &Isometry3<f64>,
+    com_base: &Vector3<f64>,
+    tcp_now: &Isometry3<f64>,
+    options: &PoseOptions,
+) -> Vec<GraspPose> {
+    let down = -Vector3::z();
+    let mut scored: Vec<(f64, GraspPose)> = Vec::new();
+    for g in grasps {
+        let centre = pose_base_from_object * Point3::from(g.centre);
+        let line = pose_base_from_object.rotation * g.closing;
+        // The approach across the line closest to straight down.
+        let mut base_approach = down - line * down.dot(&line);
+        if base_approach.norm() < 1e-3 {
+            // A vertical line: approach horizontally, away from the robot base.
+            base_approach = Vector3::new(centre.x, centre.y, 0.0);
+            if base_approach.norm() < 1e-6 {
+                base_approach = Vector3::x();
+            }
+        }
+        let base_approach = base_approach.normalize();
+        let off_com = (centre.coords - com_base).xy().norm();
+        for &turn in options.approach_turns {
+            let approach =
+                UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_normalize(line), turn)
+                    * base_approach;
+            let tilt = approach.dot(&down).clamp(-1.0, 1.0).acos();
+            if tilt > 0.5 * std::f64::consts::PI + 1e-6 {
+                continue; // from below
+            }
+            for y in [line, -line] {
+                let x = y.cross(&approach);
+                let frame =
+                    Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[x, y, approach]));
+                let rotation = UnitQuaternion::from_rotation_matrix(&frame);
+                let position = centre.coords + approach * options.pad_depth;
+                let pose = Isometry3::from_parts(Translation3::from(position), rotation);
+                let turn_from_hand = rotation.angle_to(&tcp_now.rotation);
+                let score =
+                    tilt + options.com_weight * off_com + 0.3 * turn_from_hand + 0.5 * g.cone_angle;
+                let kind = if tilt < std::f64::consts::FRAC_PI_4 {
+                    GraspKind::TopDown
+                } else {
+                    GraspKind::Side
+                };
+                scored.push((
+                    score,
+                    GraspPose {
+                        pose_base_from_tcp: pose,
+                        kind,
+                        width: g.width,
+                    },
+                ));
+            }
+        }
+    }
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    scored.into_iter().map(|(_, g)| g).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    fn block(hx: f32, hy: f32, hz: f32) -> Vec<Point3<f32>> {
+        let mut v = Vec::new();
+        for sx in [-1.0, 1.0] {
+            for sy in [-1.0, 1.0] {
+                for sz in [-1.0, 1.0] {
+                    v.push(Point3::new(sx * hx, sy * hy, sz * hz));
+                }
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn a_box_is_grasped_across_its_narrow_sides_only() {
+        // 3 cm along x, 12 cm along y (too wide), 5 cm tall.
+        let pieces = vec![block(0.015, 0.06, 0.025)];
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let grasps = sample_antipodal(&pieces, 50, 0.072, 0.3, &mut rng);
+        assert!(grasps.len() >= 10, "{} grasps", grasps.len());
+        for g in &grasps {
+            let across_x = g.closing.x.abs() > 0.95 && (g.width - 0.03).abs() < 1e-3;
+            let across_z = g.closing.z.abs() > 0.95 && (g.width - 0.05).abs() < 1e-3;
+            assert!(across_x || across_z, "{g:?}");
+            assert!(g.centre.norm() < 0.07);
+        }
+    }
+
+    #[test]
+    fn an_l_shape_is_grasped_on_its_outermost_surfaces() {
+        // Two pieces: a 2 cm thick slab and a post on one end; a line through both must
+        // measure from outermost to outermost surface.
+        let slab = block(0.05, 0.01, 0.01);
+        let post: Vec<_> = block(0.01, 0.01, 0.04)
+            .into_iter()
+            .map(|p| p + Vector3::new(0.04, 0.0, 0.05))
+            .collect();
+        let pieces = vec![slab, post];
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let grasps = sample_antipodal(&pieces, 80, 0.072, 0.3, &mut rng);
+        assert!(!grasps.is_empty());
+        let shape = object_shape(&pieces).unwrap();
+        for g in &grasps {
+            for side in [-0.5, 0.5] {
+                let contact = g.centre + g.closing * (side * g.width);
+                let outside = contact + g.closing * (side.signum() * 0.002);
+                let p = Vector::new(outside.x as f32, outside.y as f32, outside.z as f32);
+                assert!(
+                    !shape.contains_point(&ms2_plan::parry3d::math::Pose::IDENTITY, p),
+                    "{g:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn poses_close_along_the_line_and_prefer_a_downward_approach() {
+        let grasp = AntipodalGrasp {
+            centre: Vector3::new(0.0, 0.0, 0.02),
+            closing: Vector3::x(),
+            width: 0.04,
+            cone_angle: 0.0,
+        };
+        let object = Isometry3::translation(0.5, 0.1, 0.0);
+        let hand = Isometry3::from_parts(
+            Translation3::new(0.4, 0.0, 0.3),
+            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI),
+        );
+        let com = Vector3::new(0.5, 0.1, 0.02);
+        let poses = grasp_poses(&[grasp], &object, &com, &hand, &DEFAULT_POSE_OPTIONS);
+        assert_eq!(poses.len(), 2 * DEFAULT_POSE_OPTIONS.approach_turns.len());
+        let best = poses[0].pose_base_from_tcp;
+        assert!((best.rotation * Vector3::z() - (-Vector3::z())).norm() < 1e-9);
+        assert!((best.rotation * Vector3::y()).x.abs() > 1.0 - 1e-9);
+        // TCP 1 cm below the contact line (past it along the approach).
+        assert!((best.translation.vector - Vector3::new(0.5, 0.1, 0.01)).norm() < 1e-9);
+        assert_eq!(poses[0].kind, GraspKind::TopDown);
+        assert_eq!(poses.last().unwrap().kind, GraspKind::Side);
+    }
+}
