@@ -218,13 +218,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let cabinets: Vec<(&str, usize)> = [0, 1, 2, 4, 5, 6]
         .iter()
         .map(|&i| (cabinet::DRAWER_CATEGORY, i))
-        .chain([0, 1, 2, 4, 5, 6].iter().map(|&i| (cabinet::DOOR_CATEGORY, i)))
+        .chain(
+            [0, 1, 2, 4, 5, 6]
+                .iter()
+                .map(|&i| (cabinet::DOOR_CATEGORY, i)),
+        )
         .collect();
-    articulated_sheet(&renderer, &cabinets, 1.25, &out.join("articulated_cabinets.png"))?;
+    articulated_sheet(
+        &renderer,
+        &cabinets,
+        1.25,
+        &out.join("articulated_cabinets.png"),
+    )?;
     let seats: Vec<(&str, usize)> = (0..8)
         .map(|i| (chair::CATEGORY, i))
         .chain((0..4).map(|i| (bucket::CATEGORY, i)))
         .collect();
-    articulated_sheet(&renderer, &seats, 0.8, &out.join("articulated_chairs_buckets.png"))?;
+    articulated_sheet(
+        &renderer,
+        &seats,
+        0.8,
+        &out.join("articulated_chairs_buckets.png"),
+    )?;
     Ok(())
 }

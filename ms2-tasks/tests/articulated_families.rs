@@ -182,9 +182,11 @@ fn a_drawer_slides_out_at_the_speed_its_damping_allows() {
         world.step();
     }
     assert!(world.qpos(art).unwrap()[dof].abs() < 1e-3);
-    // A 2 N pull towards −x (the front) for 1 s: steady speed (2 − 0.1) / 10 = 0.19 m/s.
+    // A 2 N pull towards −x (the front) for 1 s: the speed approaches (2 − 0.1) / 10 =
+    // 0.19 m/s with the time constant mass / damping.
     let pull = 2.0;
-    let steps = (1.0 / world.timestep()).round() as usize;
+    let seconds = 1.0;
+    let steps = (seconds / world.timestep()).round() as usize;
     for _ in 0..steps {
         world
             .apply_force(body, &Vector3::new(-pull, 0.0, 0.0))
@@ -192,10 +194,12 @@ fn a_drawer_slides_out_at_the_speed_its_damping_allows() {
         world.step();
     }
     let speed = world.qvel(art).unwrap()[dof];
-    let expected = (pull - friction) / damping;
+    let mass = world.body_mass(body).unwrap();
+    assert!((0.5..10.0).contains(&mass), "drawer mass {mass} kg");
+    let expected = (pull - friction) / damping * (1.0 - (-damping * seconds / mass).exp());
     assert!(
-        (speed - expected).abs() < 0.1 * expected,
-        "speed {speed}, expected {expected}"
+        (speed - expected).abs() < 0.05 * expected,
+        "speed {speed}, expected {expected} (mass {mass} kg)"
     );
     let q = world.qpos(art).unwrap()[dof];
     let moved = world.body_pose(body).unwrap().translation.vector - start;
@@ -204,11 +208,12 @@ fn a_drawer_slides_out_at_the_speed_its_damping_allows() {
         (moved.x + q).abs() < 2e-3 && moved.y.abs() < 1e-3 && moved.z.abs() < 1e-3,
         "the drawer slides along −x only: {moved:?} for q = {q}"
     );
-    // Let go: the damping stops it within its range.
-    world.step_n(steps);
+    // Let go: damping and friction stop it (after about 1.4 s) within its range.
+    world.step_n(2 * steps);
     let q_end = world.qpos(art).unwrap()[dof];
     let [_, hi] = joint_of(&desc, &drawer).limits.unwrap();
-    assert!(world.qvel(art).unwrap()[dof].abs() < 1e-3);
+    let v_end = world.qvel(art).unwrap()[dof];
+    assert!(v_end.abs() < 2e-3, "still moving at {v_end} m/s");
     assert!(q_end > q && q_end < hi + 1e-3, "{q_end} in (..{hi}]");
 }
 
@@ -243,11 +248,13 @@ fn a_door_swings_open_when_its_handle_is_pulled() {
     let handle = Point3::from(mean);
     let steps = (1.5 / world.timestep()).round() as usize;
     for _ in 0..steps {
-        // Pull the handle straight out of the door's face (the door's −x).
+        // Pull the handle (25 N) straight out of the door's face (the door's −x).
         let pose = world.body_pose(body).unwrap();
         let at = pose * handle;
         let out = pose.rotation * Vector3::new(-1.0, 0.0, 0.0);
-        world.apply_force_at_point(body, &(out * 8.0), &at).unwrap();
+        world
+            .apply_force_at_point(body, &(out * 25.0), &at)
+            .unwrap();
         world.step();
     }
     let q = world.qpos(art).unwrap()[dof];
@@ -282,8 +289,8 @@ fn a_chair_seat_swivels_and_a_bucket_handle_falls_over() {
     }
     let speed = world.qvel(art).unwrap()[dof];
     assert!((speed - 0.19).abs() < 0.02, "seat speed {speed} rad/s");
-    // The bucket handle, let go upright with a nudge, falls to its limit and stays clear of
-    // the body (its links never overlap: the limit stops it, not a collision).
+    // The bucket handle: its dry friction holds it upright; pushed past 0.5 rad and let go, it
+    // falls to its limit beside the body (the limit stops it, not a collision with the body).
     let buckets = ModelSet::open(dir.path(), "bucket", &split("train")).unwrap();
     let id = buckets.ids()[0].to_owned();
     let desc = buckets.load(&id).unwrap();
@@ -292,9 +299,11 @@ fn a_chair_seat_swivels_and_a_bucket_handle_falls_over() {
         .link_body(art, world.link_index(art, "link_0").unwrap())
         .unwrap();
     let dof = world.dof_index(art, "joint_0").unwrap();
-    for _ in 0..10 {
+    world.step_n(100);
+    assert!(world.qpos(art).unwrap()[dof].abs() < 1e-3, "held upright");
+    while world.qpos(art).unwrap()[dof] < 0.5 {
         world
-            .apply_torque(handle, &Vector3::new(0.0, 0.05, 0.0))
+            .apply_torque(handle, &Vector3::new(0.0, 0.2, 0.0))
             .unwrap();
         world.step();
     }

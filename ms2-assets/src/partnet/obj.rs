@@ -1,5 +1,5 @@
-//! Convex pieces (boxes, prisms) and their Wavefront OBJ text: one `o` object per piece, so a
-//! loader can take one convex hull per object.
+//! Convex pieces (boxes, prisms) and their Wavefront OBJ text: one `o` object and `g` group per
+//! piece, so a loader can take one convex hull per piece.
 
 use std::fmt::Write;
 
@@ -121,7 +121,10 @@ pub(crate) fn to_obj(pieces: &[Piece], header: &str) -> String {
     let mut out = format!("# {header}\n");
     let mut base = 1;
     for (i, p) in pieces.iter().enumerate() {
+        // `o` and `g` both: loaders split on one or the other, and pieces that touch (share a
+        // corner position) stay separate hulls.
         let _ = writeln!(out, "o part_{i}");
+        let _ = writeln!(out, "g part_{i}");
         for v in &p.vertices {
             let _ = writeln!(out, "v {:.6} {:.6} {:.6}", v[0], v[1], v[2]);
         }
