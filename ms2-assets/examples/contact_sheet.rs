@@ -128,8 +128,8 @@ fn sheet(
     render_grid(renderer, &models, spacing, out)
 }
 
-/// A sheet of procedural articulated models (`(category, index)`), at rest, fronts (−x)
-/// turned towards the camera.
+/// A sheet of procedural articulated models (`(category, index)`), at rest, fronts turned
+/// towards the camera (cabinets face −x, chairs +x).
 fn articulated_sheet(
     renderer: &Renderer,
     picks: &[(&str, usize)],
@@ -152,7 +152,11 @@ fn articulated_sheet(
             .collect();
         models.push(SheetModel {
             parts,
-            yaw: std::f32::consts::FRAC_PI_2,
+            yaw: if *category == ms2_assets::partnet::chair::CATEGORY {
+                -std::f32::consts::FRAC_PI_2
+            } else {
+                std::f32::consts::FRAC_PI_2
+            },
             lift: 0.0,
         });
     }

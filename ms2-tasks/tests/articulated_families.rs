@@ -38,6 +38,7 @@ fn cabinets_load_with_drawers_doors_and_handles() {
             (30, 10),
             "{category}"
         );
+        let mut masses = (f32::INFINITY, 0.0_f32);
         for set in [&train, &test] {
             for id in set.ids() {
                 let info = set.info(id).unwrap();
@@ -68,6 +69,7 @@ fn cabinets_load_with_drawers_doors_and_handles() {
                     assert!(j.damping > 0.0 && j.friction > 0.0, "{id}/{link}");
                     let m = mass_of(&desc, link);
                     assert!((0.3..25.0).contains(&m), "{id}/{link}: {m} kg");
+                    masses = (masses.0.min(m), masses.1.max(m));
                     // The handle is a named visual of the moving link (what ManiSkill2's
                     // cabinet tasks look for) and a collision shape the gripper touches.
                     let block = &urdf[urdf.find(&format!("<link name=\"{link}\">")).unwrap()..];
@@ -83,6 +85,10 @@ fn cabinets_load_with_drawers_doors_and_handles() {
                 assert!(bbox.min[2].abs() < 1e-6, "{id}: bottom at z = 0");
             }
         }
+        eprintln!(
+            "{category}: {label} masses {:.2}..{:.2} kg",
+            masses.0, masses.1
+        );
     }
 }
 
@@ -116,6 +122,7 @@ fn chairs_and_buckets_load_with_their_semantics() {
         assert_eq!(info.initial_qpos.as_ref().unwrap().len(), dof, "{id}");
         let total: f32 = desc.links.iter().map(|l| mass_of(&desc, &l.name)).sum();
         assert!((3.0..12.0).contains(&total), "{id}: {total} kg");
+        eprintln!("{id}: {total:.2} kg");
     }
     let buckets = ModelSet::open(dir.path(), "bucket", &split("train")).unwrap();
     assert_eq!(buckets.ids().len(), 30);
@@ -139,6 +146,9 @@ fn chairs_and_buckets_load_with_their_semantics() {
         // A ball of 5 cm radius (MoveBucket's) fits inside.
         let bbox = info.bbox.as_ref().unwrap();
         assert!(bbox.max[0] - bbox.min[0] > 0.2, "{id}");
+        let total: f32 = desc.links.iter().map(|l| mass_of(&desc, &l.name)).sum();
+        assert!((0.5..5.0).contains(&total), "{id}: {total} kg");
+        eprintln!("{id}: {total:.2} kg");
     }
 }
 

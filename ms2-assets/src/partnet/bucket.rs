@@ -32,7 +32,7 @@ pub const BUCKET_VARIANTS: usize = 40;
 /// Category name (`info_bucket_<split>.json`).
 pub const CATEGORY: &str = "bucket";
 /// Version of the generator; a change regenerates the models.
-pub const GENERATOR_VERSION: u32 = 1;
+pub const GENERATOR_VERSION: u32 = 2;
 /// Density (kg/m³) written into the info file.
 pub const DENSITY: f32 = 1000.0;
 /// Wall staves around the body.
@@ -113,14 +113,17 @@ fn body_pieces(p: &BucketParams) -> Vec<Piece> {
         })));
     }
     if p.rim {
-        // Four short rim blocks at the top, between the pivots.
-        for a in [PI / 4.0, 3.0 * PI / 4.0, 5.0 * PI / 4.0, 7.0 * PI / 4.0] {
-            let r = p.radius[1] + 0.004;
-            v.push(Piece::cuboid(
-                [r * a.cos(), r * a.sin(), p.height - 0.008],
-                [0.008, p.radius[1] * 0.55, 0.008],
-                a,
-            ));
+        // A rolled rim: a ring of short blocks 15 mm tall, 8 mm proud of the wall.
+        for k in 0..STAVES {
+            let a = TAU * k as f64 / STAVES as f64;
+            let (s, c) = a.sin_cos();
+            v.push(Piece::hexahedron(std::array::from_fn(|i| {
+                let z = p.height - if i & 4 == 0 { 0.015 } else { 0.0 };
+                let r = p.radius[1] + if i & 1 == 0 { -p.wall } else { 0.008 };
+                let t = if i & 2 == 0 { -half_angle } else { half_angle };
+                let (radial, tangential) = (r * t.cos(), r * t.sin());
+                [radial * c - tangential * s, radial * s + tangential * c, z]
+            })));
         }
     }
     // Lugs carrying the pivots on both sides (y).

@@ -19,8 +19,7 @@
 //! their box depth; doors swing outwards from 0 (closed) to 1.4-2.0 rad. `<dynamics
 //! damping="10" friction="0.1">` (N·s/m or N·m·s/rad, N or N·m), the middle of the ranges
 //! ManiSkill2's cabinet tasks draw per episode (damping 5-20, friction 0.05-0.15). Links have
-//! no `<inertial>`: the info's density (1000 kg/m³, SAPIEN's default that ManiSkill2's
-//! cabinets get) gives their mass.
+//! no `<inertial>`: the info's density (600 kg/m³, particle board) gives their mass.
 
 use std::path::{Path, PathBuf};
 
@@ -42,9 +41,9 @@ pub const DRAWER_CATEGORY: &str = "cabinet_drawer";
 /// Category of the door cabinets (`info_cabinet_door_<split>.json`).
 pub const DOOR_CATEGORY: &str = "cabinet_door";
 /// Version of the generator; a change regenerates the models.
-pub const GENERATOR_VERSION: u32 = 1;
+pub const GENERATOR_VERSION: u32 = 2;
 /// Density (kg/m³) written into the info files.
-pub const DENSITY: f32 = 1000.0;
+pub const DENSITY: f32 = 600.0;
 /// Panel thickness of the carcass (m).
 pub const PANEL: f64 = 0.018;
 /// Thickness of drawer fronts and doors (m).
