@@ -321,3 +321,46 @@ fn a_chair_seat_swivels_and_a_bucket_handle_falls_over() {
     let q = world.qpos(art).unwrap()[dof];
     assert!(q > 1.4 && q < 1.5708 + 0.02, "handle at {q} rad");
 }
+
+#[test]
+fn a_floating_chair_stands_on_its_casters_and_rolls_when_pushed() {
+    use ms2_tasks::families::articulated::floating::{with_floating_root, FLOATING_JOINTS};
+    let dir = tempfile::tempdir().unwrap();
+    let chairs = ModelSet::open(dir.path(), "chair", &split("train")).unwrap();
+    let id = chairs.ids()[0].to_owned();
+    let desc = with_floating_root(&chairs.load(&id).unwrap());
+    let (mut world, art) = world_with(&desc);
+    let dof = |world: &World, name: &str| world.dof_index(art, name).unwrap();
+    let [x, _, z, _, pitch, roll] = FLOATING_JOINTS.map(|n| dof(&world, n));
+    let support = world
+        .link_body(art, world.link_index(art, "link_support").unwrap())
+        .unwrap();
+    let second = (1.0 / world.timestep()).round() as usize;
+    // Let go: it stands on its five wheels.
+    world.step_n(second);
+    let q = world.qpos(art).unwrap();
+    assert!(q[z].abs() < 5e-3, "height change {} m", q[z]);
+    assert!(
+        q[pitch].abs() < 0.02 && q[roll].abs() < 0.02,
+        "tilt {} {}",
+        q[pitch],
+        q[roll]
+    );
+    let x0 = q[x];
+    // A 10 N push on the base for 1 s: the casters roll (a chair sliding on locked wheels at
+    // the default friction 1 would not move: 10 N < 1 · 5 kg · 9.81 m/s²).
+    for _ in 0..second {
+        world
+            .apply_force(support, &Vector3::new(10.0, 0.0, 0.0))
+            .unwrap();
+        world.step();
+    }
+    let q = world.qpos(art).unwrap();
+    assert!(q[x] - x0 > 0.1, "rolled {} m", q[x] - x0);
+    assert!(
+        q[pitch].abs() < 0.05 * std::f32::consts::PI && q[roll].abs() < 0.05 * std::f32::consts::PI,
+        "upright: {} {}",
+        q[pitch],
+        q[roll]
+    );
+}

@@ -16,8 +16,9 @@
 //!
 //! Joints (documented in docs/assets.md): seat swivel `<dynamics damping="10" friction="0.1">`
 //! (N·m·s/rad, N·m; ManiSkill2 draws 5-15 and 0.05-0.15 per episode), casters and wheels
-//! `damping="0.25" friction="0.05"` (ManiSkill2: 0-0.5, 0-0.1). Density 200 kg/m³ (ManiSkill2's
-//! chair density) in the info: a chair weighs 4-8 kg.
+//! nearly free ([`CASTER_DYNAMICS`], [`WHEEL_DYNAMICS`]: ManiSkill2's 0-0.1 for these joints is
+//! PhysX's friction coefficient; as a torque, 0.05 N·m on a 3 cm wheel would be a 1.7 N brake
+//! per wheel). Density 200 kg/m³ (ManiSkill2's chair density) in the info: 4.2-5.5 kg a chair.
 
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
@@ -38,11 +39,17 @@ pub const CHAIR_VARIANTS: usize = 40;
 /// Category name (`info_chair_<split>.json`).
 pub const CATEGORY: &str = "chair";
 /// Version of the generator; a change regenerates the models.
-pub const GENERATOR_VERSION: u32 = 1;
+pub const GENERATOR_VERSION: u32 = 2;
 /// Density (kg/m³) written into the info file.
 pub const DENSITY: f32 = 200.0;
 /// Number of casters.
 pub const CASTERS: usize = 5;
+/// Caster swivel `(damping N·m·s/rad, friction N·m)`: a fork that turns freely into the
+/// direction of motion.
+pub const CASTER_DYNAMICS: (f64, f64) = (1e-3, 1e-3);
+/// Wheel axle `(damping N·m·s/rad, friction N·m)`: rolling resistance 0.03-0.04 N per wheel
+/// (friction / radius) and 0.1-0.17 N per wheel at 1 m/s from the damping (damping / radius²).
+pub const WHEEL_DYNAMICS: (f64, f64) = (1e-4, 1e-3);
 const SEGMENTS: usize = 12;
 
 /// The parameters of one procedural chair (m, rad).
@@ -325,7 +332,7 @@ pub(crate) fn generated(p: &ChairParams) -> GeneratedModel {
             &caster,
             c,
             [0.0, 0.0, 1.0],
-            (0.25, 0.05),
+            CASTER_DYNAMICS,
         ));
         joints.push(joint(
             &format!("joint_wheel_{k}"),
@@ -334,7 +341,7 @@ pub(crate) fn generated(p: &ChairParams) -> GeneratedModel {
             &wheel,
             w,
             [0.0, 1.0, 0.0],
-            (0.25, 0.05),
+            WHEEL_DYNAMICS,
         ));
         semantics.push((caster, "hinge".into(), "caster".into()));
         semantics.push((wheel, "hinge".into(), "wheel".into()));
