@@ -2,11 +2,13 @@
 //!
 //! [`model`] reads articulated models in ManiSkill2's PartNet-Mobility layout (ManiSkill2's
 //! models, or ms2's procedural ones from [`ms2_assets::partnet`]); [`common`] adds them to a
-//! world with the task's joint dynamics and samples link surfaces; each task is its hooks and
-//! spec; [`scripted`] is the family's oracle policy, [`solutions`] (feature `demos`) plays it
-//! in `pd_joint_pos` as the demonstration solution.
+//! world with the task's joint dynamics and samples link surfaces; [`floating`] hangs an object
+//! on a free-floating root (chairs, buckets); each task is its hooks and spec; [`scripted`] is
+//! the family's oracle policy, [`solutions`] (feature `demos`) plays it in `pd_joint_pos` as the
+//! demonstration solution.
 
 pub mod common;
+pub mod floating;
 pub mod model;
 pub mod scripted;
 #[cfg(feature = "demos")]
