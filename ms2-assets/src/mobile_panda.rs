@@ -47,18 +47,18 @@ pub struct MobileArmSide {
     pub mount_rpy: [f64; 3],
 }
 
-/// The right arm (ManiSkill2: origin (0.08083, -0.3012, 0.2885), rpy (1.57079, 0, 0)).
+/// The right arm (ManiSkill2: origin (0.08083, -0.3012, 0.2885), rpy (π/2, 0, 0)).
 pub const RIGHT_ARM: MobileArmSide = MobileArmSide {
     side: "right",
     mount_xyz: [0.08083, -0.3012, 0.2885],
-    mount_rpy: [1.57079, 0.0, 0.0],
+    mount_rpy: [std::f64::consts::FRAC_PI_2, 0.0, 0.0],
 };
 
-/// The left arm (ManiSkill2: origin (0.08083, 0.3012, 0.2885), rpy (-1.57079, 0, 0)).
+/// The left arm (ManiSkill2: origin (0.08083, 0.3012, 0.2885), rpy (-π/2, 0, 0)).
 pub const LEFT_ARM: MobileArmSide = MobileArmSide {
     side: "left",
     mount_xyz: [0.08083, 0.3012, 0.2885],
-    mount_rpy: [-1.57079, 0.0, 0.0],
+    mount_rpy: [-std::f64::consts::FRAC_PI_2, 0.0, 0.0],
 };
 
 impl MobileArmSide {

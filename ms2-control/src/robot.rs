@@ -64,6 +64,11 @@ pub struct BaseSpec {
     pub force_limit: f64,
 }
 
+/// ManiSkill2's bound (rad/s) of the mobile Pandas' yaw rate and arm joint velocities: the
+/// number 3.14, not π.
+#[allow(clippy::approx_constant)]
+pub const MOBILE_ANGULAR_BOUND: f64 = 3.14;
+
 /// One arm of a robot with several (or with ManiSkill2's side-named parts): its parts are named
 /// `<side>_arm` and `<side>_gripper`, as ManiSkill2's mobile Pandas name them.
 #[derive(Debug, Clone, PartialEq)]
@@ -223,7 +228,7 @@ impl RobotConfig {
                     joint_delta: 0.1,
                     joint_delta_pos_vel: 0.1,
                     ee_delta: 0.1,
-                    joint_velocity: 3.14,
+                    joint_velocity: MOBILE_ANGULAR_BOUND,
                     ee_frame: EeFrame::Ee,
                     ik: EeIkSolver::default(),
                 },
@@ -255,8 +260,8 @@ impl RobotConfig {
             gripper: primary.gripper,
             base: Some(BaseSpec {
                 joint_names: owned(&ms2_assets::MOBILE_PANDA_BASE_JOINTS),
-                lower: vec![-0.5, -0.5, -3.14, -0.5],
-                upper: vec![0.5, 0.5, 3.14, 0.5],
+                lower: vec![-0.5, -0.5, -MOBILE_ANGULAR_BOUND, -0.5],
+                upper: vec![0.5, 0.5, MOBILE_ANGULAR_BOUND, 0.5],
                 damping: 1000.0,
                 force_limit: 500.0,
             }),

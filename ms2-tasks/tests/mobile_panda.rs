@@ -121,7 +121,12 @@ fn base_tracks_ego_velocity_commands() {
         let (forward, left, omega, lift) = (0.3_f32, -0.2_f32, 0.5_f32, 0.1_f32);
         let mut action = vec![0.0_f32; agent.controller().action_dim()];
         // Normalised against ManiSkill2's bounds ±0.5 m/s, ±3.14 rad/s, ±0.5 m/s.
-        action[..4].copy_from_slice(&[forward / 0.5, left / 0.5, omega / 3.14, lift / 0.5]);
+        action[..4].copy_from_slice(&[
+            forward / 0.5,
+            left / 0.5,
+            omega / ms2_control::MOBILE_ANGULAR_BOUND as f32,
+            lift / 0.5,
+        ]);
         // Let the drives spin up (0.25 s), then measure over 1 s.
         for _ in 0..5 {
             step(world.as_mut(), agent.as_mut(), &action);
