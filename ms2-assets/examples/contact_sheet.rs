@@ -1,8 +1,9 @@
 //! Renders contact sheets of the procedural object families with ms2-render (offscreen):
 //! `cargo run --release -p ms2-assets --example contact_sheet -- <asset dir> <out dir>`
-//! writes `<out dir>/objects_household.png` (12 household objects) and
+//! writes `<out dir>/objects_household.png` (12 household objects),
 //! `<out dir>/objects_egad.png` (12 EGAD-like shapes, one per complexity × difficulty corner
-//! and diagonal cell).
+//! and diagonal cell), `<out dir>/articulated_cabinets.png` (6 drawer and 6 door cabinets) and
+//! `<out dir>/articulated_chairs_buckets.png` (8 swivel chairs, 4 buckets).
 
 use std::path::{Path, PathBuf};
 
@@ -32,31 +33,37 @@ fn flat(piece: &ms2_assets::objects::MeshPiece) -> MeshData {
     m
 }
 
-fn sheet(
+/// One model of a sheet: its pieces (model frame) with their colours, and its yaw (rad) and
+/// lift (m) on the grid.
+struct SheetModel {
+    parts: Vec<(MeshData, [f32; 3])>,
+    yaw: f32,
+    lift: f32,
+}
+
+/// Renders up to 12 models on a 4-wide grid `spacing` m apart, seen from −y and above.
+fn render_grid(
     renderer: &Renderer,
-    root: &Path,
-    kind: ObjectKind,
-    ids: &[String],
+    models: &[SheetModel],
     spacing: f32,
     out: &Path,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let db = load_model_db(root, kind, Some(Split::of_egad_id(&ids[0])))?;
     let mut scene = Scene::new();
     scene.lighting.background = [0.18, 0.2, 0.24];
-    let ground = renderer.add_mesh(&MeshData::plane(2.0, 2.0))?;
-    for (k, id) in ids.iter().enumerate() {
-        let info = db.get(id)?;
-        let z = -info.bbox.map(|b| b.min[2]).unwrap_or(0.0) as f32;
+    let ground = renderer.add_mesh(&MeshData::plane(2.0 * spacing / 0.3, 2.0 * spacing / 0.3))?;
+    let rows = models.len().div_ceil(4) as f32;
+    for (k, model) in models.iter().enumerate() {
         let (col, row) = ((k % 4) as f32, (k / 4) as f32);
-        let pose = Isometry3::translation((col - 1.5) * spacing, (1.0 - row) * spacing, z);
-        let files = model_files(root, kind, id);
-        for (j, part) in read_visual_parts(&files.visual, id)?.iter().enumerate() {
-            let mesh = renderer.add_mesh(&flat(part))?;
-            let c = part.rgba.unwrap_or({
-                // EGAD-like shapes carry no colour (ManiSkill2 picks one per episode).
-                let h = (k as f32 * 0.37).fract();
-                [0.3 + 0.5 * h, 0.75 - 0.4 * h, 0.35 + 0.3 * (1.0 - h), 1.0]
-            });
+        let pose = Isometry3::new(
+            Vector3::new(
+                (col - 1.5) * spacing,
+                ((rows - 1.0) / 2.0 - row) * spacing,
+                model.lift,
+            ),
+            Vector3::z() * model.yaw,
+        );
+        for (j, (mesh, c)) in model.parts.iter().enumerate() {
+            let mesh = renderer.add_mesh(mesh)?;
             let ids = SegmentationIds {
                 actor: k as u32 + 1,
                 link: j as u32 + 1,
@@ -78,7 +85,7 @@ fn sheet(
             link: 99,
         },
     ));
-    let cam = Camera::new(960, 720, 0.6, 0.01, 10.0).looking_at(
+    let cam = Camera::new(960, 720, 0.6, 0.01, 10.0 * spacing / 0.3).looking_at(
         Point3::new(0.0, -spacing * 4.6, spacing * 4.4),
         Point3::new(0.0, 0.0, 0.0),
         Vector3::z(),
@@ -87,6 +94,69 @@ fn sheet(
     images[0].save_rgb_png(out)?;
     println!("wrote {}", out.display());
     Ok(())
+}
+
+fn sheet(
+    renderer: &Renderer,
+    root: &Path,
+    kind: ObjectKind,
+    ids: &[String],
+    spacing: f32,
+    out: &Path,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let db = load_model_db(root, kind, Some(Split::of_egad_id(&ids[0])))?;
+    let mut models = Vec::new();
+    for (k, id) in ids.iter().enumerate() {
+        let info = db.get(id)?;
+        let lift = -info.bbox.map(|b| b.min[2]).unwrap_or(0.0) as f32;
+        let files = model_files(root, kind, id);
+        let mut parts = Vec::new();
+        for part in read_visual_parts(&files.visual, id)? {
+            let c = part.rgba.unwrap_or({
+                // EGAD-like shapes carry no colour (ManiSkill2 picks one per episode).
+                let h = (k as f32 * 0.37).fract();
+                [0.3 + 0.5 * h, 0.75 - 0.4 * h, 0.35 + 0.3 * (1.0 - h), 1.0]
+            });
+            parts.push((flat(&part), [c[0], c[1], c[2]]));
+        }
+        models.push(SheetModel {
+            parts,
+            yaw: 0.0,
+            lift,
+        });
+    }
+    render_grid(renderer, &models, spacing, out)
+}
+
+/// A sheet of procedural articulated models (`(category, index)`), at rest, fronts (−x)
+/// turned towards the camera.
+fn articulated_sheet(
+    renderer: &Renderer,
+    picks: &[(&str, usize)],
+    spacing: f32,
+    out: &Path,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut models = Vec::new();
+    for (category, index) in picks {
+        let parts = ms2_assets::partnet::preview(category, *index)?
+            .into_iter()
+            .map(|p| {
+                let piece = ms2_assets::objects::MeshPiece {
+                    name: String::new(),
+                    vertices: p.vertices,
+                    triangles: p.triangles,
+                    rgba: None,
+                };
+                (flat(&piece), [p.rgba[0], p.rgba[1], p.rgba[2]])
+            })
+            .collect();
+        models.push(SheetModel {
+            parts,
+            yaw: std::f32::consts::FRAC_PI_2,
+            lift: 0.0,
+        });
+    }
+    render_grid(renderer, &models, spacing, out)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -143,5 +213,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         0.16,
         &out.join("objects_egad.png"),
     )?;
+
+    use ms2_assets::partnet::{bucket, cabinet, chair};
+    let cabinets: Vec<(&str, usize)> = [0, 1, 2, 4, 5, 6]
+        .iter()
+        .map(|&i| (cabinet::DRAWER_CATEGORY, i))
+        .chain([0, 1, 2, 4, 5, 6].iter().map(|&i| (cabinet::DOOR_CATEGORY, i)))
+        .collect();
+    articulated_sheet(&renderer, &cabinets, 1.25, &out.join("articulated_cabinets.png"))?;
+    let seats: Vec<(&str, usize)> = (0..8)
+        .map(|i| (chair::CATEGORY, i))
+        .chain((0..4).map(|i| (bucket::CATEGORY, i)))
+        .collect();
+    articulated_sheet(&renderer, &seats, 0.8, &out.join("articulated_chairs_buckets.png"))?;
     Ok(())
 }

@@ -12,14 +12,17 @@
 //! Links carry no `<inertial>`: their mass comes from a density (ManiSkill2's 8000 kg/m³).
 
 use std::f64::consts::PI;
-use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::obj::{bounds, to_obj, Piece};
-use super::{info_path, model_dir, write_atomic, BBox, ModelDb, ModelInfo, PROCEDURAL_DIR};
+use super::family::{
+    ensure_family, GeneratedModel, JointKind, JointSpec, NamedMesh, UrdfLayout, UrdfWriter,
+};
+pub use super::family::{procedural_root, split_of};
+use super::obj::{bounds, Piece};
+use super::{BBox, ModelInfo};
 use crate::error::AssetError;
 
 /// Number of procedural faucet models.
@@ -27,7 +30,7 @@ pub const FAUCET_VARIANTS: usize = 40;
 /// Category name of the faucets in info file names (`info_faucet_<split>.json`).
 pub const CATEGORY: &str = "faucet";
 /// Version of the generator; a change regenerates the models (it is part of the info files).
-pub const GENERATOR_VERSION: u32 = 2;
+pub const GENERATOR_VERSION: u32 = 3;
 
 /// Segments of the prisms that approximate cylinders.
 const SEGMENTS: usize = 16;
@@ -69,15 +72,6 @@ pub struct FaucetParams {
     pub spout: f64,
     /// The handles (one or two).
     pub handles: Vec<HandleParams>,
-}
-
-/// The split of variant `index`: `test` for every fourth, else `train`.
-pub fn split_of(index: usize) -> &'static str {
-    if index % 4 == 3 {
-        "test"
-    } else {
-        "train"
-    }
 }
 
 /// The parameters of variant `index` (deterministic).
@@ -196,56 +190,55 @@ fn handle_pieces(h: &HandleParams) -> Vec<Piece> {
 }
 
 /// The URDF text of a faucet whose link meshes are `meshes/<link>.obj`.
-fn urdf_text(p: &FaucetParams) -> String {
-    let mut u = String::new();
-    let _ = writeln!(u, "<?xml version=\"1.0\"?>");
-    let _ = writeln!(
-        u,
-        "<!-- ms2 procedural faucet {} (generator v{GENERATOR_VERSION}); metres, radians -->",
-        p.model_id
+fn urdf_text(p: &FaucetParams) -> (String, UrdfLayout) {
+    let mut u = UrdfWriter::new(
+        &p.model_id,
+        "faucet",
+        GENERATOR_VERSION,
+        &[
+            ("chrome", [0.67, 0.67, 0.67, 1.0]),
+            ("handle", [0.45, 0.5, 0.6, 1.0]),
+        ],
     );
-    let _ = writeln!(u, "<robot name=\"{}\">", p.model_id);
-    let _ = writeln!(
-        u,
-        "  <material name=\"chrome\"><color rgba=\"0.67 0.67 0.67 1\"/></material>"
-    );
-    let _ = writeln!(
-        u,
-        "  <material name=\"handle\"><color rgba=\"0.45 0.5 0.6 1\"/></material>"
-    );
-    let _ = writeln!(u, "  <link name=\"base\"/>");
+    u.empty_link("base");
     let n = p.handles.len();
     let body = format!("link_{n}");
-    let mesh_link = |u: &mut String, name: &str, material: &str| {
-        let _ = writeln!(u, "  <link name=\"{name}\">");
-        let _ = writeln!(
-            u,
-            "    <visual><origin xyz=\"0 0 0\"/><geometry><mesh filename=\"meshes/{name}.obj\"/></geometry><material name=\"{material}\"/></visual>"
-        );
-        let _ = writeln!(
-            u,
-            "    <collision><origin xyz=\"0 0 0\"/><geometry><mesh filename=\"meshes/{name}.obj\"/></geometry></collision>"
-        );
-        let _ = writeln!(u, "  </link>");
-    };
-    mesh_link(&mut u, &body, "chrome");
-    let _ = writeln!(
-        u,
-        "  <joint name=\"joint_{n}\" type=\"fixed\"><parent link=\"base\"/><child link=\"{body}\"/><origin xyz=\"0 0 0\"/></joint>"
+    let body_mesh = format!("{body}.obj");
+    u.link(
+        &body,
+        &[NamedMesh::solid("faucet_base", &body_mesh, "chrome")],
+        &[],
     );
+    u.joint(&JointSpec {
+        name: &format!("joint_{n}"),
+        kind: JointKind::Fixed,
+        parent: "base",
+        child: &body,
+        origin: [0.0; 3],
+        axis: [0.0, 0.0, 1.0],
+        limits: [0.0, 0.0],
+        effort: 0.0,
+        damping: 0.0,
+        friction: 0.0,
+    });
     for (i, h) in p.handles.iter().enumerate() {
         let name = format!("link_{i}");
-        mesh_link(&mut u, &name, "handle");
-        let _ = writeln!(
-            u,
-            "  <joint name=\"joint_{i}\" type=\"revolute\"><parent link=\"{body}\"/><child link=\"{name}\"/>\
-<origin xyz=\"{:.6} {:.6} {:.6}\" rpy=\"0 0 0\"/><axis xyz=\"0 0 1\"/>\
-<limit lower=\"0\" upper=\"{:.6}\" effort=\"10\" velocity=\"3\"/><dynamics damping=\"0.5\" friction=\"0.05\"/></joint>",
-            h.pivot[0], h.pivot[1], h.pivot[2], h.range
-        );
+        let mesh = format!("{name}.obj");
+        u.link(&name, &[NamedMesh::solid("switch", &mesh, "handle")], &[]);
+        u.joint(&JointSpec {
+            name: &format!("joint_{i}"),
+            kind: JointKind::Revolute,
+            parent: &body,
+            child: &name,
+            origin: h.pivot,
+            axis: [0.0, 0.0, 1.0],
+            limits: [0.0, h.range],
+            effort: 10.0,
+            damping: 0.5,
+            friction: 0.05,
+        });
     }
-    let _ = writeln!(u, "</robot>");
-    u
+    u.finish()
 }
 
 /// The info entry of a faucet: bbox at zero angle, offset (base bottom on the ground), scale 1,
@@ -267,73 +260,45 @@ fn info_of(p: &FaucetParams) -> ModelInfo {
         .collect();
     semantics.push((format!("link_{n}"), "static".into(), "faucet_base".into()));
     ModelInfo {
-        bbox: BBox {
+        bbox: Some(BBox {
             min: f(lo),
             max: f(hi),
-        },
+        }),
         offset: Some([0.0, 0.0, -lo[2] as f32]),
         scale: Some(1.0),
         semantics,
-        density: None,
+        ..ModelInfo::default()
     }
 }
 
-/// Writes one faucet's folder (URDF and meshes) under `dataset_root`, each file atomically.
-pub fn write_faucet(dataset_root: &Path, p: &FaucetParams) -> Result<PathBuf, AssetError> {
-    let dir = model_dir(dataset_root, &p.model_id);
-    let header = format!("ms2 procedural faucet {}, metres", p.model_id);
+/// The generated files and info entry of one faucet.
+pub(crate) fn generated(p: &FaucetParams) -> GeneratedModel {
     let n = p.handles.len();
-    write_atomic(
-        &dir.join("meshes").join(format!("link_{n}.obj")),
-        to_obj(&base_pieces(p), &header).as_bytes(),
-    )?;
+    let mut meshes = vec![(format!("link_{n}.obj"), base_pieces(p))];
     for (i, h) in p.handles.iter().enumerate() {
-        write_atomic(
-            &dir.join("meshes").join(format!("link_{i}.obj")),
-            to_obj(&handle_pieces(h), &header).as_bytes(),
-        )?;
+        meshes.push((format!("link_{i}.obj"), handle_pieces(h)));
     }
-    let urdf = dir.join(super::URDF_NAMES[0]);
-    write_atomic(&urdf, urdf_text(p).as_bytes())?;
-    Ok(urdf)
-}
-
-/// The procedural dataset folder under an asset directory.
-pub fn procedural_root(asset_dir: &Path) -> PathBuf {
-    asset_dir.join(PROCEDURAL_DIR)
+    let (urdf, layout) = urdf_text(p);
+    GeneratedModel {
+        model_id: p.model_id.clone(),
+        category: CATEGORY,
+        split: p.split,
+        info: info_of(p),
+        urdf,
+        meshes,
+        layout,
+    }
 }
 
 /// Makes sure the procedural faucets exist under `asset_dir` (generating them on first use,
 /// or when [`GENERATOR_VERSION`] changed) and returns their dataset root. The info files are
 /// written last, atomically, so a half-generated set is regenerated on the next call.
 pub fn ensure_faucets(asset_dir: &Path) -> Result<PathBuf, AssetError> {
-    let root = procedural_root(asset_dir);
-    let stamp = root.join("meta").join(format!("{CATEGORY}.version"));
-    let current = GENERATOR_VERSION.to_string();
-    let up_to_date = std::fs::read_to_string(&stamp).is_ok_and(|s| s.trim() == current)
-        && ["train", "test"]
-            .iter()
-            .all(|s| info_path(&root, CATEGORY, s).is_file());
-    if up_to_date {
-        return Ok(root);
-    }
-    let mut dbs: [(&str, ModelDb); 2] = [("train", ModelDb::new()), ("test", ModelDb::new())];
-    for i in 0..FAUCET_VARIANTS {
-        let p = faucet_params(i);
-        write_faucet(&root, &p)?;
-        let db = &mut dbs
-            .iter_mut()
-            .find(|(s, _)| *s == p.split)
-            .expect("two splits")
-            .1;
-        db.insert(p.model_id.clone(), info_of(&p));
-    }
-    for (split, db) in &dbs {
-        let text = serde_json::to_string_pretty(db).expect("info serializes");
-        write_atomic(&info_path(&root, CATEGORY, split), text.as_bytes())?;
-    }
-    write_atomic(&stamp, current.as_bytes())?;
-    Ok(root)
+    ensure_family(asset_dir, CATEGORY, GENERATOR_VERSION, &[CATEGORY], || {
+        (0..FAUCET_VARIANTS)
+            .map(|i| generated(&faucet_params(i)))
+            .collect()
+    })
 }
 
 #[cfg(test)]
@@ -359,8 +324,10 @@ mod tests {
     fn generated_set_has_info_files_with_switch_links() {
         let dir = tempfile::tempdir().unwrap();
         let root = ensure_faucets(dir.path()).unwrap();
-        let train = super::super::read_info(&info_path(&root, CATEGORY, "train")).unwrap();
-        let test = super::super::read_info(&info_path(&root, CATEGORY, "test")).unwrap();
+        let train =
+            super::super::read_info(&super::super::info_path(&root, CATEGORY, "train")).unwrap();
+        let test =
+            super::super::read_info(&super::super::info_path(&root, CATEGORY, "test")).unwrap();
         assert_eq!((train.len(), test.len()), (30, 10));
         for (id, info) in train.iter().chain(&test) {
             assert!(!info.links_labelled("switch").is_empty(), "{id}");
@@ -372,7 +339,10 @@ mod tests {
                     "{id}: {link}"
                 );
             }
-            assert!(info.bbox.min[2].abs() < 1e-6, "{id}: base bottom at z = 0");
+            assert!(
+                info.bbox.as_ref().unwrap().min[2].abs() < 1e-6,
+                "{id}: base bottom at z = 0"
+            );
         }
         // A second call finds the set complete and does not rewrite it.
         let urdf = super::super::find_urdf(&root, "ms2_faucet_000").unwrap();

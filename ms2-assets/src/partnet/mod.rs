@@ -11,11 +11,19 @@
 //!
 //! An info file maps model ids to [`ModelInfo`]: bounding box, offset, scale and link
 //! semantics (`[link, joint kind, label]`, e.g. `["link_0", "hinge", "switch"]`). The
-//! procedural families ([`faucet`]) write the same files with the same labels, so one loader
-//! serves both.
+//! procedural families ([`faucet`], [`cabinet`], [`chair`], [`bucket`]; shared machinery in
+//! `family`) write the same files with the same labels and the visual names ManiSkill2's tasks
+//! look for (`handle`, `seat`, `wheel`, `leg`), so one loader serves both
+//! ([`ensure_procedural`] dispatches on the category).
 
+pub mod bucket;
+pub mod cabinet;
+pub mod chair;
+mod family;
 pub mod faucet;
 mod obj;
+
+pub use family::{procedural_root, split_of, PreviewPart};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -32,7 +40,7 @@ pub const PROCEDURAL_DIR: &str = "ms2_partnet_mobility";
 pub const URDF_NAMES: [&str; 2] = ["mobility_cvx.urdf", "mobility.urdf"];
 
 /// Axis-aligned bounding box of a model at its zero configuration (model units, before scale).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct BBox {
     /// Smallest corner.
     pub min: [f32; 3],
@@ -41,10 +49,15 @@ pub struct BBox {
 }
 
 /// One entry of an info file: how a model is scaled and placed, and what its links are.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+///
+/// ManiSkill2's files differ by category: faucets give `bbox`, `offset`, `scale`, `semantics`;
+/// cabinets `scale` and `num_target_links`; chairs a resting state (`position`, `rotation`,
+/// `initial_qpos`); buckets `scale`. Every field but the model id is optional here.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ModelInfo {
     /// Bounding box in model units.
-    pub bbox: BBox,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bbox: Option<BBox>,
     /// Position (m) of the model origin above the ground after scaling (ManiSkill2 uses its z).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub offset: Option<[f32; 3]>,
@@ -57,6 +70,18 @@ pub struct ModelInfo {
     /// Density (kg/m³) of the links, when the file gives one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<f32>,
+    /// Number of links a cabinet task can target (handled drawers or doors).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub num_target_links: Option<u32>,
+    /// Resting position (m, world, after scale) of the model's root (ManiSkill2's chairs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<[f32; 3]>,
+    /// Resting orientation (quaternion w, x, y, z) of the model's root (ManiSkill2's chairs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotation: Option<[f32; 4]>,
+    /// Resting joint positions (rad or m, in the URDF's joint order) (ManiSkill2's chairs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_qpos: Option<Vec<f32>>,
 }
 
 impl ModelInfo {
@@ -70,25 +95,25 @@ impl ModelInfo {
     }
 
     /// The scale ManiSkill2 uses: the file's, else the one that makes the largest bbox side
-    /// 0.3 m.
+    /// 0.3 m, else 1.
     pub fn effective_scale(&self) -> f32 {
-        self.scale.unwrap_or_else(|| {
-            let side = (0..3)
-                .map(|i| self.bbox.max[i] - self.bbox.min[i])
-                .fold(0.0_f32, f32::max);
-            0.3 / side.max(1e-6)
+        self.scale.unwrap_or_else(|| match &self.bbox {
+            Some(b) => {
+                let side = (0..3).map(|i| b.max[i] - b.min[i]).fold(0.0_f32, f32::max);
+                0.3 / side.max(1e-6)
+            }
+            None => 1.0,
         })
     }
 
-    /// The model origin's offset (m): the file's, else `-bbox.min · scale`.
+    /// The model origin's offset (m): the file's, else `-bbox.min · scale`, else zero.
     pub fn effective_offset(&self) -> [f32; 3] {
-        self.offset.unwrap_or_else(|| {
-            let s = self.effective_scale();
-            [
-                -self.bbox.min[0] * s,
-                -self.bbox.min[1] * s,
-                -self.bbox.min[2] * s,
-            ]
+        self.offset.unwrap_or_else(|| match &self.bbox {
+            Some(b) => {
+                let s = self.effective_scale();
+                [-b.min[0] * s, -b.min[1] * s, -b.min[2] * s]
+            }
+            None => [0.0; 3],
         })
     }
 }
@@ -104,23 +129,17 @@ pub fn read_info(path: &Path) -> Result<ModelDb, AssetError> {
     })?;
     let db: ModelDb = serde_json::from_str(&text).map_err(|e| AssetError::BadInfo {
         file: path.to_path_buf(),
-        reason: format!("{e}: expected {{model_id: {{bbox, offset?, scale?, semantics}}}}"),
+        reason: format!("{e}: expected {{model_id: {{bbox?, offset?, scale?, semantics?, ...}}}}"),
     })?;
     for (id, info) in &db {
-        let finite = info
-            .bbox
-            .min
-            .iter()
-            .chain(&info.bbox.max)
-            .all(|v| v.is_finite());
-        if !finite || (0..3).any(|i| info.bbox.min[i] > info.bbox.max[i]) {
-            return Err(AssetError::BadInfo {
-                file: path.to_path_buf(),
-                reason: format!(
-                    "model \"{id}\": bbox {:?}: expected finite min <= max",
-                    info.bbox
-                ),
-            });
+        if let Some(b) = &info.bbox {
+            let finite = b.min.iter().chain(&b.max).all(|v| v.is_finite());
+            if !finite || (0..3).any(|i| b.min[i] > b.max[i]) {
+                return Err(AssetError::BadInfo {
+                    file: path.to_path_buf(),
+                    reason: format!("model \"{id}\": bbox {b:?}: expected finite min <= max"),
+                });
+            }
         }
         if let Some(s) = info.scale {
             if !(s.is_finite() && s > 0.0) {
@@ -132,6 +151,55 @@ pub fn read_info(path: &Path) -> Result<ModelDb, AssetError> {
         }
     }
     Ok(db)
+}
+
+/// Categories of ms2's procedural articulated models (the info file names'
+/// `info_<category>_<split>.json`).
+pub const PROCEDURAL_CATEGORIES: [&str; 5] = [
+    faucet::CATEGORY,
+    cabinet::DRAWER_CATEGORY,
+    cabinet::DOOR_CATEGORY,
+    chair::CATEGORY,
+    bucket::CATEGORY,
+];
+
+/// Makes sure the procedural models of `category` (one of [`PROCEDURAL_CATEGORIES`]) exist
+/// under `asset_dir` and returns their dataset root; an unknown category is an error naming it.
+pub fn ensure_procedural(asset_dir: &Path, category: &str) -> Result<PathBuf, AssetError> {
+    match category {
+        faucet::CATEGORY => faucet::ensure_faucets(asset_dir),
+        cabinet::DRAWER_CATEGORY | cabinet::DOOR_CATEGORY => cabinet::ensure_cabinets(asset_dir),
+        chair::CATEGORY => chair::ensure_chairs(asset_dir),
+        bucket::CATEGORY => bucket::ensure_buckets(asset_dir),
+        other => Err(unknown_category(other)),
+    }
+}
+
+/// The visual geometry at rest (model frame, zero joint positions) of procedural model `index`
+/// of `category`, e.g. for contact sheets; an unknown category is an error naming it.
+pub fn preview(category: &str, index: usize) -> Result<Vec<PreviewPart>, AssetError> {
+    let model = match category {
+        faucet::CATEGORY => faucet::generated(&faucet::faucet_params(index)),
+        cabinet::DRAWER_CATEGORY => {
+            cabinet::generated(&cabinet::cabinet_params(cabinet::DRAWER_CATEGORY, index))
+        }
+        cabinet::DOOR_CATEGORY => {
+            cabinet::generated(&cabinet::cabinet_params(cabinet::DOOR_CATEGORY, index))
+        }
+        chair::CATEGORY => chair::generated(&chair::chair_params(index)),
+        bucket::CATEGORY => bucket::generated(&bucket::bucket_params(index)),
+        other => return Err(unknown_category(other)),
+    };
+    Ok(model.preview())
+}
+
+fn unknown_category(category: &str) -> AssetError {
+    AssetError::Generation {
+        family: category.to_string(),
+        reason: format!(
+            "no procedural articulated models of category \"{category}\": expected one of {PROCEDURAL_CATEGORIES:?}"
+        ),
+    }
 }
 
 /// `<root>/<dataset dir>/meta/info_<category>_<split>.json`.

@@ -14,18 +14,22 @@ impl Piece {
     /// A box of half extents `half` centred at `center`, rotated by `yaw` (rad) about z.
     pub(crate) fn cuboid(center: [f64; 3], half: [f64; 3], yaw: f64) -> Piece {
         let (s, c) = yaw.sin_cos();
-        let mut vertices = Vec::with_capacity(8);
-        for i in 0..8 {
+        Piece::hexahedron(std::array::from_fn(|i| {
             let x = if i & 1 == 0 { -half[0] } else { half[0] };
             let y = if i & 2 == 0 { -half[1] } else { half[1] };
             let z = if i & 4 == 0 { -half[2] } else { half[2] };
-            vertices.push([
+            [
                 center[0] + c * x - s * y,
                 center[1] + s * x + c * y,
                 center[2] + z,
-            ]);
-        }
-        // Corner index bits: x = 1, y = 2, z = 4.
+            ]
+        }))
+    }
+
+    /// A convex hexahedron from its 8 corners, indexed by bits (x = 1, y = 2, z = 4) of a
+    /// right-handed frame: corner `i` lies on the `+x` side when `i & 1`, `+y` when `i & 2`,
+    /// `+z` when `i & 4` (a box deformed without folding, e.g. a tapered stave).
+    pub(crate) fn hexahedron(vertices: [[f64; 3]; 8]) -> Piece {
         let quads = [
             [0, 2, 3, 1], // -z
             [4, 5, 7, 6], // +z
@@ -38,7 +42,10 @@ impl Piece {
             .iter()
             .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
             .collect();
-        Piece { vertices, faces }
+        Piece {
+            vertices: vertices.to_vec(),
+            faces,
+        }
     }
 
     /// A regular `n`-gon prism (a cylinder approximation) of `radius` along z, from `z0` to
@@ -62,6 +69,40 @@ impl Piece {
             faces.push([n, n + k, n + k + 1]); // top, facing +z
         }
         Piece { vertices, faces }
+    }
+
+    /// A regular `n`-gon prism of `radius` from `a` to `b` along one coordinate axis
+    /// (`axis` 0 = x, 1 = y, 2 = z) through `center` (the other two coordinates).
+    pub(crate) fn cylinder_axis(
+        axis: usize,
+        center: [f64; 3],
+        radius: f64,
+        a: f64,
+        b: f64,
+        n: usize,
+    ) -> Piece {
+        let along_z = Piece::cylinder_z(0.0, 0.0, radius, a, b, n);
+        // Proper rotations taking z to the axis (so faces keep their outward winding).
+        let rotated = match axis {
+            0 => along_z.rotated([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]),
+            1 => along_z.rotated([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
+            _ => along_z,
+        };
+        let mut d = center;
+        d[axis.min(2)] = 0.0;
+        rotated.translated(d)
+    }
+
+    /// The piece rotated about the origin by the rotation matrix `r` (rows), which must be
+    /// proper (determinant +1) so the triangles stay outward.
+    pub(crate) fn rotated(mut self, r: [[f64; 3]; 3]) -> Piece {
+        for v in &mut self.vertices {
+            let p = *v;
+            for (i, row) in r.iter().enumerate() {
+                v[i] = row[0] * p[0] + row[1] * p[1] + row[2] * p[2];
+            }
+        }
+        self
     }
 
     /// The piece moved by `d` (m).

@@ -44,21 +44,12 @@ pub struct ModelSet {
 
 impl ModelSet {
     /// The models of `category` from `source` under the asset directory `asset_dir`.
-    /// Procedural faucets are generated on first use.
+    /// Procedural models are generated on first use.
     pub fn open(asset_dir: &Path, category: &str, source: &ModelSource) -> Result<Self, EnvError> {
         let asset = |e: ms2_assets::AssetError| EnvError::Asset(e.to_string());
         let (root, info_file) = match source {
             ModelSource::Procedural { split } => {
-                let root = match category {
-                    ms2_assets::partnet::faucet::CATEGORY => {
-                        ms2_assets::partnet::faucet::ensure_faucets(asset_dir).map_err(asset)?
-                    }
-                    other => {
-                        return Err(EnvError::Asset(format!(
-                            "no procedural models of category \"{other}\": expected \"faucet\""
-                        )))
-                    }
-                };
+                let root = partnet::ensure_procedural(asset_dir, category).map_err(asset)?;
                 let info = partnet::info_path(&root, category, split);
                 (root, info)
             }
