@@ -365,24 +365,24 @@ impl MobilePandaAgent {
     }
 
     /// ManiSkill2's finger tips of every arm (right arm first; per arm the right finger's then
-    /// the left finger's): the finger joint frames moved 0.035 m along the closing direction,
-    /// world frame (m).
+    /// the left finger's): 0.035 m from each finger joint's frame towards the finger's tip
+    /// (the hand's approach axis), world frame (m).
     pub fn finger_tips(&self, world: &dyn RigidWorld) -> Vec<Vector3<f32>> {
         self.finger_points(world, 0.035)
     }
 
-    /// Points on the fingers' inner faces, `offset` m from the finger joint frame along each
-    /// finger's opening axis, in the finger-tip order of [`Self::finger_tips`].
+    /// Points on the fingers, `offset` m from each finger joint's frame along the hand's
+    /// approach axis (towards the tips), in the order of [`Self::finger_tips`] (world, m).
     pub fn finger_points(&self, world: &dyn RigidWorld, offset: f32) -> Vec<Vector3<f32>> {
         self.arms
             .iter()
             .flat_map(|arm| {
                 let [left, right] = arm.fingers;
-                [right, left].map(|(_, link, sign)| {
-                    // The finger link frame is the finger joint frame (joint origin at the
-                    // link's origin, no rotation).
+                [right, left].map(|(_, link, _)| {
+                    // The finger link frame is its joint's frame moved with the joint (same
+                    // orientation as the hand).
                     let pose = self.link_pose(world, link);
-                    pose.transform_point(&nalgebra::Point3::new(0.0, sign * offset, 0.0))
+                    pose.transform_point(&nalgebra::Point3::new(0.0, 0.0, offset))
                         .coords
                 })
             })
