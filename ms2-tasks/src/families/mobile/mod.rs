@@ -8,6 +8,7 @@
 pub mod common;
 pub mod handles;
 pub mod open_cabinet;
+pub mod scripted;
 
 pub use open_cabinet::{CabinetTarget, OpenCabinet};
 
@@ -49,10 +50,16 @@ pub const OPEN_CABINET_DOOR: TaskSpec = TaskSpec {
 
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
-    r.add(TaskRegistration::new(OPEN_CABINET_DRAWER, |_| {
-        Ok(Box::new(OpenCabinet::new(CabinetTarget::Drawer)?))
-    }));
-    r.add(TaskRegistration::new(OPEN_CABINET_DOOR, |_| {
-        Ok(Box::new(OpenCabinet::new(CabinetTarget::Door)?))
-    }));
+    r.add(
+        TaskRegistration::new(OPEN_CABINET_DRAWER, |_| {
+            Ok(Box::new(OpenCabinet::new(CabinetTarget::Drawer)?))
+        })
+        .scripted(scripted::policy),
+    );
+    r.add(
+        TaskRegistration::new(OPEN_CABINET_DOOR, |_| {
+            Ok(Box::new(OpenCabinet::new(CabinetTarget::Door)?))
+        })
+        .scripted(scripted::policy),
+    );
 }
