@@ -1,5 +1,6 @@
 //! A privileged oracle for OpenCabinetDrawer / OpenCabinetDoor in
-//! `base_pd_joint_vel_arm_pd_joint_pos`: the base and the arm move together. Each step it picks
+//! `base_pd_joint_vel_arm_pd_joint_pos` (or the default `…_pd_joint_vel`): the base and the arm
+//! move together. Each step it picks
 //! a TCP target (in front of the handle, on it, then along the joint's motion: a straight line
 //! for a drawer, an arc about the hinge for a door), solves IK over the whole chain (base x, y,
 //! yaw, lift and the arm), drives the base towards the solution's base joints by velocity and
@@ -15,8 +16,14 @@ use crate::error::EnvError;
 use crate::geometry::{wrap_angle, Pose3};
 use crate::scripted::{no_policy, ScriptedPolicy};
 
-/// The control mode the oracle drives.
-pub const ORACLE_MODE: &str = "base_pd_joint_vel_arm_pd_joint_pos";
+/// The control modes the oracle drives: absolute arm joint targets, or (the tasks' default)
+/// arm joint velocities toward them.
+pub const ORACLE_MODES: [&str; 2] = [
+    "base_pd_joint_vel_arm_pd_joint_pos",
+    "base_pd_joint_vel_arm_pd_joint_vel",
+];
+/// Gain (1/s) of the arm's joint velocity command in `pd_joint_vel`.
+const ARM_VEL_GAIN: f32 = 10.0;
 /// Standoff (m) in front of the handle before going in.
 const STANDOFF: f32 = 0.12;
 /// How deep (m) the TCP goes past the handle's centre along the approach.
@@ -40,6 +47,8 @@ enum Phase {
 
 /// The policy (see the module docs).
 pub struct OpenCabinetPolicy {
+    /// Arm in `pd_joint_vel` (else `pd_joint_pos`).
+    joint_velocity: bool,
     phase: Phase,
     steps: u32,
     /// The grasp orientation (link frame) chosen at the first step.
@@ -48,13 +57,14 @@ pub struct OpenCabinetPolicy {
 
 /// The cabinet oracle for `env` (an error in another control mode).
 pub fn policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
-    if env.control_mode() != ORACLE_MODE {
+    if !ORACLE_MODES.contains(&env.control_mode()) {
         return Err(no_policy(
             env,
-            &format!("the cabinet oracle drives control_mode={ORACLE_MODE:?}"),
+            &format!("the cabinet oracle drives control_mode in {ORACLE_MODES:?}"),
         ));
     }
     Ok(Box::new(OpenCabinetPolicy {
+        joint_velocity: env.control_mode() == ORACLE_MODES[1],
         phase: Phase::Standoff,
         steps: 0,
         grasp_in_link: None,
@@ -186,8 +196,16 @@ impl OpenCabinetPolicy {
                 action[k] = (BASE_GAIN * d / bounds[k]).clamp(-1.0, 1.0);
             }
         }
-        // Arm: absolute joint targets (pd_joint_pos), then the gripper.
-        action[4..11].copy_from_slice(&sol[4..11]);
+        // Arm: absolute joint targets (pd_joint_pos) or velocities toward them (pd_joint_vel),
+        // then the gripper.
+        if self.joint_velocity {
+            let bound = ms2_control::MOBILE_ANGULAR_BOUND as f32;
+            for k in 4..11 {
+                action[k] = (ARM_VEL_GAIN * (sol[k] - q[k]) / bound).clamp(-1.0, 1.0);
+            }
+        } else {
+            action[4..11].copy_from_slice(&sol[4..11]);
+        }
         action[11] = gripper;
         action
     }
