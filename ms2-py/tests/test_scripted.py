@@ -17,8 +17,9 @@ MIN_SUCCESS_RATE = 0.8
 SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
 #: Known failures, documented in docs/tasks.md: TurnFaucet-v0 ("Known problem": the pushed
 #: handle barely turns; issue #18) and PickSingleYCB-v0 (6/10 on seeds 0-9 since every reset
-#: rebuilds the scene: wide bowls, long tools; issue #16).
-KNOWN_FAILING = {"TurnFaucet-v0", "PickSingleYCB-v0"}
+#: rebuilds the scene: wide bowls, long tools; issue #16), OpenCabinetDrawer-v1 (7/10 on seeds
+#: 0-9 in its default base_pd_joint_vel_arm_pd_joint_vel, 37/50 in ..._pd_joint_pos; issue #19).
+KNOWN_FAILING = {"TurnFaucet-v0", "PickSingleYCB-v0", "OpenCabinetDrawer-v1"}
 
 
 def test_scripted_policy_success_rate(env_id):
