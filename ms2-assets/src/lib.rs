@@ -14,6 +14,7 @@
 
 pub mod error;
 pub mod group;
+pub mod mobile_panda;
 pub mod objects;
 pub mod partnet;
 pub mod store;
@@ -22,6 +23,11 @@ pub use error::AssetError;
 pub use group::{
     builtin_groups, find_group, AssetFile, AssetGroup, AssetSource, FRANKA_DESCRIPTION,
     PARTNET_MOBILITY_META,
+};
+pub use mobile_panda::{
+    mobile_panda_dual_arm_urdf, mobile_panda_single_arm_urdf, MobileArmSide, LEFT_ARM,
+    MOBILE_PANDA_ARM_REST_QPOS, MOBILE_PANDA_BASE_JOINTS, MOBILE_PANDA_BASE_LINK,
+    MOBILE_PANDA_CAMERA_HEIGHT, RIGHT_ARM,
 };
 pub use store::{asset_dir, locate, locate_in, register_package_dir, LocatedGroup, ASSET_DIR_ENV};
 

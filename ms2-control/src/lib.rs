@@ -105,4 +105,4 @@ pub use kinematics::{
 };
 pub use mock::PerfectTrackingArticulation;
 pub use mode::{ControlMode, UnknownControlMode};
-pub use robot::{ArmSpec, BaseSpec, GripperSpec, RobotConfig};
+pub use robot::{ArmSpec, BaseSpec, GripperSpec, RobotConfig, SideArm, MOBILE_ANGULAR_BOUND};

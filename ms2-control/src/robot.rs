@@ -64,6 +64,23 @@ pub struct BaseSpec {
     pub force_limit: f64,
 }
 
+/// ManiSkill2's bound (rad/s) of the mobile Pandas' yaw rate and arm joint velocities: the
+/// number 3.14, not π.
+#[allow(clippy::approx_constant)]
+pub const MOBILE_ANGULAR_BOUND: f64 = 3.14;
+
+/// One arm of a robot with several (or with ManiSkill2's side-named parts): its parts are named
+/// `<side>_arm` and `<side>_gripper`, as ManiSkill2's mobile Pandas name them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SideArm {
+    /// `"right"` or `"left"`.
+    pub side: String,
+    /// The arm.
+    pub arm: ArmSpec,
+    /// Its gripper, if any.
+    pub gripper: Option<GripperSpec>,
+}
+
 /// A robot's kinematic model, parts and supported control modes.
 #[derive(Debug, Clone)]
 pub struct RobotConfig {
@@ -77,6 +94,12 @@ pub struct RobotConfig {
     pub gripper: Option<GripperSpec>,
     /// The mobile base, if any.
     pub base: Option<BaseSpec>,
+    /// Side-named arms in ManiSkill2's action order (mobile Pandas: `right`; or `left`, then
+    /// `right`). When non-empty, these make the parts after the base (`<side>_arm`,
+    /// `<side>_gripper` each), and [`RobotConfig::arm`] / [`RobotConfig::gripper`] are the
+    /// primary (right) arm's specs (its TCP, planning, conversion). Empty: the parts are `arm`
+    /// and `gripper`.
+    pub sides: Vec<SideArm>,
     /// Modes this robot offers.
     pub supported_modes: Vec<ControlMode>,
 }
@@ -114,6 +137,7 @@ impl RobotConfig {
                 gains: DriveGains::MANISKILL2_DEFAULT,
             }),
             base: None,
+            sides: Vec::new(),
             supported_modes: ControlMode::ALL.to_vec(),
         })
     }
@@ -154,11 +178,105 @@ impl RobotConfig {
                 gains: DriveGains::MANISKILL2_DEFAULT,
             }),
             base: None,
+            sides: Vec::new(),
             supported_modes: vec![
                 ControlMode::PdJointPos,
                 ControlMode::PdJointDeltaPos,
                 ControlMode::PdEeDeltaPos,
                 ControlMode::PdEeDeltaPose,
+            ],
+        })
+    }
+
+    /// ManiSkill2's mobile Pandas (`mobile_panda_single_arm`: `sides = [RIGHT_ARM]`;
+    /// `mobile_panda_dual_arm`: `[LEFT_ARM, RIGHT_ARM]`, ManiSkill2's action order) over
+    /// `urdf` (`ms2_assets::mobile_panda_*_urdf`): the base controller `base_pd_joint_vel` on
+    /// x, y, yaw and the lift (±0.5 m/s, ±3.14 rad/s, ±0.5 m/s; damping 1000, force limit 500),
+    /// then per side the arm (joint deltas ±0.1 rad also with velocity, ee deltas ±0.1 m / rad,
+    /// joint velocities ±3.14 rad/s, gains 1e3/1e2/100) and the mimic gripper over
+    /// `[-0.01, 0.04]` m. Modes: ManiSkill2's ten (`pd_joint_vel` first, its default; no
+    /// `pd_ee_delta_pose_align`), reported as `base_pd_joint_vel_arm_<mode>`.
+    ///
+    /// ```
+    /// use ms2_control::{ControlMode, RobotConfig};
+    /// let robot = RobotConfig::mobile_panda(
+    ///     "mobile_panda_single_arm",
+    ///     ms2_assets::mobile_panda_single_arm_urdf(),
+    ///     &[ms2_assets::RIGHT_ARM],
+    /// ).unwrap();
+    /// assert_eq!(robot.mode_name(ControlMode::PdJointVel), "base_pd_joint_vel_arm_pd_joint_vel");
+    /// assert_eq!(robot.arm.ee_link, "right_panda_hand_tcp");
+    /// ```
+    pub fn mobile_panda(
+        name: &str,
+        urdf: &str,
+        sides: &[ms2_assets::MobileArmSide],
+    ) -> Result<Self, BuildError> {
+        let model = Arc::new(KinematicModel::from_urdf_str(urdf)?);
+        let side_arm = |side: &ms2_assets::MobileArmSide| -> Result<SideArm, BuildError> {
+            let ee_link = side.name(ms2_assets::PANDA_TCP_LINK);
+            model.link(&ee_link)?;
+            Ok(SideArm {
+                side: side.side.to_string(),
+                arm: ArmSpec {
+                    joint_names: ms2_assets::PANDA_ARM_JOINTS
+                        .iter()
+                        .map(|j| side.name(j))
+                        .collect(),
+                    ee_link,
+                    gains: DriveGains::MANISKILL2_DEFAULT,
+                    joint_delta: 0.1,
+                    joint_delta_pos_vel: 0.1,
+                    ee_delta: 0.1,
+                    joint_velocity: MOBILE_ANGULAR_BOUND,
+                    ee_frame: EeFrame::Ee,
+                    ik: EeIkSolver::default(),
+                },
+                gripper: Some(GripperSpec {
+                    joint_names: ms2_assets::PANDA_GRIPPER_JOINTS
+                        .iter()
+                        .map(|j| side.name(j))
+                        .collect(),
+                    lower: -0.01,
+                    upper: 0.04,
+                    gains: DriveGains::MANISKILL2_DEFAULT,
+                }),
+            })
+        };
+        let sides = sides.iter().map(side_arm).collect::<Result<Vec<_>, _>>()?;
+        let primary = sides
+            .iter()
+            .find(|s| s.side == "right")
+            .or(sides.first())
+            .cloned()
+            .ok_or_else(|| BuildError::BadConfig {
+                controller: name.to_string(),
+                message: "a mobile Panda needs at least one arm".into(),
+            })?;
+        Ok(Self {
+            name: name.into(),
+            model,
+            arm: primary.arm,
+            gripper: primary.gripper,
+            base: Some(BaseSpec {
+                joint_names: owned(&ms2_assets::MOBILE_PANDA_BASE_JOINTS),
+                lower: vec![-0.5, -0.5, -MOBILE_ANGULAR_BOUND, -0.5],
+                upper: vec![0.5, 0.5, MOBILE_ANGULAR_BOUND, 0.5],
+                damping: 1000.0,
+                force_limit: 500.0,
+            }),
+            sides,
+            supported_modes: vec![
+                ControlMode::PdJointVel,
+                ControlMode::PdJointDeltaPos,
+                ControlMode::PdJointPos,
+                ControlMode::PdJointTargetDeltaPos,
+                ControlMode::PdEeDeltaPos,
+                ControlMode::PdEeDeltaPose,
+                ControlMode::PdEeTargetDeltaPos,
+                ControlMode::PdEeTargetDeltaPose,
+                ControlMode::PdJointPosVel,
+                ControlMode::PdJointDeltaPosVel,
             ],
         })
     }
@@ -214,87 +332,19 @@ impl RobotConfig {
                 }),
             ));
         }
-        parts.push(("arm".to_string(), self.arm_config(mode)));
-        if let Some(g) = &self.gripper {
-            parts.push((
-                "gripper".to_string(),
-                PartControllerConfig::JointPosition(JointPositionConfig {
-                    name: "gripper_pd_joint_pos".into(),
-                    joint_names: g.joint_names.clone(),
-                    lower: Some(vec![g.lower]),
-                    upper: Some(vec![g.upper]),
-                    use_delta: false,
-                    use_target: false,
-                    normalize_action: true,
-                    interpolate: false,
-                    mimic: true,
-                    velocity_bounds: None,
-                    gains: g.gains,
-                }),
-            ));
+        if self.sides.is_empty() {
+            parts.push(("arm".to_string(), arm_config(&self.arm, mode)));
+            if let Some(g) = &self.gripper {
+                parts.push(("gripper".to_string(), gripper_config(g)));
+            }
+        }
+        for side in &self.sides {
+            parts.push((format!("{}_arm", side.side), arm_config(&side.arm, mode)));
+            if let Some(g) = &side.gripper {
+                parts.push((format!("{}_gripper", side.side), gripper_config(g)));
+            }
         }
         Ok(parts)
-    }
-
-    fn arm_config(&self, mode: ControlMode) -> PartControllerConfig {
-        let arm = &self.arm;
-        let name = format!("arm_{}", mode.name());
-        let joint = |lower: Option<f64>, use_delta: bool, use_target: bool, velocity: bool| {
-            PartControllerConfig::JointPosition(JointPositionConfig {
-                name: name.clone(),
-                joint_names: arm.joint_names.clone(),
-                lower: lower.map(|l| vec![-l]),
-                upper: lower.map(|l| vec![l]),
-                use_delta,
-                use_target,
-                normalize_action: lower.is_some(),
-                interpolate: false,
-                mimic: false,
-                velocity_bounds: velocity.then_some((-arm.joint_velocity, arm.joint_velocity)),
-                gains: arm.gains,
-            })
-        };
-        let ee = |control_rotation: bool, use_target: bool, frame: EeFrame| {
-            PartControllerConfig::EePose(EePoseConfig {
-                name: name.clone(),
-                joint_names: arm.joint_names.clone(),
-                ee_link: arm.ee_link.clone(),
-                control_rotation,
-                pos_lower: vec![-arm.ee_delta],
-                pos_upper: vec![arm.ee_delta],
-                rot_bound: arm.ee_delta,
-                frame,
-                use_target,
-                normalize_action: true,
-                interpolate: false,
-                ik: arm.ik.clone(),
-                on_ik_failure: IkFailurePolicy::HoldCurrent,
-                gains: arm.gains,
-            })
-        };
-        match mode {
-            ControlMode::PdJointPos => joint(None, false, false, false),
-            ControlMode::PdJointDeltaPos => joint(Some(arm.joint_delta), true, false, false),
-            ControlMode::PdJointTargetDeltaPos => joint(Some(arm.joint_delta), true, true, false),
-            ControlMode::PdJointPosVel => joint(None, false, false, true),
-            ControlMode::PdJointDeltaPosVel => {
-                joint(Some(arm.joint_delta_pos_vel), true, false, true)
-            }
-            ControlMode::PdEeDeltaPos => ee(false, false, arm.ee_frame),
-            ControlMode::PdEeTargetDeltaPos => ee(false, true, arm.ee_frame),
-            ControlMode::PdEeDeltaPose => ee(true, false, arm.ee_frame),
-            ControlMode::PdEeTargetDeltaPose => ee(true, true, arm.ee_frame),
-            ControlMode::PdEeDeltaPoseAlign => ee(true, false, EeFrame::EeAligned),
-            ControlMode::PdJointVel => PartControllerConfig::JointVelocity(JointVelocityConfig {
-                name,
-                joint_names: arm.joint_names.clone(),
-                lower: vec![-arm.joint_velocity],
-                upper: vec![arm.joint_velocity],
-                normalize_action: true,
-                damping: arm.gains.damping,
-                force_limit: arm.gains.force_limit,
-            }),
-        }
     }
 
     /// Builds the combined controller of `mode` for `articulation`'s joint layout.
@@ -330,4 +380,80 @@ impl RobotConfig {
 /// Owned copies of `names`.
 fn owned(names: &[&str]) -> Vec<String> {
     names.iter().map(|s| s.to_string()).collect()
+}
+
+/// The mimic-pair position controller of a gripper.
+fn gripper_config(g: &GripperSpec) -> PartControllerConfig {
+    PartControllerConfig::JointPosition(JointPositionConfig {
+        name: "gripper_pd_joint_pos".into(),
+        joint_names: g.joint_names.clone(),
+        lower: Some(vec![g.lower]),
+        upper: Some(vec![g.upper]),
+        use_delta: false,
+        use_target: false,
+        normalize_action: true,
+        interpolate: false,
+        mimic: true,
+        velocity_bounds: None,
+        gains: g.gains,
+    })
+}
+
+/// The controller of `arm` in `mode`.
+fn arm_config(arm: &ArmSpec, mode: ControlMode) -> PartControllerConfig {
+    let name = format!("arm_{}", mode.name());
+    let joint = |lower: Option<f64>, use_delta: bool, use_target: bool, velocity: bool| {
+        PartControllerConfig::JointPosition(JointPositionConfig {
+            name: name.clone(),
+            joint_names: arm.joint_names.clone(),
+            lower: lower.map(|l| vec![-l]),
+            upper: lower.map(|l| vec![l]),
+            use_delta,
+            use_target,
+            normalize_action: lower.is_some(),
+            interpolate: false,
+            mimic: false,
+            velocity_bounds: velocity.then_some((-arm.joint_velocity, arm.joint_velocity)),
+            gains: arm.gains,
+        })
+    };
+    let ee = |control_rotation: bool, use_target: bool, frame: EeFrame| {
+        PartControllerConfig::EePose(EePoseConfig {
+            name: name.clone(),
+            joint_names: arm.joint_names.clone(),
+            ee_link: arm.ee_link.clone(),
+            control_rotation,
+            pos_lower: vec![-arm.ee_delta],
+            pos_upper: vec![arm.ee_delta],
+            rot_bound: arm.ee_delta,
+            frame,
+            use_target,
+            normalize_action: true,
+            interpolate: false,
+            ik: arm.ik.clone(),
+            on_ik_failure: IkFailurePolicy::HoldCurrent,
+            gains: arm.gains,
+        })
+    };
+    match mode {
+        ControlMode::PdJointPos => joint(None, false, false, false),
+        ControlMode::PdJointDeltaPos => joint(Some(arm.joint_delta), true, false, false),
+        ControlMode::PdJointTargetDeltaPos => joint(Some(arm.joint_delta), true, true, false),
+        ControlMode::PdJointPosVel => joint(None, false, false, true),
+        ControlMode::PdJointDeltaPosVel => joint(Some(arm.joint_delta_pos_vel), true, false, true),
+        ControlMode::PdEeDeltaPos => ee(false, false, arm.ee_frame),
+        ControlMode::PdEeTargetDeltaPos => ee(false, true, arm.ee_frame),
+        ControlMode::PdEeDeltaPose => ee(true, false, arm.ee_frame),
+        ControlMode::PdEeTargetDeltaPose => ee(true, true, arm.ee_frame),
+        ControlMode::PdEeDeltaPoseAlign => ee(true, false, EeFrame::EeAligned),
+        ControlMode::PdJointVel => PartControllerConfig::JointVelocity(JointVelocityConfig {
+            name,
+            joint_names: arm.joint_names.clone(),
+            lower: vec![-arm.joint_velocity],
+            upper: vec![arm.joint_velocity],
+            normalize_action: true,
+            damping: arm.gains.damping,
+            force_limit: arm.gains.force_limit,
+        }),
+    }
 }

@@ -108,7 +108,12 @@ def test_every_obs_control_and_reward_mode_steps(env_id):
 
 
 #: Tasks whose ManiSkill2 dense reward can be negative.
-PENALISED_REWARDS = {"PegInsertionSide-v0", "PlugCharger-v0"}
+PENALISED_REWARDS = {
+    "PegInsertionSide-v0",
+    "PlugCharger-v0",
+    "OpenCabinetDrawer-v1",
+    "OpenCabinetDoor-v1",
+}
 
 
 def test_seeded_resets_are_reproducible(env_id):

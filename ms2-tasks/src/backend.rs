@@ -36,6 +36,12 @@ pub(crate) trait EnvBackend: Send {
     fn apply_action(&mut self, action: &[f32]) -> Result<(), EnvError>;
     /// The full privileged `state_dict` observation.
     fn observe_state_dict(&self) -> ObsValue;
+    /// The `state_dict` the visual obs modes start from (before `extra` is filtered to the
+    /// non-privileged keys): [`Backend::observe_state_dict`] plus any visual-mode-only entries
+    /// (ManiSkill2's mobile robots' `base_pose`, the MS1 tasks' target link data).
+    fn observe_visual_state_dict(&self) -> ObsValue {
+        self.observe_state_dict()
+    }
     /// Success and evaluation terms of the current state.
     fn evaluate(&self) -> Evaluation;
     /// The `particles` entry of the `particles` obs mode; `None` for envs without particles.

@@ -239,7 +239,7 @@ impl Env {
     /// [`crate::sensors::visual_obs::assemble`] turns into the observation given the frame.
     fn observe_deferred(&self) -> ObsValue {
         match self.obs_mode.visual() {
-            Some(_) => self.backend.observe_state_dict(),
+            Some(_) => self.backend.observe_visual_state_dict(),
             None => self.observe(),
         }
     }
@@ -370,7 +370,7 @@ impl Env {
             Some((layout, robot_seg)) => {
                 let frame = self.backend.capture_cameras()?;
                 Ok(crate::sensors::visual_obs::assemble(
-                    self.backend.observe_state_dict(),
+                    self.backend.observe_visual_state_dict(),
                     self.spec.non_privileged_extra_keys,
                     frame,
                     layout,
@@ -385,7 +385,10 @@ impl Env {
     /// full observation; in visual modes only its non-image part (`agent` and the
     /// non-privileged `extra`; [`Env::try_observe`] adds the images).
     pub fn observe(&self) -> ObsValue {
-        let dict = self.backend.observe_state_dict();
+        let dict = match self.obs_mode.visual() {
+            Some(_) => self.backend.observe_visual_state_dict(),
+            None => self.backend.observe_state_dict(),
+        };
         match self.obs_mode {
             ObsMode::None => ObsValue::Dict(Vec::new()),
             ObsMode::Image

@@ -8,7 +8,7 @@
 //! | every reset, first | [`Task::prepare_episode`] (per-episode scene choices, e.g. the object model or an obstacle layout; returns whether the scene must be rebuilt) |
 //! | make / `reset(reconfigure = true)` / a rebuild asked for | [`Task::build_scene`] on a fresh world, with the episode's RNG (add actors to the world) |
 //! | every reset, in this order | [`Task::initialize_actors`], [`Task::initialize_agent`] (default: the robot's reset, rest qpos + noise), [`Task::initialize_task`] |
-//! | every observation | [`Task::extra_obs`] (the `extra` dict) |
+//! | every observation | [`Task::extra_obs`] (the `extra` dict; in visual obs modes also [`Task::visual_extra_obs`]) |
 //! | every step | [`Task::evaluate`], then [`Task::dense_reward`] |
 //! | `get_state` / `set_state` | [`Task::task_state`] / [`Task::set_task_state`] |
 //! | soft-body tasks only | [`Task::soft`]: one [`SoftComponent`] (substeps after each physics step, particles observed and drawn) |
@@ -102,6 +102,11 @@ pub trait Task: Any + Send {
     /// Appends the task's entries of the observation's `extra` dict (privileged: all state;
     /// the spec's `non_privileged_extra_keys` say which a real robot would know).
     fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder);
+
+    /// Appends `extra` entries that exist only in the visual obs modes (ManiSkill2's MS1 tasks
+    /// observe the target link there, their privileged state in the state modes); the spec's
+    /// `non_privileged_extra_keys` must name them. Default: none.
+    fn visual_extra_obs(&self, _scene: &TaskScene, _extra: &mut DictBuilder) {}
 
     /// Success and evaluation terms of the current state.
     fn evaluate(&self, scene: &TaskScene) -> Evaluation;

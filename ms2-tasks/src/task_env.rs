@@ -14,7 +14,6 @@ use crate::agents::{robot_spec, RobotSpec, CONTROL_MODE_ALIASES};
 use crate::backend::EnvBackend;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
-use crate::geometry::vectorize_pose;
 use crate::info::Evaluation;
 use crate::obs::{DictBuilder, ObsValue};
 use crate::rigid_world::RigidEngine;
@@ -42,6 +41,8 @@ pub(crate) struct TaskEnv {
     timing: ControlTiming,
     substeps: u32,
     control_modes: Vec<String>,
+    /// The active control mode's name as users pass it (the robot's prefix included).
+    control_mode_name: String,
     action_space: BoxSpace,
     /// The observation cameras (checked when the env is made, in every build).
     #[cfg(feature = "render")]
@@ -81,9 +82,12 @@ impl TaskEnv {
         let robot = robot_spec(agent_name)?;
         let supported: Vec<ControlMode> = (robot.control_modes)()
             .into_iter()
-            .filter(|m| spec.control_modes.is_empty() || spec.control_modes.contains(&m.name()))
+            .filter(|m| {
+                spec.control_modes.is_empty()
+                    || spec.control_modes.contains(&robot.mode_name(*m).as_str())
+            })
             .collect();
-        let control_modes: Vec<String> = supported.iter().map(|m| m.name().to_owned()).collect();
+        let control_modes: Vec<String> = supported.iter().map(|&m| robot.mode_name(m)).collect();
         // The task's default for its default robot, else the robot's own first mode
         // (ManiSkill2: the agent's first mode; `xmate3_robotiq` starts with `pd_joint_pos`).
         let default_mode = if robot_uid == Some(spec.default_robot()) {
@@ -97,11 +101,11 @@ impl TaskEnv {
         let mode = supported
             .iter()
             .copied()
-            .find(|m| {
-                m.name() == mode_name
+            .find(|&m| {
+                robot.mode_name(m) == mode_name
                     || CONTROL_MODE_ALIASES
                         .iter()
-                        .any(|(alias, aliased)| *alias == mode_name && aliased == m)
+                        .any(|(alias, aliased)| *alias == mode_name && *aliased == m)
             })
             .ok_or_else(|| EnvError::UnknownControlMode {
                 got: mode_name.to_owned(),
@@ -161,6 +165,7 @@ impl TaskEnv {
             timing,
             substeps,
             control_modes,
+            control_mode_name: robot.mode_name(mode),
             action_space,
             #[cfg(feature = "render")]
             camera_cfgs,
@@ -172,6 +177,22 @@ impl TaskEnv {
             #[cfg(feature = "render")]
             sensors: Mutex::new(None),
         })
+    }
+
+    /// The privileged `state_dict`: the agent's proprioception and the task's `extra` (with
+    /// the task's visual-mode entries when `visual`).
+    fn state_dict(&self, visual: bool) -> ObsValue {
+        let TaskScene { world, agent } = &self.scene;
+        let agent_obs = agent.proprioception(world.as_ref(), visual);
+        let mut extra = DictBuilder::new();
+        self.task.extra_obs(&self.scene, &mut extra);
+        if visual {
+            self.task.visual_extra_obs(&self.scene, &mut extra);
+        }
+        let mut root = DictBuilder::new();
+        root.push("agent", agent_obs.build());
+        root.push("extra", extra.build());
+        root.build()
     }
 
     /// The goal marker's position (m, world): the `extra` entry `goal_key` of the state.
@@ -276,7 +297,7 @@ impl EnvBackend for TaskEnv {
     }
 
     fn control_mode(&self) -> &str {
-        self.scene.agent.control_mode().name()
+        &self.control_mode_name
     }
 
     fn action_space(&self) -> &BoxSpace {
@@ -342,32 +363,11 @@ impl EnvBackend for TaskEnv {
     }
 
     fn observe_state_dict(&self) -> ObsValue {
-        let TaskScene { world, agent } = &self.scene;
-        let world = world.as_ref();
-        let mut agent_obs = DictBuilder::new();
-        agent_obs.push_vector("qpos", &agent.qpos(world));
-        agent_obs.push_vector("qvel", &agent.qvel(world));
-        // Target-accumulating modes also report their targets under the key each controller
-        // names (`target_qpos`, `target_pose`), as ManiSkill2 does.
-        let ctrl_state = agent.controller().state_entries();
-        if !ctrl_state.is_empty() {
-            let mut ctrl = DictBuilder::new();
-            for entry in ctrl_state {
-                let values: Vec<f32> = entry.values.iter().map(|&v| v as f32).collect();
-                ctrl.push(
-                    &entry.part,
-                    DictBuilder::new().vector(&entry.key, &values).build(),
-                );
-            }
-            agent_obs.push("controller", ctrl.build());
-        }
-        agent_obs.push_vector("base_pose", &vectorize_pose(&agent.base_pose()));
-        let mut extra = DictBuilder::new();
-        self.task.extra_obs(&self.scene, &mut extra);
-        let mut root = DictBuilder::new();
-        root.push("agent", agent_obs.build());
-        root.push("extra", extra.build());
-        root.build()
+        self.state_dict(false)
+    }
+
+    fn observe_visual_state_dict(&self) -> ObsValue {
+        self.state_dict(true)
     }
 
     fn evaluate(&self) -> Evaluation {

@@ -11,6 +11,8 @@
 //! | `panda` | Franka Panda, two-finger gripper, ManiSkill2's base pose | every mode of [`ms2_control::RobotConfig::panda`] |
 //! | `panda_bucket` | the Panda with a bucket fixed to its hand (soft-body tasks) | the same |
 //! | `panda_avoid_obstacles` | the Panda at the world origin with PandaAvoidObstacles' cameras (ManiSkill2's `PandaRealSensed435Config`) | the same as `panda` |
+//! | `mobile_panda_single_arm` | holonomic base (x, y, yaw) with a lift and one Panda; three overhead cameras on the base (ManiSkill2's MS1 robot) | `base_pd_joint_vel_arm_<mode>` for ManiSkill2's ten arm modes, `base_pd_joint_vel_arm_pd_joint_vel` first |
+//! | `mobile_panda_dual_arm` | the same base with two Pandas (left and right) | the same |
 //! | `xmate3_robotiq` | ROKAE xMate3 arm with a Robotiq two-finger gripper (ManiSkill2's second robot) | `pd_joint_pos` (default), `pd_joint_delta_pos` (also by ManiSkill2's name `arm_pd_joint_delta_pos`), `pd_ee_delta_pos`, `pd_ee_delta_pose` |
 //!
 //! Both robots are [`GripperArmAgent`]s: one agent type over the data of a
@@ -20,6 +22,7 @@
 //! [`ROBOTS`]; see docs/architecture.md, "How to add a robot".
 
 pub mod gripper_arm;
+pub mod mobile_panda;
 pub mod panda;
 pub mod panda_model;
 pub mod xmate3;
@@ -31,7 +34,8 @@ use ms2_control::{CombinedController, ControlMode, ControlTiming};
 use ms2_physics::{ArticulationId, BodyId};
 
 use crate::error::EnvError;
-use crate::geometry::Pose3;
+use crate::geometry::{vectorize_pose, Pose3};
+use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
 
@@ -92,6 +96,38 @@ pub trait Agent: Any + Send + Debug {
     fn is_grasping(&self, world: &dyn RigidWorld, object: BodyId, max_angle_deg: f32) -> bool;
     /// Bodies of the gripper's fingers (empty without a gripper).
     fn finger_bodies(&self) -> Vec<BodyId>;
+
+    /// The observation's `agent` dict. `visual`: the obs mode is a visual one. Default
+    /// (ManiSkill2's fixed-base arms): `qpos`, `qvel`, the controller state of
+    /// target-accumulating modes (`controller`), `base_pose`. Mobile robots
+    /// ([`mobile_panda::MobilePandaAgent`]) report their base joints separately.
+    fn proprioception(&self, world: &dyn RigidWorld, visual: bool) -> DictBuilder {
+        let _ = visual;
+        let mut obs = DictBuilder::new();
+        obs.push_vector("qpos", &self.qpos(world));
+        obs.push_vector("qvel", &self.qvel(world));
+        push_controller_state(self, &mut obs);
+        obs.push_vector("base_pose", &vectorize_pose(&self.base_pose()));
+        obs
+    }
+}
+
+/// Appends `controller` (the targets of target-accumulating modes, under the key each part
+/// names: `target_qpos`, `target_pose`, as ManiSkill2 does) when the controller has state.
+pub fn push_controller_state<A: Agent + ?Sized>(agent: &A, obs: &mut DictBuilder) {
+    let ctrl_state = agent.controller().state_entries();
+    if ctrl_state.is_empty() {
+        return;
+    }
+    let mut ctrl = DictBuilder::new();
+    for entry in ctrl_state {
+        let values: Vec<f32> = entry.values.iter().map(|&v| v as f32).collect();
+        ctrl.push(
+            &entry.part,
+            DictBuilder::new().vector(&entry.key, &values).build(),
+        );
+    }
+    obs.push("controller", ctrl.build());
 }
 
 impl dyn Agent {
@@ -117,6 +153,9 @@ pub struct RobotSpec {
     pub description: &'static str,
     /// The control modes it supports, default first.
     pub control_modes: fn() -> Vec<ControlMode>,
+    /// Prefix of its control modes' names (`""`; mobile robots `"base_pd_joint_vel_arm_"`, as
+    /// ManiSkill2 names them: `base_pd_joint_vel_arm_pd_ee_delta_pose`).
+    pub mode_prefix: &'static str,
     /// Its observation cameras (`base_camera`, `hand_camera` as ManiSkill2 mounts them).
     pub cameras: fn() -> Vec<crate::sensors::CameraConfig>,
     /// The camera of human renders (`render_mode="rgb_array"`).
@@ -125,12 +164,21 @@ pub struct RobotSpec {
     pub build: BuildAgent,
 }
 
+impl RobotSpec {
+    /// The name users pass as `control_mode` for `mode`.
+    pub fn mode_name(&self, mode: ControlMode) -> String {
+        format!("{}{}", self.mode_prefix, mode.name())
+    }
+}
+
 /// The registered robots.
 pub const ROBOTS: &[RobotSpec] = &[
     panda::PANDA,
     panda::PANDA_BUCKET,
     panda::PANDA_AVOID_OBSTACLES,
     xmate3::XMATE3_ROBOTIQ,
+    mobile_panda::MOBILE_PANDA_SINGLE_ARM,
+    mobile_panda::MOBILE_PANDA_DUAL_ARM,
 ];
 
 /// ManiSkill2's other names of control modes: `xmate3_robotiq` registers its joint-delta mode

@@ -22,6 +22,7 @@ pub const PANDA: RobotSpec = RobotSpec {
     description: "Franka Emika Panda with its two-finger gripper (the real meshes of the asset \
                   group franka_description when fetched, else ms2_assets::PANDA_URDF)",
     control_modes: panda_control_modes,
+    mode_prefix: "",
     cameras: crate::sensors::CameraConfig::panda_defaults,
     render_camera: crate::sensors::CameraConfig::render_camera,
     build: |world, mode, timing| {
@@ -38,6 +39,7 @@ pub const PANDA_BUCKET: RobotSpec = RobotSpec {
     description: "the Panda with a bucket fixed to its hand (ms2_assets::PANDA_BUCKET_URDF; the \
                   real Panda's meshes on its links when fetched)",
     control_modes: panda_control_modes,
+    mode_prefix: "",
     cameras: crate::sensors::CameraConfig::panda_defaults,
     render_camera: crate::sensors::CameraConfig::render_camera,
     build: |world, mode, timing| {
@@ -61,6 +63,7 @@ pub const PANDA_AVOID_OBSTACLES: RobotSpec = RobotSpec {
     name: "panda_avoid_obstacles",
     description: "the Panda at the world origin with the cameras of PandaAvoidObstacles-v0",
     control_modes: panda_control_modes,
+    mode_prefix: "",
     cameras: crate::sensors::CameraConfig::avoid_obstacles_defaults,
     render_camera: crate::sensors::CameraConfig::avoid_obstacles_render_camera,
     build: |world, mode, timing| {

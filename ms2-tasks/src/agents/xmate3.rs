@@ -28,6 +28,7 @@ pub const XMATE3_ROBOTIQ: RobotSpec = RobotSpec {
     description: "ROKAE xMate3 arm with a Robotiq two-finger gripper \
                   (ms2_assets::XMATE3_ROBOTIQ_URDF)",
     control_modes: xmate3_control_modes,
+    mode_prefix: "",
     cameras: crate::sensors::CameraConfig::xmate3_defaults,
     render_camera: crate::sensors::CameraConfig::xmate3_render_camera,
     build: |world, mode, timing| {

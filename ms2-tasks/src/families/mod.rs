@@ -17,6 +17,7 @@ pub mod articulated;
 pub mod assembly;
 pub mod dummy;
 pub mod misc;
+pub mod mobile;
 pub mod objects;
 pub mod rigid;
 #[cfg(feature = "soft")]
@@ -33,5 +34,6 @@ pub(crate) fn register_builtin(r: &mut Registrar) {
     #[cfg(feature = "soft")]
     soft::register(r);
     misc::register(r);
+    mobile::register(r);
     dummy::register(r);
 }

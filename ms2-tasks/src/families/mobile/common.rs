@@ -1,0 +1,204 @@
+//! The shared base of ManiSkill2's mobile-manipulation (MS1) tasks: the robot placed on a ring
+//! around the object, facing it; the privileged `extra` entries every MS1 task observes
+//! (padded articulation states, actor states, finger tips and velocities); the link static
+//! check of their success metrics; the spec defaults.
+//!
+//! ManiSkill2's MS1 observation: in the state modes `extra` is privileged state only
+//! (`actors` if any, `articulations`, `fingers_pos`, `fingers_vel`, then the task's own
+//! entries); in the visual modes it is what a real robot would know instead (the target data
+//! and the TCP poses), pushed by [`crate::task::Task::visual_extra_obs`]. The agent part is the
+//! mobile robot's ([`crate::agents::mobile_panda`]).
+
+use std::f32::consts::PI;
+
+use ms2_physics::{ArticulationId, BodyId};
+use nalgebra::Vector3;
+use rand::Rng;
+
+use crate::agents::mobile_panda::MobilePandaAgent;
+use crate::error::EnvError;
+use crate::geometry::{pose_xyz_yaw, vectorize_pose, Pose3};
+use crate::obs::DictBuilder;
+use crate::rigid_world::RigidWorld;
+use crate::seeding::EpisodeRng;
+use crate::spec::{RobotChoice, RIGID_OBS_MODES};
+use crate::task::TaskScene;
+use crate::ObsMode;
+
+/// Default control mode of the MS1 tasks (the mobile robots' first mode, as in ManiSkill2).
+pub const MS1_CONTROL_MODE: &str = "base_pd_joint_vel_arm_pd_joint_vel";
+/// Episode limit of the MS1 tasks.
+pub const MS1_MAX_EPISODE_STEPS: u32 = 200;
+/// Obs modes of the MS1 tasks.
+pub const MS1_OBS_MODES: &[ObsMode] = RIGID_OBS_MODES;
+/// Robots of the one-arm MS1 tasks (OpenCabinetDoor / Drawer).
+pub const SINGLE_ARM_ROBOTS: &[RobotChoice] = &[RobotChoice::same("mobile_panda_single_arm")];
+/// Robots of the two-arm MS1 tasks (PushChair, MoveBucket).
+pub const DUAL_ARM_ROBOTS: &[RobotChoice] = &[RobotChoice::same("mobile_panda_dual_arm")];
+/// Largest yaw noise (rad) of the robot's start orientation (ManiSkill2: ±0.05π).
+pub const BASE_YAW_NOISE: f32 = 0.05 * PI;
+
+/// The mobile robot of a scene (an error if the task runs another robot).
+pub fn mobile_agent(scene: &TaskScene) -> Result<&MobilePandaAgent, EnvError> {
+    scene
+        .agent
+        .downcast_ref::<MobilePandaAgent>()
+        .ok_or_else(|| {
+            EnvError::InvalidConfig(format!(
+                "robot {:?}: the mobile-manipulation tasks need a mobile Panda",
+                scene.agent.name()
+            ))
+        })
+}
+
+/// Where the robot starts: on a ring around `center` (m, world xy), facing it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaseRing {
+    /// Centre of the ring (m, world xy).
+    pub center: [f32; 2],
+    /// Radius range (m), drawn uniformly.
+    pub radius: [f32; 2],
+    /// Angle range (rad, world, of the robot as seen from the centre), drawn uniformly.
+    pub angle: [f32; 2],
+}
+
+impl BaseRing {
+    /// Draws (in this order) the radius r, the angle θ and a yaw noise in ±[`BASE_YAW_NOISE`];
+    /// the base goes to `center + r (cos θ, sin θ)` with yaw `θ − π + noise` (facing the
+    /// centre), ManiSkill2's MS1 robot reset.
+    pub fn sample(&self, rng: &mut EpisodeRng) -> Pose3 {
+        let r = rng.random_range(self.radius[0]..=self.radius[1]);
+        let theta = rng.random_range(self.angle[0]..=self.angle[1]);
+        let noise = rng.random_range(-BASE_YAW_NOISE..=BASE_YAW_NOISE);
+        let [cx, cy] = self.center;
+        pose_xyz_yaw(
+            [cx + r * theta.cos(), cy + r * theta.sin(), 0.0],
+            theta - PI + noise,
+        )
+    }
+}
+
+/// Puts the scene's robot at `base` (x, y, yaw) with its MS1 start posture (lift 1e-4 m, arms
+/// at rest, no noise).
+pub fn place_robot(
+    scene: &mut TaskScene,
+    base: Pose3,
+    rng: &mut EpisodeRng,
+) -> Result<(), EnvError> {
+    let TaskScene { world, agent } = scene;
+    agent.set_base_pose(base);
+    agent.initialize(world.as_mut(), rng)
+}
+
+/// ManiSkill2's actor state: position (3), quaternion wxyz (4), linear velocity (3), angular
+/// velocity (3); world frame.
+pub fn actor_state(world: &dyn RigidWorld, body: BodyId) -> Result<[f32; 13], EnvError> {
+    let pose = world.body_pose(body)?;
+    let v = world.body_linear_velocity(body)?;
+    let w = world.body_angular_velocity(body)?;
+    let mut s = [0.0; 13];
+    s[..7].copy_from_slice(&vectorize_pose(&pose));
+    s[7..10].copy_from_slice(v.as_slice());
+    s[10..].copy_from_slice(w.as_slice());
+    Ok(s)
+}
+
+/// ManiSkill2's padded articulation state: the root link's actor state (13), then qpos and
+/// qvel each zero-padded to `max_dof` (13 + 2·`max_dof` values). Errors if the articulation has
+/// more dofs than `max_dof`.
+pub fn articulation_padded_state(
+    world: &dyn RigidWorld,
+    art: ArticulationId,
+    max_dof: usize,
+) -> Result<Vec<f32>, EnvError> {
+    let root = world.link_body(art, 0)?;
+    let qpos = world.qpos(art)?;
+    let qvel = world.qvel(art)?;
+    if qpos.len() > max_dof {
+        return Err(EnvError::InvalidConfig(format!(
+            "articulation with {} dofs: expected at most {max_dof}",
+            qpos.len()
+        )));
+    }
+    let mut s = Vec::with_capacity(13 + 2 * max_dof);
+    s.extend_from_slice(&actor_state(world, root)?);
+    for values in [&qpos, &qvel] {
+        s.extend_from_slice(values);
+        s.resize(s.len() + max_dof - values.len(), 0.0);
+    }
+    Ok(s)
+}
+
+/// Appends ManiSkill2's MS1 privileged entries of `extra`, in its order: `actors` (the
+/// concatenated actor states of `actors`, when there are any), `articulations` (the padded
+/// states of `articulations`, each `(articulation, max_dof)`), `fingers_pos` (the finger tips,
+/// 3 per finger) and `fingers_vel` (the finger links' linear velocities, 3 per finger).
+pub fn push_privileged_extra(
+    scene: &TaskScene,
+    actors: &[BodyId],
+    articulations: &[(ArticulationId, usize)],
+    extra: &mut DictBuilder,
+) -> Result<(), EnvError> {
+    let world = scene.world.as_ref();
+    if !actors.is_empty() {
+        let mut states = Vec::with_capacity(13 * actors.len());
+        for &body in actors {
+            states.extend_from_slice(&actor_state(world, body)?);
+        }
+        extra.push_vector("actors", &states);
+    }
+    let mut states = Vec::new();
+    for &(art, max_dof) in articulations {
+        states.extend(articulation_padded_state(world, art, max_dof)?);
+    }
+    extra.push_vector("articulations", &states);
+    let agent = mobile_agent(scene)?;
+    let flat = |v: Vec<Vector3<f32>>| v.iter().flat_map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>();
+    extra.push_vector("fingers_pos", &flat(agent.finger_tips(world)));
+    extra.push_vector("fingers_vel", &flat(agent.finger_velocities(world)));
+    Ok(())
+}
+
+/// Linear (m/s) and angular (rad/s) speed of `body`.
+pub fn body_speeds(world: &dyn RigidWorld, body: BodyId) -> (f32, f32) {
+    let v = world
+        .body_linear_velocity(body)
+        .map_or(f32::INFINITY, |v| v.norm());
+    let w = world
+        .body_angular_velocity(body)
+        .map_or(f32::INFINITY, |w| w.norm());
+    (v, w)
+}
+
+/// Whether `body` moves at most `max_v` m/s and turns at most `max_ang_v` rad/s (ManiSkill2's
+/// `check_actor_static`, from the body's velocities).
+pub fn body_is_static(world: &dyn RigidWorld, body: BodyId, max_v: f32, max_ang_v: f32) -> bool {
+    let (v, w) = body_speeds(world, body);
+    v <= max_v && w <= max_ang_v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::seeding::episode_rng;
+
+    #[test]
+    fn ring_samples_face_the_centre_within_the_ranges() {
+        let ring = BaseRing {
+            center: [0.0, 0.8],
+            radius: [1.6, 1.8],
+            angle: [0.9 * PI, 1.1 * PI],
+        };
+        let mut rng = episode_rng(7);
+        for _ in 0..100 {
+            let pose = ring.sample(&mut rng);
+            let p = pose.translation.vector;
+            let to_centre = Vector3::new(0.0 - p.x, 0.8 - p.y, 0.0);
+            let r = to_centre.norm();
+            assert!((1.6..=1.8).contains(&r), "radius {r}");
+            let facing = pose.rotation * Vector3::x();
+            let angle = facing.angle(&to_centre);
+            assert!(angle <= BASE_YAW_NOISE + 1e-4, "faces the centre: {angle}");
+        }
+    }
+}

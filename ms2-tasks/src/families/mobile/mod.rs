@@ -1,0 +1,65 @@
+//! Mobile manipulation (ManiSkill2's MS1 tasks) on the mobile Pandas
+//! ([`crate::agents::mobile_panda`]): `OpenCabinetDrawer-v1`, `OpenCabinetDoor-v1`.
+//!
+//! [`common`] is the family's shared base: the robot's start on a ring around the object, the
+//! privileged `extra` entries, the static check, the spec defaults. [`handles`] reads handle
+//! geometry from a model's URDF. Each task is its hooks and spec.
+
+pub mod common;
+pub mod handles;
+pub mod open_cabinet;
+pub mod scripted;
+
+pub use open_cabinet::{CabinetTarget, OpenCabinet};
+
+use common::{MS1_CONTROL_MODE, MS1_MAX_EPISODE_STEPS, MS1_OBS_MODES, SINGLE_ARM_ROBOTS};
+
+use crate::registry::{Registrar, TaskRegistration};
+use crate::spec::TaskSpec;
+
+/// The visual modes' `extra` of the cabinet tasks.
+const CABINET_VISUAL_EXTRA: &[&str] = &[
+    "target_angle_diff",
+    "target_joint_axis",
+    "target_link_pos",
+    "tcp_pose",
+];
+
+/// `OpenCabinetDrawer-v1`'s spec.
+pub const OPEN_CABINET_DRAWER: TaskSpec = TaskSpec {
+    env_id: "OpenCabinetDrawer-v1",
+    family: "mobile",
+    summary: "open a cabinet's target drawer to 90 % of its range with a mobile Panda",
+    max_episode_steps: MS1_MAX_EPISODE_STEPS,
+    robots: SINGLE_ARM_ROBOTS,
+    control_modes: &[],
+    default_control_mode: MS1_CONTROL_MODE,
+    obs_modes: MS1_OBS_MODES,
+    non_privileged_extra_keys: CABINET_VISUAL_EXTRA,
+    goal_marker: None,
+    soft_bodies: false,
+    assets: &[],
+};
+
+/// `OpenCabinetDoor-v1`'s spec.
+pub const OPEN_CABINET_DOOR: TaskSpec = TaskSpec {
+    env_id: "OpenCabinetDoor-v1",
+    summary: "open a cabinet's target door to 90 % of its range with a mobile Panda",
+    ..OPEN_CABINET_DRAWER
+};
+
+/// Registers the family.
+pub fn register(r: &mut Registrar) {
+    r.add(
+        TaskRegistration::new(OPEN_CABINET_DRAWER, |_| {
+            Ok(Box::new(OpenCabinet::new(CabinetTarget::Drawer)?))
+        })
+        .scripted(scripted::policy),
+    );
+    r.add(
+        TaskRegistration::new(OPEN_CABINET_DOOR, |_| {
+            Ok(Box::new(OpenCabinet::new(CabinetTarget::Door)?))
+        })
+        .scripted(scripted::policy),
+    );
+}
