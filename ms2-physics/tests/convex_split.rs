@@ -2,7 +2,9 @@
 //! flat on the ground once split (rapier keeps 4 contact vertices per face).
 
 use ms2_physics::mesh::split_convex_for_contact;
-use ms2_physics::{ActorDesc, ActorKind, MassSpec, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig};
+use ms2_physics::{
+    ActorDesc, ActorKind, MassSpec, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig,
+};
 use nalgebra::{Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d::shape::Shape;
 

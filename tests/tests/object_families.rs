@@ -6,10 +6,10 @@ use ms2_assets::objects::{
     ensure_family, load_model_db, model_files, read_collision_pieces, ObjectFamily, ObjectKind,
     Split,
 };
+use ms2_physics::mesh::split_convex_for_contact;
 use ms2_physics::{
     ActorDesc, ActorKind, MassSpec, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig,
 };
-use ms2_physics::mesh::split_convex_for_contact;
 use nalgebra::Point3;
 
 /// Drops a model from 3 cm above the ground, slightly tilted; returns (mass, resting speed,
