@@ -513,3 +513,15 @@ def test_soak_runs_every_obs_mode_of_a_task_in_worker_processes(capsys):
     assert "soak:" in capsys.readouterr().out
     with pytest.raises(ValueError, match="jobs must be an int in \\[1, 64\\], got 0"):
         run_soak(10, jobs=0)
+
+
+def test_soak_restores_only_states_of_the_current_episode():
+    """TurnFaucet loads another faucet (maybe with another handle count, so another state
+    length) at every reset: the soak's set_state calls restore states of the episode they were
+    recorded in, so none is refused over several resets."""
+    from ms2.soak import soak_pair
+
+    row = soak_pair("TurnFaucet-v0", "state", 1200, seed=7)
+    assert row["resets"] >= 5, row
+    assert row["set_states"] > 0, row
+    assert row["errors"] == {} and row["non_finite"] == 0, row

@@ -4,8 +4,8 @@ errors rather than speed.
 Each (task, obs mode) pair gets a share of ``--steps`` env steps (default 1,000,000) in one env:
 random actions, resets when an episode ends (every tenth with ``reconfigure``), and with
 probability ``SET_STATE_PROBABILITY`` per step a ``set_state`` of a state recorded earlier in the
-run in the env's current model (any episode since the last reconfigure: a state recorded on one
-asset, such as a faucet with two handles, is not a state of another). Shares are weighted by cost, so the rigid-body state modes take
+run's current episode (a reset may load another model, as ManiSkill2's TurnFaucet does at every
+reset, and a state of one faucet is not a state of another with more handles). Shares are weighted by cost, so the rigid-body state modes take
 most steps and the rendering and soft-body pairs fewer (``WEIGHTS``); every pair runs at least
 ``MIN_STEPS``. Printed per pair and in total: steps, steps/s, resident memory (RSS) at the start
 and end, NaN/inf observations or rewards handed out (must be 0), and errors by type with the
@@ -29,7 +29,7 @@ import numpy as np
 
 #: Chance per step of restoring a random recorded state instead of stepping on.
 SET_STATE_PROBABILITY = 0.02
-#: Recorded states kept per env (a random subset of the run's states).
+#: Recorded states kept per episode (a random subset of the episode's states).
 STATE_POOL = 256
 #: Relative step shares: rigid-body state modes, visual modes, soft-body tasks (state), both.
 WEIGHTS = {"rigid_state": 1.0, "rigid_visual": 0.05, "soft_state": 0.05, "soft_visual": 0.01}
@@ -113,15 +113,14 @@ def soak_pair(env_id: str, obs_mode: str, steps: int, seed: int) -> dict[str, An
                 pool[int(rng.integers(STATE_POOL))] = state
             if terminated or truncated:
                 resets += 1
-                reconfigure = resets % 10 == 0
-                env.reset(seed=int(rng.integers(2**32)), options={"reconfigure": reconfigure})
-                if reconfigure:
-                    pool.clear()  # the recorded states belong to the model just replaced
+                env.reset(seed=int(rng.integers(2**32)), options={"reconfigure": resets % 10 == 0})
+                pool.clear()  # the recorded states belong to the episode just ended
         except (ValueError, TypeError, RuntimeError) as err:
             error(err)
             done_steps += 1
             try:
                 env.reset(seed=int(rng.integers(2**32)))
+                pool.clear()
             except (ValueError, TypeError, RuntimeError) as err2:
                 error(err2)
                 break
