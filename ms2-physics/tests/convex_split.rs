@@ -1,5 +1,6 @@
 //! `split_convex_for_contact`: the pieces add up to the hull, and a flat many-sided face rests
 //! flat on the ground once split (rapier keeps 4 contact vertices per face).
+#![cfg(feature = "rapier")] // These tests drive the rapier `World`.
 
 use ms2_physics::mesh::split_convex_for_contact;
 use ms2_physics::{
