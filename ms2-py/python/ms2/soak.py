@@ -4,12 +4,12 @@ errors rather than speed.
 Each (task, obs mode) pair gets a share of ``--steps`` env steps (default 1,000,000) in one env:
 random actions, resets when an episode ends (every tenth with ``reconfigure``), and with
 probability ``SET_STATE_PROBABILITY`` per step a ``set_state`` of a state recorded earlier in the
-run's current episode (a reset may load another model, as ManiSkill2's TurnFaucet does at every
-reset, and a state of one faucet is not a state of another with more handles). Shares are weighted by cost, so the rigid-body state modes take
-most steps and the rendering and soft-body pairs fewer (``WEIGHTS``); every pair runs at least
-``MIN_STEPS``. Printed per pair and in total: steps, steps/s, resident memory (RSS) at the start
-and end, NaN/inf observations or rewards handed out (must be 0), and errors by type with the
-first messages.
+current episode (a reset may load another model, as ManiSkill2's TurnFaucet does at every reset,
+and a state of one faucet is not a state of another with more handles). Shares are weighted by
+cost, so the rigid-body state modes take most steps and the rendering and soft-body pairs fewer
+(``WEIGHTS``); every pair runs at least ``MIN_STEPS``. Printed per pair and in total: steps,
+steps/s, resident memory (RSS) at the start and end, NaN/inf observations or rewards handed out
+(must be 0), and errors by type with the first messages.
 
 ``--jobs N`` runs the pairs in N worker processes (each worker soaks pair after pair, so its
 memory at the end of its last pair still shows a leak across pairs); rows are printed as pairs
