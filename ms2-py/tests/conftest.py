@@ -41,6 +41,18 @@ def assert_obs_equal(a, b):
         np.testing.assert_array_equal(x, y, err_msg=path)
 
 
+def assert_state_round_trip(env, steps_after: int = 5):
+    """``set_state(get_state())`` after ``steps_after`` random steps brings back the
+    observation bit for bit; returns that observation."""
+    state = env.unwrapped.get_state()
+    obs = env.unwrapped.get_obs()
+    for _ in range(steps_after):
+        env.step(env.action_space.sample())
+    env.unwrapped.set_state(state)
+    assert_obs_equal(obs, env.unwrapped.get_obs())
+    return obs
+
+
 def obs_differs(a, b) -> bool:
     return any(
         not np.array_equal(x, y) for (_, x), (_, y) in zip(leaves(a), leaves(b), strict=True)
