@@ -74,7 +74,9 @@ pub struct ReplayedEpisode {
 ///   more target steps toward the same `q̄_src(t)` follow (at most
 ///   [`MAX_EXTRA_STEPS_PER_SOURCE_STEP`]). A failed converted episode is retried up to
 ///   `opts.max_retry` times with a stricter "reached" test (see [`ReplayOptions::max_retry`]);
-///   failed sources are not retried.
+///   failed sources are not retried. A converted episode ends as soon as it has been
+///   successful for as many consecutive steps as the source's final run of successful steps
+///   (the rest of the source's actions are not stepped).
 ///
 /// Returns the last attempt whether it succeeded or not (check `episode.succeeded()`).
 pub fn replay_episode(
@@ -239,11 +241,22 @@ fn convert_once(
     let mut targets = SourceJointTargets::new(cfg, env, source)?;
     let dof = targets.dof();
     let mut desired = Vec::new();
-    for t in 0..source.actions.len() {
+    // A successful source ends after a run of successful steps; a converted episode that
+    // reaches such a run ends there too, as a demonstration does (the source's remaining
+    // actions were made for its own, later state and can only disturb the solved task).
+    let success_run = source.success.iter().rev().take_while(|&&s| s).count();
+    let solved = |recorder: &EpisodeRecorder| {
+        success_run > 0
+            && recorder.episode().success.iter().rev().take_while(|&&s| s).count() >= success_run
+    };
+    'source_steps: for t in 0..source.actions.len() {
         desired = targets.targets(source, t)?;
         debug_assert_eq!(desired.len(), dof);
         for extra in 0..=MAX_EXTRA_STEPS_PER_SOURCE_STEP {
             let reached = step_toward(env, &mut recorder, &mut obs, &desired, source, t)?;
+            if solved(&recorder) {
+                break 'source_steps;
+            }
             let trailing = match trailing_tolerance {
                 Some(tol) => {
                     tcp_position(env)?
