@@ -18,7 +18,7 @@
 
 use std::f32::consts::{PI, TAU};
 
-use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, VisualShape};
+use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, SolverConfig, VisualShape};
 use nalgebra::{UnitQuaternion, Vector2, Vector3};
 use rand::seq::SliceRandom;
 use rand::Rng;
@@ -288,6 +288,17 @@ impl AssemblyParts for AssemblingKits {
     const CAMERA_VIEWS: &'static [CameraView] = &CAMERA_VIEWS;
     const HAND_TURNED: bool = false;
     const PREDICTION_DISTANCE: Option<f32> = Some(PREDICTION_DISTANCE);
+
+    /// The common settings with contacts between convex hulls by the separating-axis test
+    /// (parry 0.31's GJK puts phantom contacts between a shape and the board pieces around its
+    /// slot, see `ms2_physics::convex_contact`).
+    fn solver_config(defaults: SolverConfig) -> SolverConfig {
+        SolverConfig {
+            prediction_distance: PREDICTION_DISTANCE,
+            sat_convex_contacts: true,
+            ..defaults
+        }
+    }
 
     fn build(&mut self, world: &mut dyn RigidWorld, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let kit = Kit::sample(rng);
