@@ -91,9 +91,12 @@ fn best_axis(a: &ConvexPolyhedron, b: &ConvexPolyhedron, pos12: &Pose) -> Axis {
     for f in b.faces() {
         consider(-(pos12.rotation * f.normal), None, 0.0);
     }
-    for (i, ea) in a.edges().iter().enumerate() {
-        for (j, eb) in b.edges().iter().enumerate() {
-            let c = ea.dir.cross(pos12.rotation * eb.dir);
+    // Parallel edges give the same axes: one edge per direction (prisms have few).
+    let da = distinct_edges(a, &Pose::IDENTITY);
+    let db = distinct_edges(b, pos12);
+    for &(i, ea) in &da {
+        for &(j, eb) in &db {
+            let c = ea.cross(eb);
             let len = c.length();
             if len < MIN_CROSS {
                 continue;
@@ -104,6 +107,19 @@ fn best_axis(a: &ConvexPolyhedron, b: &ConvexPolyhedron, pos12: &Pose) -> Axis {
         }
     }
     best
+}
+
+/// One edge of `poly` per edge direction (up to sign): `(edge index, direction in the frame
+/// `pose` maps `poly`'s into)`.
+fn distinct_edges(poly: &ConvexPolyhedron, pose: &Pose) -> Vec<(usize, Vector)> {
+    let mut out: Vec<(usize, Vector)> = Vec::new();
+    for (i, e) in poly.edges().iter().enumerate() {
+        let d = pose.rotation * e.dir;
+        if !out.iter().any(|(_, o)| o.cross(d).length() < MIN_CROSS) {
+            out.push((i, d));
+        }
+    }
+    out
 }
 
 /// The face of `poly` whose normal is closest to `dir` (its frame) as a feature of at most four
@@ -167,6 +183,14 @@ pub fn sat_contact_manifold<ManifoldData, ContactData>(
 {
     if manifold.try_update_contacts_eps(pos12, COS_1_DEGREE, REUSE_DISTANCE) {
         return;
+    }
+    // Still apart along the last axis: then apart by more than the prediction (any axis'
+    // separation is a lower bound of the distance).
+    if manifold.points.is_empty() && manifold.local_n1 != Vector::ZERO {
+        let pb: Vec<Vector> = b.points().iter().map(|q| pos12 * *q).collect();
+        if separation(manifold.local_n1, a.points(), &pb) > prediction {
+            return;
+        }
     }
     let axis = best_axis(a, b, pos12);
     let old_points = manifold.points.clone();

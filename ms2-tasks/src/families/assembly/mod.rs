@@ -1,15 +1,17 @@
-//! Assembly with real clearances: `PegInsertionSide-v0`, `PlugCharger-v0`, and
-//! `AssemblingKits-v0` (built and tested here, not registered yet: see [`register`]).
+//! Assembly with real clearances: `PegInsertionSide-v0`, `PlugCharger-v0` and
+//! `AssemblingKits-v0`.
 //!
 //! [`common`] holds what the assembly tasks share (the task base [`AssemblyTask`] around each
 //! task's [`common::AssemblyParts`], box actors whose collision shapes are their visual shapes,
 //! walls around an opening built from convex boxes, the turned-hand Panda start,
 //! grasp-orientation measures); [`kit_shapes`] the kits' outlines and carved boards; each task
-//! is its geometry, hooks and spec; [`scripted`] is the family's oracle policies and
+//! is its geometry, hooks and spec; [`scripted`] is the insertion oracle policies,
+//! [`kit_policy`] the kits' and
 //! [`solutions`] its motion-planning solutions (feature `demos`).
 
 pub mod assembling_kits;
 pub mod common;
+pub mod kit_policy;
 pub mod kit_shapes;
 pub mod peg_insertion_side;
 pub mod plug_charger;
@@ -65,7 +67,7 @@ pub const PLUG_CHARGER: TaskSpec = assembly_spec(
     &["tcp_pose"],
 );
 
-/// `AssemblingKits-v0`'s spec (not registered yet, see [`register`]).
+/// `AssemblingKits-v0`'s spec.
 pub const ASSEMBLING_KITS: TaskSpec = assembly_spec(
     "AssemblingKits-v0",
     "put a shape into the slot carved for it in a kit board",
@@ -89,7 +91,10 @@ pub fn register(r: &mut Registrar) {
     #[cfg(feature = "demos")]
     let registration = registration.solution(&solutions::PLUG_CHARGER);
     r.add(registration);
-    // AssemblingKits-v0 (`AssemblyTask<AssemblingKits>`, spec `ASSEMBLING_KITS`) is not
-    // registered yet: its shapes do not drop into their carved slots in simulation (a known
-    // failure, docs/tasks.md), so the env could not be solved.
+
+    let registration = TaskRegistration::new(ASSEMBLING_KITS, |_| {
+        Ok(Box::<AssemblyTask<AssemblingKits>>::default())
+    })
+    .scripted(kit_policy::kit_policy);
+    r.add(registration);
 }
