@@ -6,13 +6,15 @@
 //! walls around an opening built from convex boxes, the turned-hand Panda start,
 //! grasp-orientation measures); [`kit_shapes`] the kits' outlines and carved boards; each task
 //! is its geometry, hooks and spec; [`scripted`] is the insertion oracle policies,
-//! [`kit_policy`] the kits' and
-//! [`solutions`] its motion-planning solutions (feature `demos`).
+//! [`kit_policy`] the kits'; [`solutions`] the motion-planning skeleton and the insertion
+//! tasks' solutions, [`kit_solution`] the kits' (feature `demos`).
 
 pub mod assembling_kits;
 pub mod common;
 pub mod kit_policy;
 pub mod kit_shapes;
+#[cfg(feature = "demos")]
+pub mod kit_solution;
 pub mod peg_insertion_side;
 pub mod plug_charger;
 pub mod scripted;
@@ -96,5 +98,7 @@ pub fn register(r: &mut Registrar) {
         Ok(Box::<AssemblyTask<AssemblingKits>>::default())
     })
     .scripted(kit_policy::kit_policy);
+    #[cfg(feature = "demos")]
+    let registration = registration.solution(&kit_solution::ASSEMBLING_KITS);
     r.add(registration);
 }
