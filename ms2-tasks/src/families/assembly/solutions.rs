@@ -400,8 +400,10 @@ impl Solution for InsertionSolution {
                 break;
             }
             tcp_target = before * part_now.inverse() * tcp_target;
+            // A screw, else a planned path (a small correction near a joint limit may need the
+            // arm to turn around it).
             let fix = timings
-                .time(|| planner.plan_screw(&carrying, driver.arm_target(), &tcp_target))
+                .time(|| move_to_pose(&mut planner, &carrying, driver.arm_target(), &tcp_target))
                 .map_err(plan_error("align"))?;
             driver.follow(&fix.trajectory, Gripper::Closed)?;
         }
