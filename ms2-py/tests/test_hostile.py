@@ -525,3 +525,49 @@ def test_soak_restores_only_states_of_the_current_episode():
     assert row["resets"] >= 5, row
     assert row["set_states"] > 0, row
     assert row["errors"] == {} and row["non_finite"] == 0, row
+
+
+def _children(pid: int) -> list[int]:
+    """Live (not zombie) processes whose parent is ``pid``, from /proc."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid and fields[0] != "Z":
+            out.append(int(stat.parent.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc")
+def test_soak_workers_end_when_the_soak_is_killed():
+    """kill -9 of ``ms2 bench --soak --jobs 2`` leaves no worker soaking on alone."""
+    import time
+
+    script = "from ms2.soak import run_soak; run_soak(10**7, env_ids=['PickCube-v0'], jobs=2)"
+    soak = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 120
+        workers: list[int] = []
+        while time.monotonic() < deadline:
+            workers = [p for p in _children(soak.pid) if p != soak.pid]
+            if len(workers) >= 2:
+                break
+            time.sleep(0.2)
+        assert len(workers) >= 2, f"the soak started workers {workers}"
+    finally:
+        soak.kill()
+        soak.wait()
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and any(_alive(p) for p in workers):
+        time.sleep(0.2)
+    assert not [p for p in workers if _alive(p)], "workers outlived the killed soak"

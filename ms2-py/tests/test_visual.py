@@ -339,3 +339,26 @@ def test_ray_cast_and_raster_sensor_paths_agree(tmp_path):
     assert np.percentile(gap[interior], 99) < 1e-3, np.percentile(gap[interior], 99)
     # The base camera sees ground or objects at every pixel (ManiSkill2's 20 m ground).
     assert (xyz_a[0, ..., 3] == 1).all() and (xyz_b[0, ..., 3] == 1).all()
+
+
+def test_turn_faucet_places_maniskill2s_base_camera():
+    """TurnFaucet's base_camera looks from (-0.4, 0, 0.3) m at (0, 0, 0.1) m, as ManiSkill2
+    places it; the hand camera is the Panda's."""
+    env = ms2.Ms2Env(
+        "TurnFaucet-v0",
+        obs_mode="rgbd",
+        render_mode="rgb_array",
+        camera_cfgs={"width": 32, "height": 32},
+    )
+    try:
+        obs, _ = env.reset(seed=0)
+        eye, target = np.array([-0.4, 0.0, 0.3]), np.array([0.0, 0.0, 0.1])
+        pose = obs["camera_param"]["base_camera"]["cam2world_gl"]
+        np.testing.assert_allclose(pose[:3, 3], eye, atol=1e-5)
+        forward = -pose[:3, 2]  # OpenGL cameras look along -z
+        want = (target - eye) / np.linalg.norm(target - eye)
+        np.testing.assert_allclose(forward, want, atol=1e-5)
+        assert "hand_camera" in obs["camera_param"]
+        assert env.render().shape == (512, 512, 3)
+    finally:
+        env.close()

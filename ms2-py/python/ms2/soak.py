@@ -4,22 +4,24 @@ errors rather than speed.
 Each (task, obs mode) pair gets a share of ``--steps`` env steps (default 1,000,000) in one env:
 random actions, resets when an episode ends (every tenth with ``reconfigure``), and with
 probability ``SET_STATE_PROBABILITY`` per step a ``set_state`` of a state recorded earlier in the
-run's current episode (a reset may load another model, as ManiSkill2's TurnFaucet does at every
-reset, and a state of one faucet is not a state of another with more handles). Shares are weighted by cost, so the rigid-body state modes take
-most steps and the rendering and soft-body pairs fewer (``WEIGHTS``); every pair runs at least
-``MIN_STEPS``. Printed per pair and in total: steps, steps/s, resident memory (RSS) at the start
-and end, NaN/inf observations or rewards handed out (must be 0), and errors by type with the
-first messages.
+current episode (a reset may load another model, as ManiSkill2's TurnFaucet does at every reset,
+and a state of one faucet is not a state of another with more handles). Shares are weighted by
+cost, so the rigid-body state modes take most steps and the rendering and soft-body pairs fewer
+(``WEIGHTS``); every pair runs at least ``MIN_STEPS``. Printed per pair and in total: steps,
+steps/s, resident memory (RSS) at the start and end, NaN/inf observations or rewards handed out
+(must be 0), and errors by type with the first messages.
 
 ``--jobs N`` runs the pairs in N worker processes (each worker soaks pair after pair, so its
 memory at the end of its last pair still shows a leak across pairs); rows are printed as pairs
-finish.
+finish. Workers end with the soak when it is killed.
 """
 
 from __future__ import annotations
 
 import math
 import multiprocessing
+import os
+import signal
 import time
 from collections import Counter
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -72,6 +74,21 @@ def plan(total_steps: int) -> list[tuple[str, str, int]]:
         (env_id, mode, max(MIN_STEPS, round(total_steps * w / total_weight)))
         for env_id, mode, w in pairs
     ]
+
+
+def _stop_with_parent(parent_pid: int) -> None:
+    """Worker initializer: a worker ends when the soak that started it dies (killed rather than
+    interrupted), instead of soaking on alone. Linux: the kernel sends it SIGTERM
+    (``PR_SET_PDEATHSIG``); elsewhere the worker only checks at start."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+    if os.getppid() != parent_pid:  # the parent died before the signal was armed
+        os._exit(1)
 
 
 def soak_pair(env_id: str, obs_mode: str, steps: int, seed: int) -> dict[str, Any]:
@@ -174,7 +191,12 @@ def run_soak(
             _print_row(rows[-1])
     else:
         context = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=min(jobs, len(work)), mp_context=context) as ex:
+        with ProcessPoolExecutor(
+            max_workers=min(jobs, len(work)),
+            mp_context=context,
+            initializer=_stop_with_parent,
+            initargs=(os.getpid(),),
+        ) as ex:
             futures = [ex.submit(soak_pair, *item) for item in work]
             for future in as_completed(futures):
                 rows.append(future.result())

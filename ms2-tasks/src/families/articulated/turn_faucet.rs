@@ -37,6 +37,7 @@ use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::{with_views, CameraConfig};
 use crate::task::{Task, TaskScene};
 
 /// Environment variable choosing the faucet models: `train` (default), `test` (the procedural
@@ -181,6 +182,13 @@ impl TurnFaucet {
         best
     }
 }
+
+/// ManiSkill2's camera placements of this task, `(uid, eye, target)` (m, world): `base_camera`
+/// behind the robot's base looking down at the faucet, `render_camera` from the front right.
+const CAMERA_VIEWS: [(&str, [f32; 3], [f32; 3]); 2] = [
+    ("base_camera", [-0.4, 0.0, 0.3], [0.0, 0.0, 0.1]),
+    ("render_camera", [0.5, 0.5, 1.0], [0.0, 0.0, 0.5]),
+];
 
 impl Task for TurnFaucet {
     fn max_dense_reward(&self) -> f64 {
@@ -412,5 +420,13 @@ impl Task for TurnFaucet {
 
     fn task_state_len(&self) -> usize {
         2
+    }
+
+    fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
+        with_views(robot_cameras, &CAMERA_VIEWS)
+    }
+
+    fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
+        with_views(vec![robot_default], &CAMERA_VIEWS).remove(0)
     }
 }
