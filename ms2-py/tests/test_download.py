@@ -237,3 +237,59 @@ def test_the_cli_downloads_from_a_base_url(server, tmp_path):
         env=env,
     )
     assert r.returncode != 0 and "unknown asset 'nothing-v0'" in r.stderr + r.stdout
+
+
+def _partnet_server(models: dict[str, bytes]) -> _Server:
+    return _Server({f"partnet_mobility/dataset/{m}.zip": z for m, z in models.items()})
+
+
+def _write_info(root: Path, category: str, ids: list[str]) -> None:
+    meta = root / "partnet_mobility" / "meta"
+    meta.mkdir(parents=True, exist_ok=True)
+    (meta / f"info_{category}_train.json").write_text(json.dumps({i: {} for i in ids}))
+
+
+def test_turn_faucet_downloads_the_partnet_models_its_info_file_lists(tmp_path):
+    """ManiSkill2's layout: partnet_mobility/dataset/<id>/ for every faucet of the info file;
+    an id's zip with a member outside <id>/ installs nothing; a missing info file names it."""
+    root = tmp_path / "data"
+    with pytest.raises(dl.DownloadError, match="info_faucet_train.json is missing"):
+        dl.download("TurnFaucet-v0", root, base="http://127.0.0.1:9")
+    _write_info(root, "faucet", ["148", "149"])
+    good = {
+        m: _zip({f"{m}/mobility.urdf": b"<robot/>", f"{m}/meta.json": b"{}"})
+        for m in ("148", "149")
+    }
+    s = _partnet_server(good)
+    try:
+        paths = dl.download("TurnFaucet-v0", root, base=s.url("ok"))
+        assert sorted(p.name for p in paths) == ["148", "149"]
+        for m in ("148", "149"):
+            urdf = root / "partnet_mobility" / "dataset" / m / "mobility.urdf"
+            assert urdf.read_bytes() == b"<robot/>"
+        # A single model by name; present data is kept, --force downloads again.
+        one = dl.download("partnet_mobility/148", root, base=s.url("ok"), force=True)
+        assert one == [root / "partnet_mobility" / "dataset" / "148"]
+    finally:
+        s.close()
+    bad = _partnet_server(
+        {"150": _zip({"other/mobility.urdf": b"x"}), "152": _zip({"152/mobility.urdf": b"y"})}
+    )
+    try:
+        with pytest.raises(dl.DownloadError, match="not under 150/"):
+            dl.download("partnet_mobility/150", root, base=bad.url("ok"))
+        assert not (root / "partnet_mobility" / "dataset" / "150").exists()
+        with pytest.raises(dl.DownloadError, match="HTTP 404"):
+            dl.download("partnet_mobility/151", root, base=bad.url("ok"))
+        with pytest.raises(dl.DownloadError, match="interrupted"):
+            dl.download("partnet_mobility/152", root, base=bad.url("trunc"))
+        assert not (root / "partnet_mobility" / "dataset" / "152").exists()
+        # The next run resumes the partial file and installs the model.
+        dl.download("partnet_mobility/152", root, base=bad.url("ok"))
+        assert (
+            root / "partnet_mobility" / "dataset" / "152" / "mobility.urdf"
+        ).read_bytes() == b"y"
+    finally:
+        bad.close()
+    with pytest.raises(ValueError, match="model ids are numbers, got 'abc'"):
+        dl.resolve("partnet_mobility/abc")

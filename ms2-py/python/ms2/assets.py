@@ -360,7 +360,7 @@ def _cmd_download(args: argparse.Namespace) -> int:
     from . import download as dl
 
     root = asset_dir()
-    names = dl.resolve(args.what)
+    names = dl.resolve(args.what, asset_dir=root)
     for name in names:
         last = [-1]
 
@@ -404,10 +404,13 @@ def add_parser(sub: Any) -> None:
     fp.set_defaults(func=_cmd_fetch)
     dp = a.add_parser(
         "download",
-        help="download ManiSkill2's published data archives (YCB, EGAD, clutter episodes, ...)",
+        help="download ManiSkill2's published data archives (YCB, EGAD, clutter episodes, "
+        "PartNet-Mobility models, ...)",
     )
     dp.add_argument(
-        "what", help="env id (e.g. PickSingleYCB-v0), archive name (ycb, egad), or 'all'"
+        "what",
+        help="env id (e.g. PickSingleYCB-v0, TurnFaucet-v0), archive name (ycb, egad), "
+        "partnet_mobility/<model id>, or 'all'",
     )
     dp.add_argument(
         "--base-url",

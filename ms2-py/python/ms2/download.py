@@ -3,9 +3,11 @@
 The archives, their checksums and the env ids that need them are ManiSkill2 0.5.3's
 (``mani_skill2/utils/download_asset.py``): ``ycb`` (``mani_skill2_ycb/``), ``egad``
 (``mani_skill2_egad/``), ``pick_clutter_ycb`` (``pick_clutter/ycb_train_5k.json.gz``),
-``assembling_kits``, ``panda_avoid_obstacles``, ``pinch``, ``write``. ManiSkill2 publishes
-checksums but no sizes: a download is checked against the server's ``Content-Length`` (a short
-body is an interrupted download) and then against the sha256.
+``assembling_kits``, ``panda_avoid_obstacles``, ``pinch``, ``write``, and one zip per
+PartNet-Mobility model (``partnet_mobility/<model id>``; ``TurnFaucet-v0`` and the mobile env ids
+download the models ManiSkill2's info files list). ManiSkill2 publishes checksums (none for the
+PartNet-Mobility models) but no sizes: a download is checked against the server's
+``Content-Length`` (a short body is an interrupted download) and then against the sha256.
 
 Safety: bytes go to ``<asset dir>/.ms2_downloads/<name>.part``; an interrupted download keeps
 that file and the next run resumes it with an HTTP ``Range`` request. A zip archive is checked
@@ -43,9 +45,13 @@ class Archive:
     """One published archive: its path under the base URL, sha256 and where it goes."""
 
     path: str
-    sha256: str
+    sha256: str | None
+    """``None`` where ManiSkill2 publishes none (the PartNet-Mobility models): then only the
+    server's ``Content-Length`` and the zip's own CRCs check the bytes."""
     target: str
-    """Folder (zip archives: the archive's top folder) or file path under the asset dir."""
+    """Folder (zip archives: the archive's top folder) or file path under ``parent``."""
+    parent: str = ""
+    """Folder under the asset dir that receives ``target`` (default: the asset dir itself)."""
 
     @property
     def is_zip(self) -> bool:
@@ -103,6 +109,46 @@ GROUPS: dict[str, list[str]] = {
 }
 
 
+#: Env ids to the PartNet-Mobility categories whose models they need (ManiSkill2 0.5.3's data
+#: groups); the model ids are the keys of ``partnet_mobility/meta/info_<category>_train.json``.
+PARTNET_GROUPS: dict[str, list[str]] = {
+    "TurnFaucet-v0": ["faucet"],
+    "OpenCabinetDrawer-v1": ["cabinet_drawer"],
+    "OpenCabinetDoor-v1": ["cabinet_door"],
+    "PushChair-v1": ["chair"],
+    "MoveBucket-v1": ["bucket"],
+}
+#: Prefix of a single PartNet-Mobility model's name (``partnet_mobility/<model id>``).
+PARTNET_PREFIX = "partnet_mobility/"
+
+
+def partnet_archive(model_id: str) -> Archive:
+    """The published zip of PartNet-Mobility model ``model_id`` (a number), which unpacks to
+    ``partnet_mobility/dataset/<model_id>/``."""
+    if not model_id.isdigit():
+        raise ValueError(f"PartNet-Mobility model ids are numbers, got {model_id!r}")
+    return Archive(
+        f"partnet_mobility/dataset/{model_id}.zip", None, model_id, "partnet_mobility/dataset"
+    )
+
+
+def partnet_model_ids(category: str, asset_dir: Path) -> list[str]:
+    """The model ids ManiSkill2 lists for ``category`` (its train info file in ``asset_dir``)."""
+    import json
+
+    info = asset_dir / "partnet_mobility" / "meta" / f"info_{category}_train.json"
+    try:
+        ids = list(json.loads(info.read_text()))
+    except FileNotFoundError:
+        raise DownloadError(
+            f"{info} is missing: it lists the {category} models to download; get it with "
+            "`ms2 assets fetch partnet_mobility_meta`"
+        ) from None
+    except (OSError, ValueError) as err:
+        raise DownloadError(f"{info}: not a JSON object of model ids ({err})") from None
+    return ids
+
+
 class DownloadError(RuntimeError):
     """A download failed; the message names the URL or file and what was expected."""
 
@@ -112,8 +158,12 @@ def base_url() -> str:
     return os.environ.get(BASE_URL_ENV) or DEFAULT_BASE_URL
 
 
-def resolve(name: str, archives: dict[str, Archive] | None = None) -> list[str]:
-    """Archive names for an env id, an archive name, or ``all`` (``ValueError`` otherwise)."""
+def resolve(
+    name: str, archives: dict[str, Archive] | None = None, asset_dir: Path | None = None
+) -> list[str]:
+    """Archive names for an env id, an archive name, ``partnet_mobility/<model id>`` or ``all``
+    (``ValueError`` otherwise). The PartNet-Mobility env ids (:data:`PARTNET_GROUPS`) read
+    their model ids from the info files in ``asset_dir``."""
     archives = ARCHIVES if archives is None else archives
     if name == "all":
         return list(archives)
@@ -121,9 +171,18 @@ def resolve(name: str, archives: dict[str, Archive] | None = None) -> list[str]:
         return [name]
     if name in GROUPS:
         return list(GROUPS[name])
+    if name.startswith(PARTNET_PREFIX):
+        partnet_archive(name[len(PARTNET_PREFIX) :])  # checks the id
+        return [name]
+    if name in PARTNET_GROUPS and asset_dir is not None:
+        return [
+            PARTNET_PREFIX + model_id
+            for category in PARTNET_GROUPS[name]
+            for model_id in partnet_model_ids(category, asset_dir)
+        ]
     raise ValueError(
-        f"unknown asset {name!r}: expected an env id ({', '.join(GROUPS)}), "
-        f"an archive ({', '.join(archives)}) or 'all'"
+        f"unknown asset {name!r}: expected an env id ({', '.join([*GROUPS, *PARTNET_GROUPS])}), "
+        f"an archive ({', '.join(archives)}), partnet_mobility/<model id> or 'all'"
     )
 
 
@@ -225,28 +284,36 @@ def download_archive(
     """Downloads one archive into ``asset_dir`` (checksum-checked, resumable, atomic) and
     returns the installed folder or file. Present data is kept unless ``force``."""
     archives = ARCHIVES if archives is None else archives
-    if name not in archives:
+    if name.startswith(PARTNET_PREFIX) and name not in archives:
+        a = partnet_archive(name[len(PARTNET_PREFIX) :])
+    elif name in archives:
+        a = archives[name]
+    else:
         raise ValueError(f"unknown archive {name!r}: expected one of {', '.join(archives)}")
-    a = archives[name]
-    dest = asset_dir / a.target
+    dest = asset_dir / a.parent / a.target
     if dest.exists() and not force:
         return dest
     url = f"{(base or base_url()).rstrip('/')}/{a.path}"
     staging = asset_dir / STAGING_DIR
     staging.mkdir(parents=True, exist_ok=True)
-    part = staging / f"{name}.{a.sha256[:12]}.part"
+    stem = name.replace("/", "_")
+    part = staging / f"{stem}.{(a.sha256 or 'unchecked')[:12]}.part"
     _fetch_to(url, part, progress)
     found = _sha256(part)
-    if found != a.sha256:
+    if a.sha256 is not None and found != a.sha256:
         part.unlink(missing_ok=True)
         raise DownloadError(
             f"{url}: sha256 {found} does not match the published {a.sha256} "
             "(corrupt or another file); the partial download was removed"
         )
     if a.is_zip:
-        tmp = Path(tempfile.mkdtemp(prefix=f"{name}.", dir=staging))
+        tmp = Path(tempfile.mkdtemp(prefix=f"{stem}.", dir=staging))
         try:
-            _extract_zip(part, name, a.target, asset_dir, tmp)
+            (asset_dir / a.parent).mkdir(parents=True, exist_ok=True)
+            _extract_zip(part, name, a.target, asset_dir / a.parent, tmp)
+        except DownloadError:
+            part.unlink(missing_ok=True)  # complete but unusable: the next run fetches anew
+            raise
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
         part.unlink(missing_ok=True)
@@ -267,7 +334,7 @@ def download(
     """Downloads what an env id, archive name or ``all`` needs; returns the installed paths."""
     return [
         download_archive(n, asset_dir, base, archives, force, progress)
-        for n in resolve(what, archives)
+        for n in resolve(what, archives, asset_dir)
     ]
 
 
@@ -278,8 +345,12 @@ __all__ = [
     "DEFAULT_BASE_URL",
     "DownloadError",
     "GROUPS",
+    "PARTNET_GROUPS",
+    "PARTNET_PREFIX",
     "base_url",
     "download",
     "download_archive",
+    "partnet_archive",
+    "partnet_model_ids",
     "resolve",
 ]
