@@ -28,6 +28,17 @@ excluded=(--exclude ms2-py --exclude ms2-integration-tests)
 # of scripts/test.sh usually have uncommitted changes.
 export CARGO_PROFILE_DEV_DEBUG=0 CARGO_INCREMENTAL=0
 
+# The overlay's crates keep their version (0.1.0), and cargo reuses a crate it once extracted
+# under ~/.cargo/registry/src for the same name and version: a machine that ran this check
+# before would verify against the old sources. Drop those extractions of our own crates (they
+# never come from crates.io).
+cargo_home="${CARGO_HOME:-$HOME/.cargo}"
+# The same holds for their builds in target/debug, fingerprinted by name, version and source,
+# not by content.
+for stale in "$cargo_home"/registry/src/*/ms2-*-0.1.0 "$cargo_home"/registry/cache/*/ms2-*-0.1.0.crate \
+  target/debug/.fingerprint/ms2-* target/debug/deps/libms2_* target/debug/deps/ms2_*; do
+  [ -e "$stale" ] && rm -rf "$stale"
+done
 echo "[packages] cargo package --no-verify: every library crate"
 cargo package --workspace "${excluded[@]}" --allow-dirty --locked --no-verify
 # A crate must be listed with its ms2 dependencies (they come from the overlay, not crates.io).

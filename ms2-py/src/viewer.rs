@@ -119,14 +119,27 @@ impl NativeViewer {
         Ok(self.viewer()?.take_keys())
     }
 
-    /// Handles `key` (a name as `take_keys` returns them) exactly as a key press in the window.
-    fn press_key(&mut self, key: &str) -> PyResult<()> {
+    /// The same presses as `take_keys`, each as `(name, repeat)`: `repeat` is true for the
+    /// window system's auto-repeat while a key is held (keys that act once skip those).
+    fn take_key_presses(&mut self) -> PyResult<Vec<(String, bool)>> {
+        Ok(self
+            .viewer()?
+            .take_key_presses()
+            .into_iter()
+            .map(|k| (k.name, k.repeat))
+            .collect())
+    }
+
+    /// Handles `key` (a name as `take_keys` returns them) exactly as a key press in the window;
+    /// `repeat=True` as the auto-repeat of a held key.
+    #[pyo3(signature = (key, repeat = false))]
+    fn press_key(&mut self, key: &str, repeat: bool) -> PyResult<()> {
         if key.is_empty() {
             return Err(PyValueError::new_err(
                 "key must be a non-empty key name, got ''",
             ));
         }
-        self.viewer()?.press_key(key);
+        self.viewer()?.press_key_repeat(key, repeat);
         Ok(())
     }
 

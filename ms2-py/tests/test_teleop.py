@@ -108,6 +108,20 @@ def test_bad_arguments_are_value_errors(tmp_path):
         Teleop(ENV_ID, tmp_path / "t.txt")
 
 
+def test_auto_repeats_move_but_never_save_reset_or_quit_twice(tmp_path):
+    teleop = Teleop(ENV_ID, tmp_path / "t.h5")
+    teleop._new_episode()
+    seed = teleop.seed
+    assert teleop.handle_key("i") and teleop.handle_key("i", repeat=True)
+    assert teleop.steps == 2, "a held move key moves on every repeat"
+    assert teleop.handle_key("r", repeat=True) and teleop.seed == seed, "a repeat is no reset"
+    assert teleop.handle_key("q", repeat=True), "a repeat of q does not quit"
+    assert teleop.handle_key("v", repeat=True) and not teleop.saved_success
+    assert teleop.handle_key("r") and teleop.seed == seed + 1
+    assert not teleop.handle_key("q")
+    teleop.env.close()
+
+
 def test_scripted_key_session_saves_a_replayable_successful_episode(xserver, tmp_path):
     keys, planned_success = plan_lift_keys()
     assert planned_success, "the key plan itself must lift the cube"

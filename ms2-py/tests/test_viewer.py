@@ -215,6 +215,11 @@ def test_other_keys_reach_the_application(xserver, viewed):
     assert viewer.take_keys() == ["i", "5", "escape"]
     viewer.press_key("J")
     assert viewer.take_keys() == ["j"]
+    viewer.press_key("i")
+    viewer.press_key("i", repeat=True)
+    viewer.press_key("space", repeat=True)  # the viewer's own keys ignore auto-repeats
+    assert viewer.take_key_presses() == [("i", False), ("i", True)]
+    assert not viewer.paused
     with pytest.raises(ValueError, match="key"):
         viewer.press_key("")
 

@@ -19,7 +19,9 @@ def missing_tools() -> list[str]:
 
 
 class XServer:
-    """An Xvfb server on a free display number (``-displayfd``), 1024x768x24."""
+    """An Xvfb server on a free display number (``-displayfd``), 1024x768x24, without key
+    auto-repeat: under load xdotool's release of a key can come later than the server's
+    repeat delay (660 ms), and a repeated key would be a second press the test did not send."""
 
     def __init__(self) -> None:
         missing = missing_tools()
@@ -39,6 +41,7 @@ class XServer:
                 "1024x768x24",
                 "-nolisten",
                 "tcp",
+                "-r",
             ],
             pass_fds=(write_fd,),
             stdout=subprocess.DEVNULL,

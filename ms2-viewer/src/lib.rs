@@ -35,4 +35,4 @@ mod window;
 pub use controls::{Controls, View, MOUSE_BINDINGS, VIEWER_KEYS};
 pub use error::ViewerError;
 pub use orbit::OrbitCamera;
-pub use window::{key_name, SensorCamera, Viewer, ViewerConfig};
+pub use window::{key_name, KeyPress, SensorCamera, Viewer, ViewerConfig};

@@ -170,6 +170,16 @@ struct Mouse {
     pan_button: bool,
 }
 
+/// One key press queued for the application (see [`Viewer::take_key_presses`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct KeyPress {
+    /// The key's name ([`key_name`]): a lower-case character (`"i"`) or a named key
+    /// (`"space"`, `"escape"`).
+    pub name: String,
+    /// True for the window system's auto-repeat while the key is held, false for the press.
+    pub repeat: bool,
+}
+
 /// A viewer window: the scene through a free orbit camera or any sensor camera, with pause and
 /// single-step state for the application to honour (see the crate docs for the loop).
 pub struct Viewer {
@@ -181,7 +191,7 @@ pub struct Viewer {
     orbit: OrbitCamera,
     controls: Controls,
     sensor_count: usize,
-    keys: Vec<String>,
+    keys: Vec<KeyPress>,
     mouse: Mouse,
     modifiers: ModifiersState,
     closed: bool,
@@ -328,7 +338,10 @@ impl Viewer {
                 self.controls.press(name, self.sensor_count);
             }
         } else {
-            self.keys.push(name.to_owned());
+            self.keys.push(KeyPress {
+                name: name.to_owned(),
+                repeat,
+            });
         }
     }
 
@@ -339,9 +352,25 @@ impl Viewer {
         self.press_key_inner(&key.to_lowercase(), false);
     }
 
+    /// As [`Viewer::press_key`], but as the window system's auto-repeat of a held key when
+    /// `repeat` is true (the viewer's own keys ignore auto-repeats). For scripting and tests.
+    pub fn press_key_repeat(&mut self, key: &str, repeat: bool) {
+        self.press_key_inner(&key.to_lowercase(), repeat);
+    }
+
     /// The keys pressed since the last call that are not the viewer's own (oldest first;
-    /// auto-repeats included).
+    /// auto-repeats included). [`Viewer::take_key_presses`] tells the repeats apart.
     pub fn take_keys(&mut self) -> Vec<String> {
+        self.take_key_presses()
+            .into_iter()
+            .map(|k| k.name)
+            .collect()
+    }
+
+    /// The key presses since the last call that are not the viewer's own, oldest first, each
+    /// marked as a first press or an auto-repeat of a held key. Applications whose keys act
+    /// once (save, reset, quit) skip the repeats; those that move something keep them.
+    pub fn take_key_presses(&mut self) -> Vec<KeyPress> {
         std::mem::take(&mut self.keys)
     }
 

@@ -441,8 +441,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Runs the ``ms2`` command line with ``argv`` (default: ``sys.argv[1:]``)."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    from . import interrupts
+
+    interrupts.install()
     try:
-        return int(args.func(args))
+        code = int(args.func(args))
+        interrupts.check()  # an interrupt that something swallowed still ends in 130
+        return code
     except KeyboardInterrupt:
         # Trajectory files are committed chunk by chunk: what is on disk is complete.
         print(f"ms2 {args.command}: interrupted", file=sys.stderr)

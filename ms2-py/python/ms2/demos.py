@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from . import _native
+from . import _native, interrupts
 from .trajectory import (
     MAX_SEED,
     TrajectoryFileError,
@@ -191,6 +191,7 @@ def generate(
         writer.commit()  # a valid (empty) file from the start
         next_seed = seed
         while result.num_episodes < num_episodes and result.seeds_tried < max_seeds:
+            interrupts.check()
             # Whole chunks while many episodes remain; near the end, no more seeds than needed.
             remaining = num_episodes - result.num_episodes
             count = min(chunk_size, max(remaining, num_workers), max_seeds - result.seeds_tried)
@@ -471,6 +472,7 @@ def replay(
         try:
             with _progress(len(indices), f"replay {traj.env_id}", progress) as bar:
                 for chunk in _chunks(indices, 4 * num_workers):
+                    interrupts.check()
                     sources = [traj.read_episode(i) for i in chunk]
                     foreign = [_map_foreign_states(traj, ep, templates) for ep in sources]
                     try:

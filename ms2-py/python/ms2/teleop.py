@@ -3,9 +3,10 @@ episodes as a trajectory file (ManiSkill2's layout) that ``ms2 replay`` replays.
 
 The env runs in ``pd_ee_delta_pose``: every key press (and auto-repeat while a key is held) is
 one env step moving or turning the gripper by a fixed step along an axis of the TCP frame, as
-ManiSkill2's ``demo_manual_control`` does. The simulation advances only on those keys, so the
-viewer's pause (``space``) has nothing to pause here; the mouse and the view keys work as
-everywhere (docs/viewer.md).
+ManiSkill2's ``demo_manual_control`` does; saving, resetting and quitting act once per press
+(their auto-repeats are ignored, so a held ``r`` resets once). The simulation advances only on
+those keys, so the viewer's pause (``space``) has nothing to pause here; the mouse and the view
+keys work as everywhere (docs/viewer.md).
 """
 
 from __future__ import annotations
@@ -38,6 +39,9 @@ ROTATE_KEYS = {
     "5": (5, 1.0),
     "6": (5, -1.0),
 }
+#: Keys that act once per press: their auto-repeats (a held key) are ignored.
+ONCE_KEYS = frozenset({"v", "r", "q", "escape"})
+
 #: Every key of ``ms2 teleop`` and its meaning (printed by ``--help`` and at start).
 TELEOP_KEYS = [
     ("i / k", "move the gripper along +x / -x of the TCP frame"),
@@ -205,8 +209,12 @@ class Teleop:
 
     # --- keys -----------------------------------------------------------------------------------
 
-    def handle_key(self, key: str) -> bool:
-        """Applies one key press; returns ``False`` when the session should end."""
+    def handle_key(self, key: str, repeat: bool = False) -> bool:
+        """Applies one key press; returns ``False`` when the session should end. ``repeat``
+        marks the window system's auto-repeat of a held key: it moves, turns and grips again,
+        but never saves, resets or quits a second time."""
+        if repeat and key in ONCE_KEYS:
+            return True
         action = np.zeros(self.env.action_space.shape, dtype=np.float32)
         if key in TRANSLATE_KEYS:
             index, sign = TRANSLATE_KEYS[key]
@@ -251,9 +259,9 @@ class Teleop:
             running = True
             while running and not self.viewer.closed:
                 self.viewer.poll()
-                keys = self.viewer.take_keys()
-                for key in keys:
-                    running = self.handle_key(key)
+                keys = self.viewer.take_key_presses()
+                for key, repeat in keys:
+                    running = self.handle_key(key, repeat)
                     if not running:
                         break
                 self.viewer.set_status(self._status())
@@ -329,4 +337,4 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_cmd_teleop)
 
 
-__all__ = ["TELEOP_KEYS", "Teleop", "TeleopResult", "add_parser", "keys_help"]
+__all__ = ["ONCE_KEYS", "TELEOP_KEYS", "Teleop", "TeleopResult", "add_parser", "keys_help"]

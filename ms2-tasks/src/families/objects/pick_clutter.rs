@@ -30,15 +30,14 @@ use rand::Rng;
 
 use super::model_db::ObjectModelError;
 use super::pick_single::{
-    pick_dense_reward, settle_body, ModelSet, PlacedObject, GOAL_THRESHOLD, MAX_DENSE_REWARD,
+    evaluate_placement, pick_dense_reward, settle_body, ModelSet, PlacedObject, MAX_DENSE_REWARD,
     OBJECT_DAMPING, SETTLE_TIME, YCB,
 };
-use crate::agents::ROBOT_STATIC_QVEL;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
 use crate::families::rigid::common::{body_pose, is_actor_static};
 use crate::geometry::{vectorize_pose, Pose3};
-use crate::info::{Evaluation, InfoValue};
+use crate::info::Evaluation;
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
@@ -497,25 +496,7 @@ impl Task for PickClutter {
 
     fn evaluate(&self, scene: &TaskScene) -> Evaluation {
         let obj = self.obj_pose(scene.world.as_ref()).translation.vector;
-        let dist = (self.goal_pos - obj).norm();
-        let is_obj_placed = dist <= GOAL_THRESHOLD;
-        let is_robot_static = scene
-            .agent
-            .is_static(scene.world.as_ref(), ROBOT_STATIC_QVEL);
-        Evaluation {
-            success: is_obj_placed && is_robot_static,
-            terms: vec![
-                (
-                    "obj_to_goal_dist".to_owned(),
-                    InfoValue::F64(f64::from(dist)),
-                ),
-                ("is_obj_placed".to_owned(), InfoValue::Bool(is_obj_placed)),
-                (
-                    "is_robot_static".to_owned(),
-                    InfoValue::Bool(is_robot_static),
-                ),
-            ],
-        }
+        evaluate_placement(scene, obj, self.goal_pos)
     }
 
     fn dense_reward(&self, scene: &TaskScene, eval: &Evaluation) -> f64 {

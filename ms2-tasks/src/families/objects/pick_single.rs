@@ -236,6 +236,35 @@ fn choose<'a, T>(items: &'a [T], rng: &mut EpisodeRng) -> &'a T {
     &items[rng.random_range(0..items.len())]
 }
 
+/// ManiSkill2's pick-and-place evaluation: the object's centre of mass `obj_pos` within
+/// [`GOAL_THRESHOLD`] of `goal_pos` (m, world) and the robot static; `info` terms
+/// `obj_to_goal_dist` (m), `is_obj_placed`, `is_robot_static`.
+pub(crate) fn evaluate_placement(
+    scene: &TaskScene,
+    obj_pos: Vector3<f32>,
+    goal_pos: Vector3<f32>,
+) -> Evaluation {
+    let dist = (goal_pos - obj_pos).norm();
+    let is_obj_placed = dist <= GOAL_THRESHOLD;
+    let is_robot_static = scene
+        .agent
+        .is_static(scene.world.as_ref(), ROBOT_STATIC_QVEL);
+    Evaluation {
+        success: is_obj_placed && is_robot_static,
+        terms: vec![
+            (
+                "obj_to_goal_dist".to_owned(),
+                InfoValue::F64(f64::from(dist)),
+            ),
+            ("is_obj_placed".to_owned(), InfoValue::Bool(is_obj_placed)),
+            (
+                "is_robot_static".to_owned(),
+                InfoValue::Bool(is_robot_static),
+            ),
+        ],
+    }
+}
+
 impl Task for PickSingle {
     fn max_dense_reward(&self) -> f64 {
         MAX_DENSE_REWARD
@@ -345,25 +374,7 @@ impl Task for PickSingle {
 
     fn evaluate(&self, scene: &TaskScene) -> Evaluation {
         let obj = self.obj_pose(scene.world.as_ref()).translation.vector;
-        let dist = (self.goal_pos - obj).norm();
-        let is_obj_placed = dist <= GOAL_THRESHOLD;
-        let is_robot_static = scene
-            .agent
-            .is_static(scene.world.as_ref(), ROBOT_STATIC_QVEL);
-        Evaluation {
-            success: is_obj_placed && is_robot_static,
-            terms: vec![
-                (
-                    "obj_to_goal_dist".to_owned(),
-                    InfoValue::F64(f64::from(dist)),
-                ),
-                ("is_obj_placed".to_owned(), InfoValue::Bool(is_obj_placed)),
-                (
-                    "is_robot_static".to_owned(),
-                    InfoValue::Bool(is_robot_static),
-                ),
-            ],
-        }
+        evaluate_placement(scene, obj, self.goal_pos)
     }
 
     fn dense_reward(&self, scene: &TaskScene, eval: &Evaluation) -> f64 {
