@@ -63,7 +63,8 @@ fn box_of(shape: &KitShape) -> (Vector3<f64>, f64, Vector3<f64>) {
     )
 }
 
-/// The box frame (x down, y across the narrowest width at `yaw` in the world) as a rotation.
+/// The box frame (x down, y across the narrowest width at `yaw` about z) as a rotation in the
+/// shape's frame.
 fn box_rotation(yaw: f64) -> UnitQuaternion<f64> {
     let y = Vector3::new(yaw.cos(), yaw.sin(), 0.0);
     let x = -Vector3::z();
@@ -93,16 +94,15 @@ fn sense_assembling_kits(env: &Env) -> Result<InsertionWorld, SolveError> {
     let world = scene.world.as_ref();
     let base_from_world = scene.agent.base_pose().inverse().cast::<f64>();
     let shapes = super::assembling_kits::shapes();
-    // A shape's box (world) with the shape's frame at `pose`.
+    // A shape's box (base frame) with the shape's frame at `pose` (world). The whole pose,
+    // tilt included: a shape grasped near its top hangs a few degrees tilted in the hand, and
+    // lining up only its centre and yaw left its bottom ~1.5 mm off, on the slot's rim.
     let boxed = |shape: &KitShape, pose: &Isometry3<f64>| {
         let (centre, across, half) = box_of(shape);
-        let yaw = f64::from(pose_yaw(&pose.cast::<f32>())) + across;
         OrientedBox {
             pose_base_from_box: base_from_world
-                * Isometry3::from_parts(
-                    Translation3::from((pose * nalgebra::Point3::from(centre)).coords),
-                    box_rotation(yaw),
-                ),
+                * pose
+                * Isometry3::from_parts(Translation3::from(centre), box_rotation(across)),
             half_extents: half,
         }
     };

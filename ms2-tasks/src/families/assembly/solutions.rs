@@ -268,6 +268,26 @@ fn move_to_pose(
         .or_else(|_| planner.plan_to_pose(scene, start, pose))
 }
 
+/// As [`move_to_pose`] in free space, where a screw that cannot be smoothed (the spline
+/// through its waypoints collides or leaves the joint limits, e.g. a wrist at its limit, so
+/// the arm would stop at each of its many waypoints) is replaced by the RRT-Connect motion
+/// when that is shorter in time.
+fn move_through_free_space(
+    planner: &mut MotionPlanner<'_, KinematicRobot>,
+    scene: &CollisionScene,
+    start: &[f64],
+    pose: &Isometry3<f64>,
+) -> Result<PlannedMotion, PlanError> {
+    match planner.plan_screw(scene, start, pose) {
+        Ok(screw) if screw.smoothed || screw.waypoints.len() <= 2 => Ok(screw),
+        Ok(screw) => match planner.plan_to_pose(scene, start, pose) {
+            Ok(planned) if planned.trajectory.len() < screw.trajectory.len() => Ok(planned),
+            _ => Ok(screw),
+        },
+        Err(_) => planner.plan_to_pose(scene, start, pose),
+    }
+}
+
 impl InsertionSolution {
     fn planner<'r>(
         &self,
@@ -321,7 +341,7 @@ impl Solution for InsertionSolution {
             let grasp =
                 part_pose * Isometry3::from_parts(Translation3::from(sensed.grasp_point), rot);
             let pre = Translation3::new(0.0, 0.0, PRE_GRASP_DISTANCE) * grasp;
-            match timings.time(|| move_to_pose(&mut planner, &scene, &start, &pre)) {
+            match timings.time(|| move_through_free_space(&mut planner, &scene, &start, &pre)) {
                 Ok(motion) => {
                     reached = Some((motion, grasp));
                     break;
@@ -380,7 +400,7 @@ impl Solution for InsertionSolution {
             * grasped.inserted;
         let carry = timings
             .time(|| {
-                move_to_pose(
+                move_through_free_space(
                     &mut planner,
                     &carrying,
                     driver.arm_target(),
