@@ -88,3 +88,35 @@ def test_cameras_ride_on_the_robot():
     # The wrist camera moves with the arm; the base camera is fixed on the robot's base.
     assert not np.allclose(obs["camera_param"]["hand_camera"]["cam2world_gl"], hand_before)
     np.testing.assert_allclose(obs["camera_param"]["base_camera"]["cam2world_gl"], base_before)
+
+
+# ManiSkill2 0.5.3 builds every StationaryManipulationEnv with either robot; its own test_robots
+# skips only PandaAvoidObstacles, PegInsertionSide, PickClutterYCB, TurnFaucet and mobile tasks.
+OTHER_STATIONARY_TASKS = ["PickSingleYCB-v0", "PickSingleEGAD-v0", "PlugCharger-v0"]
+
+
+@pytest.mark.parametrize("env_id", OTHER_STATIONARY_TASKS)
+def test_other_stationary_tasks_take_the_xmate3(env_id):
+    panda_obs, _ = gym.make(env_id).reset(seed=0)
+    env = gym.make(env_id, robot=XMATE)
+    assert env.unwrapped.robot == XMATE and env.action_space.shape == (8,)
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == panda_obs.shape  # both robots have 9 joints: the same layout
+    tcp_start = env.unwrapped.get_obs()
+    for _ in range(5):
+        obs, reward, *_ = env.step(env.action_space.sample())
+        assert np.isfinite(obs).all() and np.isfinite(reward)
+    state = env.unwrapped.get_state()
+    before = env.unwrapped.get_obs()
+    for _ in range(3):
+        env.step(env.action_space.sample())
+    env.unwrapped.set_state(state)
+    assert_obs_equal(before, env.unwrapped.get_obs())
+    assert not np.allclose(tcp_start, before), "the arm moved"
+    env.close()
+
+
+@pytest.mark.parametrize("env_id", ["PegInsertionSide-v0", "PickClutterYCB-v0"])
+def test_panda_only_tasks_refuse_the_xmate3(env_id):
+    with pytest.raises(ValueError, match="panda"):
+        gym.make(env_id, robot=XMATE)

@@ -24,6 +24,14 @@ impl RobotChoice {
     }
 }
 
+/// The robots of ManiSkill2's stationary manipulation tasks (`StationaryManipulationEnv`): the
+/// Panda (default) and the xMate3 with its Robotiq gripper. The cube tasks, PickSingleYCB,
+/// PickSingleEGAD, PlugCharger and AssemblingKits accept both.
+pub const STATIONARY_ROBOTS: &[RobotChoice] = &[
+    RobotChoice::same("panda"),
+    RobotChoice::same("xmate3_robotiq"),
+];
+
 /// ManiSkill2's default control mode of the Panda tasks.
 pub const DEFAULT_CONTROL_MODE: &str = "pd_joint_delta_pos";
 

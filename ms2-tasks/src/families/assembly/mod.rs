@@ -27,9 +27,11 @@ pub use peg_insertion_side::PegInsertionSide;
 pub use plug_charger::PlugCharger;
 
 use crate::registry::{Registrar, TaskRegistration};
-use crate::spec::{RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE, RIGID_OBS_MODES};
+use crate::spec::{
+    RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE, RIGID_OBS_MODES, STATIONARY_ROBOTS,
+};
 
-/// The assembly tasks' robots: the Panda.
+/// PegInsertionSide's robot (ManiSkill2's: the Panda only).
 const PANDA_ONLY: &[RobotChoice] = &[RobotChoice::same("panda")];
 
 /// The spec shared by the assembly tasks (ManiSkill2's: 200 steps, the Panda,
@@ -62,12 +64,15 @@ pub const PEG_INSERTION_SIDE: TaskSpec = assembly_spec(
     &["tcp_pose"],
 );
 
-/// `PlugCharger-v0`'s spec.
-pub const PLUG_CHARGER: TaskSpec = assembly_spec(
-    "PlugCharger-v0",
-    "plug a two-prong charger into its receptacle (0.5 mm clearance)",
-    &["tcp_pose"],
-);
+/// `PlugCharger-v0`'s spec (ManiSkill2's: the Panda or the xMate3).
+pub const PLUG_CHARGER: TaskSpec = TaskSpec {
+    robots: STATIONARY_ROBOTS,
+    ..assembly_spec(
+        "PlugCharger-v0",
+        "plug a two-prong charger into its receptacle (0.5 mm clearance)",
+        &["tcp_pose"],
+    )
+};
 
 /// `AssemblingKits-v0`'s spec.
 pub const ASSEMBLING_KITS: TaskSpec = assembly_spec(

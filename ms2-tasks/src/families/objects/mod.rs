@@ -22,11 +22,14 @@ pub use pick_clutter::PickClutter;
 pub use pick_single::PickSingle;
 
 use crate::registry::{Registrar, TaskRegistration};
-use crate::spec::{RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE, RIGID_OBS_MODES};
+use crate::spec::{
+    RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE, RIGID_OBS_MODES, STATIONARY_ROBOTS,
+};
 
+/// PickClutterYCB's robot (ManiSkill2's: the Panda only).
 const PANDA_ONLY: &[RobotChoice] = &[RobotChoice::same("panda")];
 
-/// The spec shared by the object tasks (ManiSkill2's: 200 steps, the Panda,
+/// The spec shared by the object tasks (ManiSkill2's: 200 steps, the Panda or the xMate3,
 /// `pd_joint_delta_pos` by default, goal marked in renders).
 const fn object_spec(env_id: &'static str, summary: &'static str) -> TaskSpec {
     TaskSpec {
@@ -34,7 +37,7 @@ const fn object_spec(env_id: &'static str, summary: &'static str) -> TaskSpec {
         family: "objects",
         summary,
         max_episode_steps: 200,
-        robots: PANDA_ONLY,
+        robots: STATIONARY_ROBOTS,
         control_modes: &[],
         default_control_mode: DEFAULT_CONTROL_MODE,
         obs_modes: RIGID_OBS_MODES,
@@ -60,6 +63,7 @@ pub const PICK_SINGLE_EGAD: TaskSpec = object_spec(
 /// `PickClutterYCB-v0`'s spec (the target's start point is known without privileged state).
 pub const PICK_CLUTTER_YCB: TaskSpec = TaskSpec {
     non_privileged_extra_keys: &["tcp_pose", "goal_pos", "obj_start_pos"],
+    robots: PANDA_ONLY,
     ..object_spec(
         "PickClutterYCB-v0",
         "pick the object at a given point out of a clutter of household objects and move it to a 3D goal",

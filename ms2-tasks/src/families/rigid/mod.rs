@@ -17,15 +17,8 @@ pub use pick_cube::{PickCube, PickCubeGoal};
 pub use stack_cube::StackCube;
 
 use crate::registry::{Registrar, TaskRegistration};
-use crate::spec::{RobotChoice, TaskSpec, DEFAULT_CONTROL_MODE, RIGID_OBS_MODES};
+use crate::spec::{TaskSpec, DEFAULT_CONTROL_MODE, RIGID_OBS_MODES, STATIONARY_ROBOTS};
 use scripted::Plan;
-
-/// The cube tasks' robots (ManiSkill2's `StationaryManipulationEnv`): the Panda (default) and
-/// the xMate3 with its Robotiq gripper.
-const CUBE_ROBOTS: &[RobotChoice] = &[
-    RobotChoice::same("panda"),
-    RobotChoice::same("xmate3_robotiq"),
-];
 
 /// The spec shared by the cube tasks (ManiSkill2's: 200 steps, the Panda,
 /// `pd_joint_delta_pos` by default).
@@ -35,7 +28,7 @@ const fn cube_spec(env_id: &'static str, summary: &'static str) -> TaskSpec {
         family: "rigid",
         summary,
         max_episode_steps: 200,
-        robots: CUBE_ROBOTS,
+        robots: STATIONARY_ROBOTS,
         control_modes: &[],
         default_control_mode: DEFAULT_CONTROL_MODE,
         obs_modes: RIGID_OBS_MODES,
