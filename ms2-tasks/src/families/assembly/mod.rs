@@ -74,12 +74,15 @@ pub const PLUG_CHARGER: TaskSpec = TaskSpec {
     )
 };
 
-/// `AssemblingKits-v0`'s spec.
-pub const ASSEMBLING_KITS: TaskSpec = assembly_spec(
-    "AssemblingKits-v0",
-    "put a shape into the slot carved for it in a kit board",
-    &["tcp_pose", "obj_init_pos", "obj_goal_pos"],
-);
+/// `AssemblingKits-v0`'s spec (ManiSkill2's: the Panda or the xMate3).
+pub const ASSEMBLING_KITS: TaskSpec = TaskSpec {
+    robots: STATIONARY_ROBOTS,
+    ..assembly_spec(
+        "AssemblingKits-v0",
+        "put a shape into the slot carved for it in a kit board",
+        &["tcp_pose", "obj_init_pos", "obj_goal_pos"],
+    )
+};
 
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
