@@ -41,6 +41,13 @@ const EDGE_AXIS_BIAS: f32 = 1.0e-5;
 /// Edge pairs whose cross product is shorter than this (nearly parallel edges) give no axis.
 const MIN_CROSS: f32 = 1.0e-5;
 
+/// Most vertices a hull may have for its pairs to take the SAT path. The edge-edge axes cost
+/// (edges of a) × (edges of b) × (vertices of both) per query: a few thousand operations for the
+/// kits' prisms (≤ 16 vertices), tens of millions for two of the Panda's link hulls (100-150
+/// vertices), which made an env step of a random arm touching the board take 0.2 s. Larger
+/// hulls go on to parry's GJK (the robot's links; the Panda's fingers have 18 vertices).
+pub const MAX_SAT_VERTICES: usize = 32;
+
 /// A query dispatcher that computes convex-polyhedron/convex-polyhedron contact manifolds with
 /// the separating-axis test and answers `Unsupported` to everything else (chain it before
 /// parry's `DefaultQueryDispatcher`).
@@ -225,12 +232,17 @@ pub fn sat_contact_manifold<ManifoldData, ContactData>(
     manifold.match_contacts(&old_points);
 }
 
-/// Both shapes as convex polyhedra, if they are.
+/// Both shapes as convex polyhedra, if they are and neither has more than
+/// [`MAX_SAT_VERTICES`] vertices.
 fn polyhedra<'a>(
     g1: &'a dyn Shape,
     g2: &'a dyn Shape,
 ) -> Option<(&'a ConvexPolyhedron, &'a ConvexPolyhedron)> {
-    Some((g1.as_convex_polyhedron()?, g2.as_convex_polyhedron()?))
+    let small = |p: &'a ConvexPolyhedron| (p.points().len() <= MAX_SAT_VERTICES).then_some(p);
+    Some((
+        small(g1.as_convex_polyhedron()?)?,
+        small(g2.as_convex_polyhedron()?)?,
+    ))
 }
 
 impl QueryDispatcher for SatConvexDispatcher {

@@ -120,3 +120,56 @@ fn sat_manifolds_are_exact_to_the_clearance() {
         }
     }
 }
+
+/// Hulls of more than `MAX_SAT_VERTICES` vertices (the robot's links) are left to parry's GJK:
+/// their edge-edge axes would cost millions of operations per pair; the kits' prisms take
+/// the SAT.
+#[test]
+fn only_small_hulls_take_the_sat_path() {
+    use ms2_physics::convex_contact::{SatConvexDispatcher, MAX_SAT_VERTICES};
+    use parry3d::query::PersistentQueryDispatcher;
+    use parry3d::shape::Shape;
+    // A regular polygon prism of `n` corners, 2 cm across, 1 cm high.
+    let ngon = |n: usize| {
+        let xy: Vec<(f32, f32)> = (0..n)
+            .map(|i| {
+                let a = i as f32 * std::f32::consts::TAU / n as f32;
+                (0.01 * a.cos(), 0.01 * a.sin())
+            })
+            .collect();
+        prism(&xy, 0.0, 0.01)
+    };
+    let small = ngon(MAX_SAT_VERTICES / 2);
+    let large = ngon(MAX_SAT_VERTICES / 2 + 1);
+    assert_eq!(small.points().len(), MAX_SAT_VERTICES);
+    // Touching: b on top of a, 0.5 mm apart.
+    let pos12 = Pose::translation(0.0, 0.0, 0.0105);
+    let manifolds = |a: &dyn Shape, b: &dyn Shape| {
+        let mut out: Vec<ContactManifold<(), ()>> = Vec::new();
+        let result = PersistentQueryDispatcher::<(), ()>::contact_manifolds(
+            &SatConvexDispatcher,
+            &pos12,
+            a,
+            b,
+            0.001,
+            &mut out,
+            &mut None,
+        );
+        (result.is_ok(), out)
+    };
+    let (handled, out) = manifolds(&small, &small);
+    assert!(handled);
+    let dists: Vec<f32> = out[0].points.iter().map(|p| p.dist).collect();
+    assert!(
+        !dists.is_empty() && dists.iter().all(|d| (d - 0.0005).abs() < 1e-5),
+        "{dists:?}"
+    );
+    assert!(
+        !manifolds(&small, &large).0,
+        "a large hull went through the SAT"
+    );
+    assert!(
+        !manifolds(&large, &small).0,
+        "a large hull went through the SAT"
+    );
+}
