@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-
 import gymnasium as gym
 import ms2
 import numpy as np
@@ -18,13 +16,8 @@ settings.register_profile("heavy", max_examples=500, deadline=None, suppress_hea
 settings.load_profile("ci")
 
 ENV_IDS = ms2.env_ids()
-#: Tasks whose resets and steps cost seconds (PickClutterYCB-v0: four to eight objects of many
-#: convex pieces in contact, docs/tasks.md): left out of the every-task parametrizations unless
-#: MS2_SLOW_TESTS=1; their own test files still run them.
-SLOW_ENV_IDS = {"PickClutterYCB-v0"}
-EVERY_TASK = [
-    e for e in ENV_IDS if e not in SLOW_ENV_IDS or os.environ.get("MS2_SLOW_TESTS") == "1"
-]
+#: The tasks of the every-task parametrizations: all of them.
+EVERY_TASK = list(ENV_IDS)
 #: The task single-env tests use.
 MAIN_ID = "PickCube-v0" if "PickCube-v0" in ENV_IDS else ENV_IDS[0]
 
@@ -48,6 +41,18 @@ def assert_obs_equal(a, b):
         np.testing.assert_array_equal(x, y, err_msg=path)
 
 
+def assert_state_round_trip(env, steps_after: int = 5):
+    """``set_state(get_state())`` after ``steps_after`` random steps brings back the
+    observation bit for bit; returns that observation."""
+    state = env.unwrapped.get_state()
+    obs = env.unwrapped.get_obs()
+    for _ in range(steps_after):
+        env.step(env.action_space.sample())
+    env.unwrapped.set_state(state)
+    assert_obs_equal(obs, env.unwrapped.get_obs())
+    return obs
+
+
 def obs_differs(a, b) -> bool:
     return any(
         not np.array_equal(x, y) for (_, x), (_, y) in zip(leaves(a), leaves(b), strict=True)
@@ -56,7 +61,7 @@ def obs_differs(a, b) -> bool:
 
 @pytest.fixture(params=EVERY_TASK)
 def env_id(request):
-    """Every registered task (but :data:`SLOW_ENV_IDS`)."""
+    """Every registered task."""
     return request.param
 
 

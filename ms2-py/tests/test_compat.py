@@ -8,7 +8,7 @@ import gymnasium as gym
 import ms2
 import numpy as np
 import pytest
-from conftest import EVERY_TASK, assert_obs_equal, leaves
+from conftest import assert_obs_equal, leaves
 from gymnasium.utils.env_checker import check_env
 
 RIGID = "PickCube-v0"
@@ -168,8 +168,7 @@ def _check_env_modes():
     # (ManiSkill2 registers its envs with disable_env_checker=True for this reason).
     for env_id in ms2.env_ids():
         for obs_mode in ms2.Ms2Env(env_id).supported_obs_modes:
-            slow_extra = env_id not in EVERY_TASK and obs_mode not in ("state", "rgbd")
-            if obs_mode != "none" and not slow_extra:
+            if obs_mode != "none":
                 yield env_id, obs_mode
 
 

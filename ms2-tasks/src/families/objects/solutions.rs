@@ -79,6 +79,9 @@ const PRE_GRASP_DISTANCE: f64 = 0.05;
 const LIFT_GROUND_CLEARANCE: f64 = 0.02;
 /// Height (m) the hand rises first when it starts touching an object.
 const START_CLEARANCE: f64 = 0.15;
+/// Further rises (m) tried, one after the other, while the lifted object still touches a
+/// neighbour (or the ground) where the carry starts.
+const CARRY_ESCAPE_HEIGHTS: [f64; 2] = [0.05, 0.08];
 /// Height (m) the hand lifts the object straight up after closing.
 const LIFT_HEIGHT: f64 = 0.06;
 /// How far (m) short of the goal, toward the shoulder, the carry may end (success: 0.025).
@@ -376,20 +379,8 @@ impl Run<'_> {
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
         let holding = self.holding_robot(driver.env())?;
-        let scene = self.scene(&[])?;
-        let mut planner = self.planner(&holding, 1)?;
-        let mut rise = |driver: &mut JointTargetDriver<'_>, height: f64| {
-            let start = driver.arm_target().to_vec();
-            let up = Translation3::new(0.0, 0.0, height) * holding.tcp_pose(&start);
-            match timings.time(|| move_to_pose(&mut planner, &scene, &start, &up)) {
-                Ok(motion) => driver
-                    .follow(&motion.trajectory, Gripper::Closed)
-                    .map(|()| true),
-                Err(_) => Ok(false),
-            }
-        };
         for height in [LIFT_HEIGHT, 0.5 * LIFT_HEIGHT] {
-            if rise(driver, height)? {
+            if self.rise(driver, &holding, height, timings)? {
                 break;
             }
         }
@@ -401,29 +392,43 @@ impl Run<'_> {
             .map(|p| (sensed.target.pose_world_from_object * p.cast::<f64>()).z)
             .fold(f64::INFINITY, f64::min);
         if lowest < LIFT_GROUND_CLEARANCE {
-            rise(driver, LIFT_GROUND_CLEARANCE + 0.01 - lowest)?;
+            self.rise(driver, &holding, LIFT_GROUND_CLEARANCE + 0.01 - lowest, timings)?;
         }
         Ok(())
     }
 
-    /// Carries the held object's centre of mass to `goal` (base frame): the object attached
-    /// to the hand where it is now, the other objects as obstacles; upright hand to the goal
-    /// or up to [`GOAL_TOLERANCE`] short of it, else tilted. One corrective move follows if
-    /// the object ends more than [`CORRECTION_THRESHOLD`] from the goal.
-    fn carry(
+    /// Moves the hand (`holding` what it holds) straight up by `height` (m), the ground the
+    /// only obstacle; `false` when no such motion was found (nothing moved).
+    fn rise(
         &self,
         driver: &mut JointTargetDriver<'_>,
-        goal: &Vector3<f64>,
+        holding: &KinematicRobot,
+        height: f64,
         timings: &mut SolveTimings,
-    ) -> Result<(), SolveError> {
-        let holding = self.holding_robot(driver.env())?;
-        let sensed = (self.sense)(driver.env())?;
+    ) -> Result<bool, SolveError> {
+        let scene = self.scene(&[])?;
+        let mut planner = self.planner(holding, 1)?;
+        let start = driver.arm_target().to_vec();
+        let up = Translation3::new(0.0, 0.0, height) * holding.tcp_pose(&start);
+        match timings.time(|| move_to_pose(&mut planner, &scene, &start, &up)) {
+            Ok(motion) => driver
+                .follow(&motion.trajectory, Gripper::Closed)
+                .map(|()| true),
+            Err(_) => Ok(false),
+        }
+    }
+
+    /// The carry's world: the other objects as obstacles, the target attached to the hand
+    /// where it is now.
+    fn carry_scene(
+        &self,
+        holding: &KinematicRobot,
+        driver: &JointTargetDriver<'_>,
+        sensed: &ObjectScene,
+    ) -> Result<CollisionScene, SolveError> {
         let obstacles: Vec<&SensedObject> = sensed.obstacles.iter().collect();
         let mut scene = self.scene(&obstacles)?;
         let start = driver.arm_target().to_vec();
-        let tcp_now = holding.tcp_pose(&start);
-        let com_now =
-            (self.base_from_world * nalgebra::Point3::from(sensed.target.com_world)).coords;
         let carrier = holding.grasp_link();
         let mut link_poses = Vec::new();
         holding.link_poses(&start, &mut link_poses);
@@ -439,6 +444,41 @@ impl Run<'_> {
                 touch_links: self.gripper.touch_links.clone(),
             })
             .map_err(plan_error("carry"))?;
+        Ok(scene)
+    }
+
+    /// Carries the held object's centre of mass to `goal` (base frame): the object attached
+    /// to the hand where it is now, the other objects as obstacles; upright hand to the goal
+    /// or up to [`GOAL_TOLERANCE`] short of it, else tilted. One corrective move follows if
+    /// the object ends more than [`CORRECTION_THRESHOLD`] from the goal.
+    fn carry(
+        &self,
+        driver: &mut JointTargetDriver<'_>,
+        goal: &Vector3<f64>,
+        timings: &mut SolveTimings,
+    ) -> Result<(), SolveError> {
+        let holding = self.holding_robot(driver.env())?;
+        let mut sensed = (self.sense)(driver.env())?;
+        let mut scene = self.carry_scene(&holding, driver, &sensed)?;
+        // The held object may still touch a neighbour it was stacked against (or the ground):
+        // the planner refuses a start in collision, so rise further first.
+        for height in CARRY_ESCAPE_HEIGHTS {
+            let start = driver.arm_target().to_vec();
+            let free = self
+                .planner(&holding, 2)?
+                .checker(&scene)
+                .map(|c| c.is_valid(&start))
+                .map_err(plan_error("carry"))?;
+            if free || !self.rise(driver, &holding, height, timings)? {
+                break;
+            }
+            sensed = (self.sense)(driver.env())?;
+            scene = self.carry_scene(&holding, driver, &sensed)?;
+        }
+        let start = driver.arm_target().to_vec();
+        let tcp_now = holding.tcp_pose(&start);
+        let com_now =
+            (self.base_from_world * nalgebra::Point3::from(sensed.target.com_world)).coords;
         let tcp_for = |com: &Vector3<f64>| Translation3::from(com - com_now) * tcp_now;
         let mut planner = self.planner(&holding, 2)?;
         let carry = timings.time(|| {
