@@ -53,6 +53,8 @@ pub mod articulation;
 mod bodies;
 pub mod config;
 pub mod contact;
+#[cfg(feature = "rapier")]
+pub mod convex_contact;
 pub mod description;
 pub mod error;
 mod ids;

@@ -19,6 +19,7 @@ pub use crate::ids::{BodyId, BodyKind};
 use crate::math::{pose_from_na, vec_from_na};
 use crate::shape::{ShapeSpec, VisualShape};
 use crate::state::SnapshotCache;
+use parry3d::query::{DefaultQueryDispatcher, QueryDispatcher};
 
 /// One entry of the body table.
 #[derive(Clone, Debug)]
@@ -121,7 +122,13 @@ impl World {
             sim: Sim {
                 islands: IslandManager::new(),
                 broad_phase: BroadPhaseBvh::new(),
-                narrow_phase: NarrowPhase::new(),
+                narrow_phase: if s.sat_convex_contacts {
+                    NarrowPhase::with_query_dispatcher(
+                        crate::convex_contact::SatConvexDispatcher.chain(DefaultQueryDispatcher),
+                    )
+                } else {
+                    NarrowPhase::new()
+                },
                 bodies: RigidBodySet::new(),
                 colliders: ColliderSet::new(),
                 impulse_joints: ImpulseJointSet::new(),

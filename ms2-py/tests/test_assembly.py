@@ -1,4 +1,5 @@
-"""The assembly tasks (PegInsertionSide-v0, PlugCharger-v0) under ManiSkill2's ids and layouts."""
+"""The assembly tasks (PegInsertionSide-v0, PlugCharger-v0, AssemblingKits-v0) under ManiSkill2's
+ids and layouts."""
 
 from __future__ import annotations
 
@@ -25,6 +26,25 @@ ASSEMBLY = {
         ["/extra/tcp_pose", "/extra/charger_pose", "/extra/receptacle_pose", "/extra/goal_pose"],
         50.0,
     ),
+    "AssemblingKits-v0": (
+        51,
+        [
+            "/extra/tcp_pose",
+            "/extra/obj_init_pos",
+            "/extra/obj_goal_pos",
+            "/extra/obj_pose",
+            "/extra/tcp_to_obj_pos",
+            "/extra/obj_to_goal_pos",
+        ],
+        10.0,
+    ),
+}
+
+#: The `extra` keys of the visual obs modes (ManiSkill2's: what is not privileged).
+VISUAL_EXTRA = {
+    "PegInsertionSide-v0": ["tcp_pose"],
+    "PlugCharger-v0": ["tcp_pose"],
+    "AssemblingKits-v0": ["tcp_pose", "obj_init_pos", "obj_goal_pos"],
 }
 
 
@@ -100,10 +120,10 @@ def test_scripted_policy_succeeds_and_rewards_stay_in_range(env_id):
 
 
 @pytest.mark.parametrize("env_id", sorted(ASSEMBLY))
-def test_rgbd_keeps_only_the_tcp_pose(env_id):
+def test_rgbd_keeps_only_unprivileged_extras(env_id):
     env = gym.make(env_id, obs_mode="rgbd")
     obs, _ = env.reset(seed=0)
-    assert list(obs["extra"]) == ["tcp_pose"]
+    assert list(obs["extra"]) == VISUAL_EXTRA[env_id]
     for cam in ("base_camera", "hand_camera"):
         assert obs["image"][cam]["rgb"].shape == (128, 128, 3)
         assert obs["image"][cam]["depth"].shape == (128, 128, 1)
@@ -122,3 +142,59 @@ def test_make_vec_batches_assembly_envs():
     )
     assert obs.shape == (2, 50) and reward.shape == (2,)
     envs.close()
+
+
+def test_kits_shape_lands_in_its_slot():
+    env = gym.make("AssemblingKits-v0", obs_mode="state_dict")
+    policy = ms2.ScriptedPolicy(env)
+    extra = env.reset(seed=1)[0]["extra"]
+    policy.reset()
+    # The shape starts on the ground, away from its slot in the board.
+    assert np.linalg.norm(extra["obj_pose"][:2] - extra["obj_goal_pos"][:2]) > 0.05
+    for _ in range(200):
+        obs, _, terminated, _, info = env.step(policy.act())
+        if terminated:
+            break
+    assert info["success"] and info["in_slot"] and info["rot_correct"], info
+    # Down in the slot: its bottom below 3 mm, at the slot's xy.
+    assert obs["extra"]["obj_pose"][2] < 0.003
+    assert np.linalg.norm(obs["extra"]["obj_to_goal_pos"][:2]) < 0.02
+
+
+@pytest.mark.parametrize("mode", ["pd_joint_pos", "pd_joint_delta_pos", "pd_ee_delta_pose"])
+def test_kits_take_the_xmate3(mode):
+    # ManiSkill2's AssemblingKits is a StationaryManipulationEnv: the Panda or the xMate3.
+    panda = gym.make("AssemblingKits-v0", obs_mode="state_dict")
+    env = gym.make("AssemblingKits-v0", robot="xmate3_robotiq", control_mode=mode)
+    assert env.unwrapped.robot == "xmate3_robotiq"
+    obs, _ = env.reset(seed=2)
+    assert obs.shape == (51,)  # both robots have 9 joints: the Panda's layout
+    sd = env.unwrapped.get_obs()
+    start = gym.make("AssemblingKits-v0", robot="xmate3_robotiq", obs_mode="state_dict")
+    x_extra = start.reset(seed=2)[0]["extra"]
+    p_extra = panda.reset(seed=2)[0]["extra"]
+    # Same kit and shape for the same seed, whichever robot.
+    np.testing.assert_array_equal(x_extra["obj_goal_pos"], p_extra["obj_goal_pos"])
+    np.testing.assert_array_equal(x_extra["obj_init_pos"], p_extra["obj_init_pos"])
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        act = rng.uniform(-1, 1, env.action_space.shape).astype(np.float32)
+        obs, reward, terminated, truncated, info = env.step(act)
+        assert np.isfinite(obs).all() and np.isfinite(reward)
+    assert not info["success"]
+    assert not np.allclose(obs[:7], sd[:7]), "the arm moved"
+
+
+def test_kits_cameras_with_the_xmate3():
+    # ManiSkill2's agent cameras override the task's: the xMate3's base_camera stays on its
+    # mount, the Panda's (a camera in the world) takes the task's view; render() is the task's.
+    views = {}
+    for robot in ("panda", "xmate3_robotiq"):
+        env = gym.make("AssemblingKits-v0", robot=robot, obs_mode="rgbd")
+        obs, _ = env.reset(seed=0)
+        assert set(obs["image"]) == {"base_camera", "hand_camera"}
+        views[robot] = obs["camera_param"]["base_camera"]["cam2world_gl"][:3, 3]
+        assert obs["image"]["base_camera"]["rgb"].std() > 5
+    np.testing.assert_allclose(views["panda"], [0.2, 0.0, 0.4], atol=1e-5)
+    # The xMate3's base camera: 0.965 m in front of its base at x = -0.562, 0.5 m up.
+    np.testing.assert_allclose(views["xmate3_robotiq"], [0.403, 0.0, 0.5], atol=1e-3)

@@ -7,7 +7,7 @@
 //! | family | tasks | feature |
 //! |---|---|---|
 //! | [`rigid`] | `PickCube-v0`, `LiftCube-v0`, `StackCube-v0` | — |
-//! | [`assembly`] | `PegInsertionSide-v0`, `PlugCharger-v0` | — |
+//! | [`assembly`] | `PegInsertionSide-v0`, `PlugCharger-v0`, `AssemblingKits-v0` | — |
 //! | [`soft`] | `Excavate-v0`, `Fill-v0` | `soft` |
 //! | [`articulated`] | `TurnFaucet-v0` (PartNet-Mobility-layout models) | — |
 //! | [`misc`] | `PandaAvoidObstacles-v0` | — |

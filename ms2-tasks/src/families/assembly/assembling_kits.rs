@@ -18,7 +18,7 @@
 
 use std::f32::consts::{PI, TAU};
 
-use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, VisualShape};
+use ms2_physics::{ActorDesc, ActorKind, BodyId, ShapeDesc, ShapeSpec, SolverConfig, VisualShape};
 use nalgebra::{UnitQuaternion, Vector2, Vector3};
 use rand::seq::SliceRandom;
 use rand::Rng;
@@ -209,7 +209,11 @@ pub fn pose_yaw(pose: &Pose3) -> f32 {
 }
 
 /// A prism actor desc: `outline` extruded between `z0` and `z1` (m), colliding exactly where
-/// drawn (its convex hull and its closed triangle mesh have the same corners).
+/// drawn (its collision hulls and its closed triangle mesh have the same corners). An outline
+/// of more than four vertices collides as the wedges from its centroid to each edge: rapier's
+/// contacts use at most four vertices of a face
+/// ([`ms2_physics::mesh::CONTACT_FACE_VERTICES`]), so an octagon standing on its whole bottom
+/// face would be held by half of it and tip over.
 fn prism_desc(
     desc: ActorDesc,
     outline: &Outline,
@@ -217,14 +221,29 @@ fn prism_desc(
     rgba: [f32; 4],
 ) -> ActorDesc {
     let (vertices, indices) = prism_mesh(outline, z0, z1);
-    desc.with_shape(ShapeSpec::new(ShapeDesc::ConvexHull {
-        points: prism_points(outline, z0, z1),
-    }))
-    .with_visual(VisualShape {
-        shape: ShapeDesc::TriMesh { vertices, indices },
-        pose_body_from_shape: Pose3::identity(),
-        rgba,
-    })
+    let n = outline.vertices.len();
+    let hulls: Vec<Outline> = if n <= ms2_physics::mesh::CONTACT_FACE_VERTICES {
+        vec![outline.clone()]
+    } else {
+        let c = outline.vertices.iter().sum::<Vector2<f32>>() / n as f32;
+        (0..n)
+            .map(|i| Outline {
+                vertices: vec![c, outline.vertices[i], outline.vertices[(i + 1) % n]],
+            })
+            .collect()
+    };
+    hulls
+        .iter()
+        .fold(desc, |desc, hull| {
+            desc.with_shape(ShapeSpec::new(ShapeDesc::ConvexHull {
+                points: prism_points(hull, z0, z1),
+            }))
+        })
+        .with_visual(VisualShape {
+            shape: ShapeDesc::TriMesh { vertices, indices },
+            pose_body_from_shape: Pose3::identity(),
+            rgba,
+        })
 }
 
 /// `AssemblingKits-v0` (see the module docs).
@@ -288,6 +307,17 @@ impl AssemblyParts for AssemblingKits {
     const CAMERA_VIEWS: &'static [CameraView] = &CAMERA_VIEWS;
     const HAND_TURNED: bool = false;
     const PREDICTION_DISTANCE: Option<f32> = Some(PREDICTION_DISTANCE);
+
+    /// The common settings with contacts between convex hulls by the separating-axis test
+    /// (parry 0.31's GJK puts phantom contacts between a shape and the board pieces around its
+    /// slot, see `ms2_physics::convex_contact`).
+    fn solver_config(defaults: SolverConfig) -> SolverConfig {
+        SolverConfig {
+            prediction_distance: PREDICTION_DISTANCE,
+            sat_convex_contacts: true,
+            ..defaults
+        }
+    }
 
     fn build(&mut self, world: &mut dyn RigidWorld, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let kit = Kit::sample(rng);

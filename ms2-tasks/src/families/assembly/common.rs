@@ -16,7 +16,7 @@ use crate::info::Evaluation;
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
-use crate::sensors::{with_views, CameraConfig};
+use crate::sensors::{with_views, CameraConfig, CameraMount};
 use crate::task::{Task, TaskScene};
 
 /// A camera placement `(uid, eye, target)` (m, world), as ManiSkill2's `look_at`.
@@ -158,8 +158,17 @@ impl<P: AssemblyParts> Task for AssemblyTask<P> {
         self.parts.task_state_len()
     }
 
+    /// The task's views replace the robot's cameras of the same uid that stand in the world
+    /// (the Panda's `base_camera`); cameras mounted on the robot (the xMate3's `base_camera` and
+    /// both robots' `hand_camera`) stay, as ManiSkill2's agent cameras override the task's.
     fn sensor_cameras(&self, robot_cameras: Vec<CameraConfig>) -> Vec<CameraConfig> {
-        with_views(robot_cameras, P::CAMERA_VIEWS)
+        robot_cameras
+            .into_iter()
+            .map(|cam| match cam.mount {
+                CameraMount::World { .. } => with_views(vec![cam], P::CAMERA_VIEWS).remove(0),
+                CameraMount::RobotLink { .. } => cam,
+            })
+            .collect()
     }
 
     fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {

@@ -1,16 +1,20 @@
-//! Assembly with real clearances: `PegInsertionSide-v0`, `PlugCharger-v0`, and
-//! `AssemblingKits-v0` (built and tested here, not registered yet: see [`register`]).
+//! Assembly with real clearances: `PegInsertionSide-v0`, `PlugCharger-v0` and
+//! `AssemblingKits-v0`.
 //!
 //! [`common`] holds what the assembly tasks share (the task base [`AssemblyTask`] around each
 //! task's [`common::AssemblyParts`], box actors whose collision shapes are their visual shapes,
 //! walls around an opening built from convex boxes, the turned-hand Panda start,
 //! grasp-orientation measures); [`kit_shapes`] the kits' outlines and carved boards; each task
-//! is its geometry, hooks and spec; [`scripted`] is the family's oracle policies and
-//! [`solutions`] its motion-planning solutions (feature `demos`).
+//! is its geometry, hooks and spec; [`scripted`] is the insertion oracle policies,
+//! [`kit_policy`] the kits'; [`solutions`] the motion-planning skeleton and the insertion
+//! tasks' solutions, [`kit_solution`] the kits' (feature `demos`).
 
 pub mod assembling_kits;
 pub mod common;
+pub mod kit_policy;
 pub mod kit_shapes;
+#[cfg(feature = "demos")]
+pub mod kit_solution;
 pub mod peg_insertion_side;
 pub mod plug_charger;
 pub mod scripted;
@@ -70,12 +74,15 @@ pub const PLUG_CHARGER: TaskSpec = TaskSpec {
     )
 };
 
-/// `AssemblingKits-v0`'s spec (not registered yet, see [`register`]).
-pub const ASSEMBLING_KITS: TaskSpec = assembly_spec(
-    "AssemblingKits-v0",
-    "put a shape into the slot carved for it in a kit board",
-    &["tcp_pose", "obj_init_pos", "obj_goal_pos"],
-);
+/// `AssemblingKits-v0`'s spec (ManiSkill2's: the Panda or the xMate3).
+pub const ASSEMBLING_KITS: TaskSpec = TaskSpec {
+    robots: STATIONARY_ROBOTS,
+    ..assembly_spec(
+        "AssemblingKits-v0",
+        "put a shape into the slot carved for it in a kit board",
+        &["tcp_pose", "obj_init_pos", "obj_goal_pos"],
+    )
+};
 
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
@@ -94,7 +101,12 @@ pub fn register(r: &mut Registrar) {
     #[cfg(feature = "demos")]
     let registration = registration.solution(&solutions::PLUG_CHARGER);
     r.add(registration);
-    // AssemblingKits-v0 (`AssemblyTask<AssemblingKits>`, spec `ASSEMBLING_KITS`) is not
-    // registered yet: its shapes do not drop into their carved slots in simulation (a known
-    // failure, docs/tasks.md), so the env could not be solved.
+
+    let registration = TaskRegistration::new(ASSEMBLING_KITS, |_| {
+        Ok(Box::<AssemblyTask<AssemblingKits>>::default())
+    })
+    .scripted(kit_policy::kit_policy);
+    #[cfg(feature = "demos")]
+    let registration = registration.solution(&kit_solution::ASSEMBLING_KITS);
+    r.add(registration);
 }

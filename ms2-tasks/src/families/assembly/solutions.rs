@@ -67,6 +67,9 @@ pub struct InsertionWorld {
     pub inserted: Isometry3<f64>,
     /// Where the hand grasps the part (part frame).
     pub grasp_point: Vector3<f64>,
+    /// The two TCP rotations (part frame) the part may be grasped with
+    /// ([`grasps_across_x_from_above`] for a part lying along its axis).
+    pub grasps: [UnitQuaternion<f64>; 2],
     /// Distance along the part's x from the inserted pose to where its leading end reaches the
     /// opening's entrance.
     pub entry_distance: f64,
@@ -148,6 +151,7 @@ fn sense_plug_charger(env: &Env) -> Result<InsertionWorld, SolveError> {
         inserted: goal * box_from_charger,
         // 2.5 cm behind the charger's front face, in the box's frame.
         grasp_point: Vector3::new(-0.025 - box_from_charger.x, 0.0, 0.0),
+        grasps: grasps_across_x_from_above(),
         entry_distance: tip,
         aligned: 0.0002,
         insert_segment: CHARGER_INSERT_SEGMENT,
@@ -178,20 +182,28 @@ fn sense_peg_insertion(env: &Env) -> Result<InsertionWorld, SolveError> {
         obstacles,
         inserted,
         grasp_point: Vector3::new(-0.055, 0.0, 0.0),
+        grasps: grasps_across_x_from_above(),
         entry_distance: f64::from(g.length()),
         aligned: 0.0007,
         insert_segment: PEG_INSERT_SEGMENT,
     })
 }
 
-/// The two top-down grasps across a part's x axis (TCP rotation in the part's frame); the one
-/// nearest `rot_part_from_tcp` first.
-fn side_grasps(rot_part_from_tcp: &UnitQuaternion<f64>) -> [UnitQuaternion<f64>; 2] {
-    let [a, b] = [
+/// The two top-down grasps across the x axis of a part lying with its z up (TCP rotations in
+/// the part's frame).
+pub fn grasps_across_x_from_above() -> [UnitQuaternion<f64>; 2] {
+    [
         Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0)),
         Matrix3::from_diagonal(&Vector3::new(-1.0, 1.0, -1.0)),
     ]
-    .map(|m| UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m)));
+    .map(|m| UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m)))
+}
+
+/// `grasps` with the one nearest `rot_part_from_tcp` first.
+fn nearest_first(
+    [a, b]: [UnitQuaternion<f64>; 2],
+    rot_part_from_tcp: &UnitQuaternion<f64>,
+) -> [UnitQuaternion<f64>; 2] {
     if a.angle_to(rot_part_from_tcp) <= b.angle_to(rot_part_from_tcp) {
         [a, b]
     } else {
@@ -256,6 +268,26 @@ fn move_to_pose(
         .or_else(|_| planner.plan_to_pose(scene, start, pose))
 }
 
+/// As [`move_to_pose`] in free space, where a screw that cannot be smoothed (the spline
+/// through its waypoints collides or leaves the joint limits, e.g. a wrist at its limit, so
+/// the arm would stop at each of its many waypoints) is replaced by the RRT-Connect motion
+/// when that is shorter in time.
+fn move_through_free_space(
+    planner: &mut MotionPlanner<'_, KinematicRobot>,
+    scene: &CollisionScene,
+    start: &[f64],
+    pose: &Isometry3<f64>,
+) -> Result<PlannedMotion, PlanError> {
+    match planner.plan_screw(scene, start, pose) {
+        Ok(screw) if screw.smoothed || screw.waypoints.len() <= 2 => Ok(screw),
+        Ok(screw) => match planner.plan_to_pose(scene, start, pose) {
+            Ok(planned) if planned.trajectory.len() < screw.trajectory.len() => Ok(planned),
+            _ => Ok(screw),
+        },
+        Err(_) => planner.plan_to_pose(scene, start, pose),
+    }
+}
+
 impl InsertionSolution {
     fn planner<'r>(
         &self,
@@ -305,11 +337,11 @@ impl Solution for InsertionSolution {
         let mut planner = self.planner(panda, driver, seed, 0, SPEED_SCALE)?;
         let mut reached = None;
         let mut last = PlanError::NoPathFound { iterations: 0 };
-        for rot in side_grasps(&rot_now) {
+        for rot in nearest_first(sensed.grasps, &rot_now) {
             let grasp =
                 part_pose * Isometry3::from_parts(Translation3::from(sensed.grasp_point), rot);
             let pre = Translation3::new(0.0, 0.0, PRE_GRASP_DISTANCE) * grasp;
-            match timings.time(|| move_to_pose(&mut planner, &scene, &start, &pre)) {
+            match timings.time(|| move_through_free_space(&mut planner, &scene, &start, &pre)) {
                 Ok(motion) => {
                     reached = Some((motion, grasp));
                     break;
@@ -368,7 +400,7 @@ impl Solution for InsertionSolution {
             * grasped.inserted;
         let carry = timings
             .time(|| {
-                move_to_pose(
+                move_through_free_space(
                     &mut planner,
                     &carrying,
                     driver.arm_target(),
@@ -388,8 +420,10 @@ impl Solution for InsertionSolution {
                 break;
             }
             tcp_target = before * part_now.inverse() * tcp_target;
+            // A screw, else a planned path (a small correction near a joint limit may need the
+            // arm to turn around it).
             let fix = timings
-                .time(|| planner.plan_screw(&carrying, driver.arm_target(), &tcp_target))
+                .time(|| move_to_pose(&mut planner, &carrying, driver.arm_target(), &tcp_target))
                 .map_err(plan_error("align"))?;
             driver.follow(&fix.trajectory, Gripper::Closed)?;
         }
