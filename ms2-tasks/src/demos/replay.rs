@@ -247,7 +247,14 @@ fn convert_once(
     let success_run = source.success.iter().rev().take_while(|&&s| s).count();
     let solved = |recorder: &EpisodeRecorder| {
         success_run > 0
-            && recorder.episode().success.iter().rev().take_while(|&&s| s).count() >= success_run
+            && recorder
+                .episode()
+                .success
+                .iter()
+                .rev()
+                .take_while(|&&s| s)
+                .count()
+                >= success_run
     };
     'source_steps: for t in 0..source.actions.len() {
         desired = targets.targets(source, t)?;

@@ -392,7 +392,12 @@ impl Run<'_> {
             .map(|p| (sensed.target.pose_world_from_object * p.cast::<f64>()).z)
             .fold(f64::INFINITY, f64::min);
         if lowest < LIFT_GROUND_CLEARANCE {
-            self.rise(driver, &holding, LIFT_GROUND_CLEARANCE + 0.01 - lowest, timings)?;
+            self.rise(
+                driver,
+                &holding,
+                LIFT_GROUND_CLEARANCE + 0.01 - lowest,
+                timings,
+            )?;
         }
         Ok(())
     }
