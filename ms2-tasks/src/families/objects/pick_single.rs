@@ -26,10 +26,11 @@ use rand::Rng;
 
 use super::model_db::{ModelDb, ModelLayout, ObjectModel};
 use super::source::{resolve_model_root, ObjectSource};
-use crate::agents::ROBOT_STATIC_QVEL;
 use crate::config::EnvConfig;
 use crate::error::EnvError;
-use crate::families::rigid::common::{body_pose, closeness, REWARD_GRASP_ANGLE_DEG};
+use crate::families::rigid::common::{
+    body_pose, closeness, placed_and_static, REWARD_GRASP_ANGLE_DEG,
+};
 use crate::geometry::{vectorize_pose, Pose3};
 use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
@@ -245,24 +246,15 @@ pub(crate) fn evaluate_placement(
     goal_pos: Vector3<f32>,
 ) -> Evaluation {
     let dist = (goal_pos - obj_pos).norm();
-    let is_obj_placed = dist <= GOAL_THRESHOLD;
-    let is_robot_static = scene
-        .agent
-        .is_static(scene.world.as_ref(), ROBOT_STATIC_QVEL);
-    Evaluation {
-        success: is_obj_placed && is_robot_static,
-        terms: vec![
-            (
-                "obj_to_goal_dist".to_owned(),
-                InfoValue::F64(f64::from(dist)),
-            ),
-            ("is_obj_placed".to_owned(), InfoValue::Bool(is_obj_placed)),
-            (
-                "is_robot_static".to_owned(),
-                InfoValue::Bool(is_robot_static),
-            ),
-        ],
-    }
+    let mut evaluation = placed_and_static(scene, dist <= GOAL_THRESHOLD);
+    evaluation.terms.insert(
+        0,
+        (
+            "obj_to_goal_dist".to_owned(),
+            InfoValue::F64(f64::from(dist)),
+        ),
+    );
+    evaluation
 }
 
 impl Task for PickSingle {

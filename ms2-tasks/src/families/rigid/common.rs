@@ -140,9 +140,9 @@ impl CubeOnGround {
     }
 }
 
-/// Evaluation of a single-cube goal task: `is_obj_placed`, `is_robot_static`, success when both
-/// hold.
-fn placed_and_static(scene: &TaskScene, is_obj_placed: bool) -> Evaluation {
+/// Evaluation of a goal task (the cube tasks, PickSingle, PickClutter): `is_obj_placed`,
+/// `is_robot_static`, success when both hold.
+pub(crate) fn placed_and_static(scene: &TaskScene, is_obj_placed: bool) -> Evaluation {
     let is_robot_static = scene
         .agent
         .is_static(scene.world.as_ref(), ROBOT_STATIC_QVEL);
