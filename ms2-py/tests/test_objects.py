@@ -140,7 +140,7 @@ def test_model_id_and_scale_name_the_episode_s_model():
     cube.reset(seed=0)
     assert not hasattr(cube.unwrapped, "model_id")
     with pytest.raises(AttributeError, match="PickCube-v0"):
-        cube.unwrapped.model_scale
+        _ = cube.unwrapped.model_scale
 
 
 def test_state_round_trip():
