@@ -15,7 +15,7 @@
 //! ([`MAX_CORRECTION_M`], [`MAX_CORRECTION_RAD`]) are left alone: the grasps are then not the
 //! same grasp, and following the object would drag the hand far from the source's path.
 
-use ms2_control::{DlsIk, IkOptions, KinematicChain, RobotConfig};
+use ms2_control::{DlsIk, IkOptions, KinematicChain};
 use ms2_physics::{BodyId, BodyKind};
 use nalgebra::Isometry3;
 
@@ -23,6 +23,7 @@ use super::source_targets::SourceJointTargets;
 use super::{DemoEpisode, DemoError};
 use crate::agents::ARM_DOF;
 use crate::env::Env;
+use crate::scripted::oracle::panda_tcp_chain;
 use crate::task::TaskScene;
 
 /// Largest in-hand offset (m) that is corrected.
@@ -49,15 +50,7 @@ impl InHandCorrection {
     /// The correction for `env`'s robot, or `None` when its joints are not the Panda's (the
     /// only arm whose kinematic chain the conversion knows).
     pub(crate) fn new(env: &Env) -> Option<Self> {
-        let scene = env.task_scene()?;
-        let robot = RobotConfig::panda(ms2_assets::PANDA_URDF).ok()?;
-        let chain = robot.tcp_chain().ok()?;
-        let names = scene.world.joint_names(scene.agent.articulation()).ok()?;
-        let chain_to_articulation = chain
-            .joint_names()
-            .iter()
-            .map(|n| names.iter().position(|m| m == n))
-            .collect::<Option<Vec<_>>>()?;
+        let (chain, chain_to_articulation) = panda_tcp_chain(env.task_scene()?).ok()?;
         let ik = DlsIk::new(IkOptions {
             max_iterations: 50,
             position_tolerance_m: 1e-5,
