@@ -244,10 +244,6 @@ pub struct PoseOptions {
     /// Weight (1/m) of the contact line's horizontal distance from the centre of mass in the
     /// score (rad-equivalent per metre).
     pub com_weight: f64,
-    /// Weight (rad-equivalent) of the sine of the angle between the closing line and the
-    /// direction a rocking or rolling object moves along ([`GraspSite::drift`]): moving
-    /// along the closing line it stays between the fingers.
-    pub drift_weight: f64,
 }
 
 /// The default: upright first, then tilted up to a side grasp; contacts 1 cm up the pads, down
@@ -259,7 +255,6 @@ pub const DEFAULT_POSE_OPTIONS: PoseOptions = PoseOptions {
     ground_clearance: 0.0015,
     fingertips: PANDA_FINGERTIPS,
     com_weight: 8.0,
-    drift_weight: 2.0,
 };
 
 /// Where the object to grasp is (robot base frame).
@@ -269,8 +264,6 @@ pub struct GraspSite {
     pub pose_base_from_object: Isometry3<f64>,
     /// Its centre of mass (m).
     pub com: Vector3<f64>,
-    /// The horizontal unit direction it rocks or rolls along, if it moves.
-    pub drift: Option<Vector3<f64>>,
     /// Height of the ground (m).
     pub ground_z: f64,
 }
@@ -306,7 +299,7 @@ impl PoseOptions {
 
 /// TCP poses (base frame) realising `grasps` on the object at `site`, best first: the approach
 /// closest to straight down, the line closest to the centre of mass, the hand turned least
-/// from `tcp_now`, the tightest cone, (a moving object) the line along its drift. The
+/// from `tcp_now`, the tightest cone. The
 /// fingertips are kept off the ground ([`PoseOptions::min_pad_depth`]).
 pub fn grasp_poses(
     grasps: &[AntipodalGrasp],
@@ -331,7 +324,6 @@ pub fn grasp_poses(
         }
         let base_approach = base_approach.normalize();
         let off_com = (centre.coords - site.com).xy().norm();
-        let across_drift = site.drift.map_or(0.0, |d| line.cross(&d).norm());
         for &turn in options.approach_turns {
             let approach =
                 UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_normalize(line), turn)
@@ -353,11 +345,8 @@ pub fn grasp_poses(
                 let position = centre.coords + approach * depth;
                 let pose = Isometry3::from_parts(Translation3::from(position), rotation);
                 let turn_from_hand = rotation.angle_to(&tcp_now.rotation);
-                let score = tilt
-                    + options.com_weight * off_com
-                    + 0.3 * turn_from_hand
-                    + 0.5 * g.cone_angle
-                    + options.drift_weight * across_drift;
+                let score =
+                    tilt + options.com_weight * off_com + 0.3 * turn_from_hand + 0.5 * g.cone_angle;
                 let kind = if tilt < std::f64::consts::FRAC_PI_4 {
                     GraspKind::TopDown
                 } else {
@@ -437,6 +426,94 @@ mod tests {
         }
     }
 
+    /// A cup `2·radius` wide and `height` tall: a bottom slab and `walls` wall slabs
+    /// `thickness` thick around it.
+    fn cup(radius: f32, height: f32, thickness: f32, walls: usize) -> Vec<Vec<Point3<f32>>> {
+        let mut pieces = vec![block(radius, radius, 0.5 * thickness)];
+        let half_side = radius * (std::f32::consts::PI / walls as f32).tan();
+        for k in 0..walls {
+            let a = std::f32::consts::TAU * k as f32 / walls as f32;
+            let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), a);
+            let offset = Vector3::new(radius - 0.5 * thickness, 0.0, 0.5 * height);
+            pieces.push(
+                block(0.5 * thickness, half_side, 0.5 * height)
+                    .into_iter()
+                    .map(|p| Point3::from(turn * (p.coords + offset)))
+                    .collect(),
+            );
+        }
+        pieces
+    }
+
+    #[test]
+    fn a_cup_wider_than_the_gripper_is_grasped_across_its_wall() {
+        // 10 cm wide (the Panda opens 8 cm), 4 mm walls.
+        let pieces = cup(0.05, 0.08, 0.004, 12);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let grasps = sample_antipodal(&pieces, 100, 0.075, 0.45, &mut rng);
+        let across_wall: Vec<_> = grasps
+            .iter()
+            .filter(|g| g.width < 0.006 && g.closing.z.abs() < 0.1)
+            .collect();
+        assert!(
+            across_wall.len() >= 10,
+            "{} of {grasps:?}",
+            across_wall.len()
+        );
+        for g in across_wall {
+            let radial = Vector3::new(g.centre.x, g.centre.y, 0.0);
+            // The line crosses the wall, at the wall.
+            assert!((radial.norm() - 0.048).abs() < 0.003, "{g:?}");
+            assert!(g.closing.dot(&radial.normalize()).abs() > 0.9, "{g:?}");
+        }
+        // Nothing spans the whole cup.
+        assert!(grasps.iter().all(|g| g.width <= 0.075));
+    }
+
+    #[test]
+    fn low_objects_are_grasped_with_the_fingertips_above_the_ground() {
+        // A 12 mm thick spoon-like bar lying on the ground (z = 0), grasped across its 3 cm.
+        let grasp = AntipodalGrasp {
+            centre: Vector3::new(0.0, 0.0, 0.006),
+            closing: Vector3::x(),
+            width: 0.03,
+            cone_angle: 0.0,
+        };
+        let site = GraspSite {
+            pose_base_from_object: Isometry3::translation(0.5, 0.0, 0.0),
+            com: Vector3::new(0.5, 0.0, 0.006),
+            ground_z: 0.0,
+        };
+        let hand = Isometry3::from_parts(
+            Translation3::new(0.4, 0.0, 0.3),
+            UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI),
+        );
+        let options = DEFAULT_POSE_OPTIONS;
+        let poses = grasp_poses(&[grasp], &site, &hand, &options);
+        assert!(!poses.is_empty());
+        let tips = options.fingertips;
+        for p in &poses {
+            let tcp = p.pose_base_from_tcp;
+            let approach = tcp.rotation * Vector3::z();
+            let depth = (tcp.translation.vector - Vector3::new(0.5, 0.0, 0.006)).dot(&approach);
+            assert!(depth >= options.min_pad_depth - 1e-9 && depth <= options.pad_depth + 1e-9);
+            // Every fingertip corner above the ground by the clearance.
+            for sx in [-1.0, 1.0] {
+                for sy in [-1.0, 1.0] {
+                    let corner = tcp
+                        * Point3::new(sx * tips.half_width, sy * tips.outer_reach, tips.past_tcp);
+                    assert!(corner.z >= options.ground_clearance - 1e-9, "{p:?}");
+                }
+            }
+        }
+        // The upright grasp is among them, its contacts 4.5 mm up from the fingertips' ends.
+        let upright = &poses[0].pose_base_from_tcp;
+        assert!((upright.rotation * Vector3::z()).z < -0.999);
+        assert!(
+            (upright.translation.vector.z - (0.006 + 0.0015 + tips.past_tcp - 0.006)).abs() < 1e-3
+        );
+    }
+
     #[test]
     fn poses_close_along_the_line_and_prefer_a_downward_approach() {
         let grasp = AntipodalGrasp {
@@ -450,8 +527,12 @@ mod tests {
             Translation3::new(0.4, 0.0, 0.3),
             UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI),
         );
-        let com = Vector3::new(0.5, 0.1, 0.02);
-        let poses = grasp_poses(&[grasp], &object, &com, &hand, &DEFAULT_POSE_OPTIONS);
+        let site = GraspSite {
+            pose_base_from_object: object,
+            com: Vector3::new(0.5, 0.1, 0.02),
+            ground_z: -0.1,
+        };
+        let poses = grasp_poses(&[grasp], &site, &hand, &DEFAULT_POSE_OPTIONS);
         assert_eq!(poses.len(), 2 * DEFAULT_POSE_OPTIONS.approach_turns.len());
         let best = poses[0].pose_base_from_tcp;
         assert!((best.rotation * Vector3::z() - (-Vector3::z())).norm() < 1e-9);

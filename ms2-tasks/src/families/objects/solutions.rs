@@ -12,7 +12,7 @@ use ms2_plan::{
     reachable_grasps, AttachedObject, CheckerOptions, CollisionScene, GraspCandidate, GraspPose,
     GripperSpec, KinematicRobot, MotionPlanner, PlanError, PlannerConfig, PlanningRobot,
 };
-use nalgebra::{Isometry3, Matrix2, Translation3, Vector2, Vector3};
+use nalgebra::{Isometry3, Translation3, Vector3};
 use rand::SeedableRng;
 
 use super::grasping::{
@@ -42,8 +42,6 @@ pub struct SensedObject {
     pub pose_world_from_object: Isometry3<f64>,
     /// Centre of mass in the world (m).
     pub com_world: Vector3<f64>,
-    /// Velocity of the centre of mass (m/s, world).
-    pub velocity_world: Vector3<f64>,
 }
 
 /// What an object solution plans from.
@@ -74,23 +72,11 @@ const CONE_ANGLE: f64 = 0.45;
 const GRASP_BATCH: usize = 24;
 /// Most grasp poses tried.
 const MAX_GRASP_POSES: usize = 480;
-/// Horizontal speed (m/s) above which the target counts as moving (a rocking fruit, a
-/// rolling can): it is watched before it is grasped.
-const MOVING_SPEED: f64 = 0.005;
-/// Env steps a moving target is watched from the pre-grasp (about one period of a rocking
-/// fruit).
-const WATCH_STEPS: u32 = 16;
-/// Env steps from the pre-grasp to the fingers closing (descent, settling, pause, closing):
-/// how far ahead a steadily rolling target's position is predicted.
-const GRASP_LEAD_STEPS: f64 = 18.0;
-/// Share of a watched target's motion a straight line must explain (R²) for the target to
-/// count as rolling steadily rather than rocking.
-const STEADY_FIT: f64 = 0.9;
 /// Grasp plans at most per pick: the first, then one from the pre-grasp when the target
-/// moved.
+/// moved (a rocking fruit, a can rolling, a nudge).
 const TRACK_ROUNDS: u64 = 2;
-/// Distance (m) the target may be from where its grasp was planned (or spread about its mean
-/// while watched) before the grasp is planned again.
+/// Distance (m) the target may move from where its grasp was planned before the grasp is
+/// planned again (from the pre-grasp), or (half of it) followed by the descent.
 const TRACK_TOLERANCE: f64 = 0.004;
 /// Pre-grasp distance (m) back along the approach.
 const PRE_GRASP_DISTANCE: f64 = 0.05;
@@ -161,6 +147,11 @@ impl Solution for ObjectPickSolution {
             let sensed = (self.sense)(driver.env())?;
             run.pick(driver, &sensed, attempt, timings)?;
             run.lift(driver, timings)?;
+                let now = (self.sense)(driver.env())?;
+                let sc = driver.env().task_scene().unwrap();
+                let q = sc.agent.qpos(sc.world.as_ref());
+                eprintln!("LIFT seed {seed} {} attempt {attempt} holds {} com before {:.3?} now {:.3?} finger {:.4} step {}", sensed.target.name, run.holds(driver.env(), &sensed)?, sensed.target.com_world.as_slice(), now.target.com_world.as_slice(), q[ARM_DOF], driver.env().elapsed_steps());
+            }
             if !last && !run.holds(driver.env(), &sensed)? {
                 // Missed or slipped: let go and grasp again from where the object lies now.
                 driver.hold(OPEN_STEPS, Gripper::Open)?;
@@ -169,6 +160,12 @@ impl Solution for ObjectPickSolution {
             let goal = run.base_from_world * nalgebra::Point3::from(sensed.goal_world);
             run.carry(driver, &goal.coords, timings)?;
             let now = (self.sense)(driver.env())?;
+                eprintln!(
+                    "CARRY seed {seed} attempt {attempt} dist {:.3} step {}",
+                    (now.target.com_world - sensed.goal_world).norm(),
+                    driver.env().elapsed_steps()
+                );
+            }
             if !last && (now.target.com_world - sensed.goal_world).norm() > DROPPED_DISTANCE {
                 // Dropped on the way: start over from where it fell.
                 driver.hold(OPEN_STEPS, Gripper::Open)?;
@@ -238,14 +235,12 @@ impl Run<'_> {
 
     /// Samples antipodal grasps of `target` and keeps the first batch of poses with a
     /// reachable, collision-free grasp and pre-grasp (open fingers clear of the object) in
-    /// `scene`, from configuration `start`, preferring to close along `drift` (world) if
-    /// given. `draw` varies the samples.
+    /// `scene`, from configuration `start`. `draw` varies the samples.
     fn choose_grasp(
         &self,
         scene: &CollisionScene,
         target: &SensedObject,
         start: &[f64],
-        drift: Option<Vector3<f64>>,
         draw: u64,
     ) -> Result<GraspCandidate, SolveError> {
         let mut rng =
@@ -260,7 +255,6 @@ impl Run<'_> {
         let site = GraspSite {
             pose_base_from_object: self.base_from_world * target.pose_world_from_object,
             com: (self.base_from_world * nalgebra::Point3::from(target.com_world)).coords,
-            drift: drift.map(|d| self.base_from_world.rotation * d),
             ground_z: -self.base_from_world.inverse().translation.vector.z,
         };
         let tcp_now = self.panda.tcp_pose(start);
@@ -290,10 +284,9 @@ impl Run<'_> {
     }
 
     /// Reaches the pre-grasp of a reachable, collision-free grasp (see
-    /// [`Run::choose_grasp`]), descends and closes. From the pre-grasp a moving target is
-    /// watched ([`Run::watch`]) and its grasp planned again about where it rocks (or where
-    /// it rolls to), closing along its motion; a target that moved since it was sensed is
-    /// grasped again too.
+    /// [`Run::choose_grasp`]), descends and closes. A target that moved more than
+    /// [`TRACK_TOLERANCE`] meanwhile is grasped anew from the pre-grasp; one that moved less
+    /// is followed by the descent.
     fn pick(
         &self,
         driver: &mut JointTargetDriver<'_>,
@@ -302,14 +295,11 @@ impl Run<'_> {
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
         let mut sensed = sensed.clone();
-        let mut drift = None;
         let mut planned: Option<(GraspCandidate, CollisionScene, Vector3<f64>)> = None;
         for round in 0..TRACK_ROUNDS {
             if let Some((_, _, aim)) = &planned {
-                let planned_drift = drift.is_some();
-                (sensed, drift) = self.watch(driver)?;
-                let still = (sensed.target.com_world - aim).norm() <= TRACK_TOLERANCE;
-                if still && (drift.is_none() || planned_drift) {
+                sensed = (self.sense)(driver.env())?;
+                if (sensed.target.com_world - aim).norm() <= TRACK_TOLERANCE {
                     break;
                 }
             }
@@ -320,7 +310,7 @@ impl Run<'_> {
             let start = driver.arm_target().to_vec();
             let draw = attempt.wrapping_add(1000 * round);
             let target = &sensed.target;
-            let grasp = timings.time(|| self.choose_grasp(&scene, target, &start, drift, draw))?;
+            let grasp = timings.time(|| self.choose_grasp(&scene, target, &start, draw))?;
             let mut planner = self.planner(self.panda, 0)?;
             let pre_grasp_pose = grasp.grasp.pre_grasp_pose(PRE_GRASP_DISTANCE);
             let reach = timings.time(|| {
@@ -335,20 +325,23 @@ impl Run<'_> {
             driver.follow(&reach.trajectory, Gripper::Open)?;
             planned = Some((grasp, scene, sensed.target.com_world));
         }
-        let Some((grasp, mut approach_scene, _)) = planned else {
+        let Some((grasp, mut approach_scene, aim)) = planned else {
             return Err(SolveError::Sensing("no grasp was planned".to_owned()));
         };
+        // A target that slid a little since is followed.
+        let mut grasp_pose = grasp.grasp.pose_base_from_tcp;
+        let now = (self.sense)(driver.env())?.target.com_world;
+        let slid = Vector3::new(now.x - aim.x, now.y - aim.y, 0.0);
+        if slid.norm() > 0.5 * TRACK_TOLERANCE {
+            grasp_pose = Translation3::from(self.base_from_world.rotation * slid) * grasp_pose;
+        }
         let mut planner = self.planner(self.panda, 0)?;
         for finger in &self.gripper.touch_links {
             approach_scene.allow_collision(finger.clone(), sensed.target.name.clone());
         }
         let descend = timings.time(|| {
             planner
-                .plan_screw(
-                    &approach_scene,
-                    driver.arm_target(),
-                    &grasp.grasp.pose_base_from_tcp,
-                )
+                .plan_screw(&approach_scene, driver.arm_target(), &grasp_pose)
                 .or_else(|_| {
                     planner.plan_to_configuration(
                         &approach_scene,
@@ -362,43 +355,6 @@ impl Run<'_> {
         driver.settle(SETTLE_TOLERANCE, SETTLE_MAX_STEPS, Gripper::Open)?;
         driver.hold(PAUSE_STEPS, Gripper::Open)?;
         driver.hold(CLOSE_STEPS, Gripper::Closed)
-    }
-
-    /// Senses the scene; when the target moves faster than [`MOVING_SPEED`], holds still for
-    /// [`WATCH_STEPS`] while watching it and returns it moved to the middle of its path (to
-    /// where a straight-line fit puts it [`GRASP_LEAD_STEPS`] on, if it rolls steadily)
-    /// with its path's main horizontal direction, when that path spreads more than
-    /// [`TRACK_TOLERANCE`].
-    fn watch(
-        &self,
-        driver: &mut JointTargetDriver<'_>,
-    ) -> Result<(ObjectScene, Option<Vector3<f64>>), SolveError> {
-        let mut sensed = (self.sense)(driver.env())?;
-        if sensed.target.velocity_world.xy().norm() <= MOVING_SPEED {
-            return Ok((sensed, None));
-        }
-        let mut path = vec![sensed.target.com_world.xy()];
-        for _ in 0..WATCH_STEPS {
-            driver.hold(1, Gripper::Open)?;
-            sensed = (self.sense)(driver.env())?;
-            path.push(sensed.target.com_world.xy());
-        }
-        let Some(motion) = PathFit::of(&path) else {
-            return Ok((sensed, None));
-        };
-        let aim = if motion.steadiness >= STEADY_FIT {
-            motion.at(path.len() as f64 - 1.0 + GRASP_LEAD_STEPS)
-        } else {
-            motion.mean
-        };
-        let now = sensed.target.com_world;
-        let shift = Vector3::new(aim.x - now.x, aim.y - now.y, 0.0);
-        sensed.target.pose_world_from_object =
-            Translation3::from(shift) * sensed.target.pose_world_from_object;
-        sensed.target.com_world += shift;
-        let drift = (motion.spread > TRACK_TOLERANCE)
-            .then(|| Vector3::new(motion.direction.x, motion.direction.y, 0.0));
-        Ok((sensed, drift))
     }
 
     /// When the hand starts touching an object (a tall object next to the rest pose), backs it
@@ -611,78 +567,6 @@ impl Run<'_> {
     }
 }
 
-/// A straight-line fit of a horizontal path sampled once per step (m, world).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct PathFit {
-    /// Mean point.
-    mean: Vector2<f64>,
-    /// Unit direction of the largest spread.
-    direction: Vector2<f64>,
-    /// Largest distance of a sample from the mean (m).
-    spread: f64,
-    /// Motion along `direction` per step (m), least squares.
-    per_step: f64,
-    /// Share of the spread along `direction` the straight line explains (R², 0..1).
-    steadiness: f64,
-    /// The step at which the fit passes `mean` (the middle sample).
-    mean_step: f64,
-}
-
-impl PathFit {
-    /// The fit of `path` (at least two samples).
-    fn of(path: &[Vector2<f64>]) -> Option<Self> {
-        if path.len() < 2 {
-            return None;
-        }
-        let n = path.len() as f64;
-        let mean = path.iter().sum::<Vector2<f64>>() / n;
-        let mut covariance = Matrix2::zeros();
-        for p in path {
-            covariance += (p - mean) * (p - mean).transpose();
-        }
-        let eigen = covariance.symmetric_eigen();
-        let main = if eigen.eigenvalues[0] >= eigen.eigenvalues[1] {
-            0
-        } else {
-            1
-        };
-        let direction = eigen
-            .eigenvectors
-            .column(main)
-            .into_owned()
-            .try_normalize(1e-12)?;
-        let spread = path.iter().map(|p| (p - mean).norm()).fold(0.0, f64::max);
-        // Least squares of the position along `direction` against the step index.
-        let t_mean = 0.5 * (n - 1.0);
-        let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
-        for (i, p) in path.iter().enumerate() {
-            let (t, y) = (i as f64 - t_mean, (p - mean).dot(&direction));
-            sxy += t * y;
-            sxx += t * t;
-            syy += y * y;
-        }
-        let per_step = sxy / sxx;
-        let steadiness = if syy > 0.0 {
-            sxy * sxy / (sxx * syy)
-        } else {
-            0.0
-        };
-        Some(Self {
-            mean,
-            direction,
-            spread,
-            per_step,
-            steadiness,
-            mean_step: t_mean,
-        })
-    }
-
-    /// The fitted position at step `t` (0: the first sample).
-    fn at(&self, t: f64) -> Vector2<f64> {
-        self.mean + self.direction * (self.per_step * (t - self.mean_step))
-    }
-}
-
 /// `PickSingleYCB-v0` / `PickSingleEGAD-v0`: the one object, no obstacles.
 pub const PICK_SINGLE: ObjectPickSolution = ObjectPickSolution {
     sense: sense_pick_single,
@@ -704,10 +588,6 @@ fn sense_pick_single(env: &Env) -> Result<ObjectScene, SolveError> {
                 .ok_or_else(|| SolveError::Sensing("the scene has no object".to_owned()))?,
             pose_world_from_object: body_pose(world, task.body()).cast(),
             com_world: task.obj_pose(world).translation.vector.cast(),
-            velocity_world: world
-                .body_linear_velocity(task.body())
-                .unwrap_or_default()
-                .cast(),
         },
         obstacles: Vec::new(),
         goal_world: task.goal_pos.cast(),
@@ -737,10 +617,6 @@ fn sense_pick_clutter(env: &Env) -> Result<ObjectScene, SolveError> {
             model: o.model.clone(),
             pose_world_from_object: body_pose(world, o.body).cast(),
             com_world: com,
-            velocity_world: world
-                .body_linear_velocity(o.body)
-                .unwrap_or_default()
-                .cast(),
         };
         if i == task.target {
             target = Some(sensed);
