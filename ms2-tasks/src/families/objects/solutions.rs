@@ -147,11 +147,6 @@ impl Solution for ObjectPickSolution {
             let sensed = (self.sense)(driver.env())?;
             run.pick(driver, &sensed, attempt, timings)?;
             run.lift(driver, timings)?;
-                let now = (self.sense)(driver.env())?;
-                let sc = driver.env().task_scene().unwrap();
-                let q = sc.agent.qpos(sc.world.as_ref());
-                eprintln!("LIFT seed {seed} {} attempt {attempt} holds {} com before {:.3?} now {:.3?} finger {:.4} step {}", sensed.target.name, run.holds(driver.env(), &sensed)?, sensed.target.com_world.as_slice(), now.target.com_world.as_slice(), q[ARM_DOF], driver.env().elapsed_steps());
-            }
             if !last && !run.holds(driver.env(), &sensed)? {
                 // Missed or slipped: let go and grasp again from where the object lies now.
                 driver.hold(OPEN_STEPS, Gripper::Open)?;
@@ -160,12 +155,6 @@ impl Solution for ObjectPickSolution {
             let goal = run.base_from_world * nalgebra::Point3::from(sensed.goal_world);
             run.carry(driver, &goal.coords, timings)?;
             let now = (self.sense)(driver.env())?;
-                eprintln!(
-                    "CARRY seed {seed} attempt {attempt} dist {:.3} step {}",
-                    (now.target.com_world - sensed.goal_world).norm(),
-                    driver.env().elapsed_steps()
-                );
-            }
             if !last && (now.target.com_world - sensed.goal_world).norm() > DROPPED_DISTANCE {
                 // Dropped on the way: start over from where it fell.
                 driver.hold(OPEN_STEPS, Gripper::Open)?;
