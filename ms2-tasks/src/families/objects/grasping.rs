@@ -246,11 +246,12 @@ pub struct PoseOptions {
     pub com_weight: f64,
 }
 
-/// The default: upright first, then tilted up to a side grasp; contacts 1 cm up the pads, down
-/// to 2.5 mm from the fingertips on low objects (the fingertips 1.5 mm above the ground).
+/// The default: upright first, then tilted up to a side grasp; contacts at the TCP (the middle
+/// of the Panda's pads, which reach 9 mm above and 9.5 mm below it), down to 2.5 mm from the
+/// fingertips on low objects (the fingertips 1.5 mm above the ground).
 pub const DEFAULT_POSE_OPTIONS: PoseOptions = PoseOptions {
     approach_turns: &[0.0, 0.35, -0.35, 0.7, -0.7, 1.05, -1.05, 1.4, -1.4],
-    pad_depth: 0.01,
+    pad_depth: 0.0,
     min_pad_depth: -0.007,
     ground_clearance: 0.0015,
     fingertips: PANDA_FINGERTIPS,
@@ -537,8 +538,8 @@ mod tests {
         let best = poses[0].pose_base_from_tcp;
         assert!((best.rotation * Vector3::z() - (-Vector3::z())).norm() < 1e-9);
         assert!((best.rotation * Vector3::y()).x.abs() > 1.0 - 1e-9);
-        // TCP 1 cm below the contact line (past it along the approach).
-        assert!((best.translation.vector - Vector3::new(0.5, 0.1, 0.01)).norm() < 1e-9);
+        // The TCP (the middle of the pads) on the contact line.
+        assert!((best.translation.vector - Vector3::new(0.5, 0.1, 0.02)).norm() < 1e-9);
         assert_eq!(poses[0].kind, GraspKind::TopDown);
         assert_eq!(poses.last().unwrap().kind, GraspKind::Side);
     }

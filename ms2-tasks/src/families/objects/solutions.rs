@@ -16,7 +16,7 @@ use nalgebra::{Isometry3, Translation3, Vector3};
 use rand::SeedableRng;
 
 use super::grasping::{
-    grasp_poses, object_shape, sample_antipodal, GraspSite, PoseOptions, DEFAULT_POSE_OPTIONS,
+    grasp_poses, object_shape, sample_antipodal, GraspSite, DEFAULT_POSE_OPTIONS,
 };
 use super::model_db::ObjectModel;
 use super::pick_clutter::PickClutter;
@@ -116,12 +116,6 @@ const PAUSE_STEPS: u32 = 3;
 const SUCCESS_STEPS: usize = 3;
 /// Fraction of the joint speed and acceleration limits used.
 const SPEED_SCALE: f64 = 0.5;
-/// The pose options tried after [`DEFAULT_POSE_OPTIONS`]: contacts at the fingertips (thin,
-/// low objects the padded pose would push into the ground).
-const TIP_POSE_OPTIONS: PoseOptions = PoseOptions {
-    pad_depth: 0.0,
-    ..DEFAULT_POSE_OPTIONS
-};
 
 impl Solution for ObjectPickSolution {
     fn run(
@@ -249,11 +243,6 @@ impl Run<'_> {
         let tcp_now = self.panda.tcp_pose(start);
         let mut poses: Vec<GraspPose> = grasp_poses(&lines, &site, &tcp_now, &DEFAULT_POSE_OPTIONS);
         poses.truncate(MAX_GRASP_POSES);
-        poses.extend(
-            grasp_poses(&lines, &site, &tcp_now, &TIP_POSE_OPTIONS)
-                .into_iter()
-                .take(MAX_GRASP_POSES / 2),
-        );
         let mut last = PlanError::NoGraspFound { candidates: 0 };
         for batch in poses.chunks(GRASP_BATCH) {
             match reachable_grasps(
