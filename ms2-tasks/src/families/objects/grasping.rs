@@ -2,11 +2,15 @@
 //! realise them.
 //!
 //! [`sample_antipodal`] draws points on the surface of the pieces (area-weighted), and for each
-//! looks along its normal for the two outermost surface points the closing fingers would touch
-//! (ray casts from outside the object on both sides). A line is kept when both contacts'
-//! normals lie within a friction cone of the closing direction and the object is narrower there
-//! than the open gripper. [`grasp_poses`] turns each line into TCP poses (closing axis along
-//! the line, approach axis across it, from above where possible), best first.
+//! looks along its normal for the contacts the closing fingers would touch: the two outermost
+//! surface points (ray casts from outside the object on both sides: the fingers enclose all
+//! the line crosses) and the thinnest layer through the point (from its surface to where the
+//! material first ends: a wall at a bowl's or mug's rim, a handle; the far finger then sits in
+//! the free space beyond, which the planner checks). A pair is kept when both contacts'
+//! normals lie within a friction cone of the closing direction and it is narrower than the
+//! open gripper. [`grasp_poses`] turns each line into TCP poses (closing axis along the line,
+//! approach axis across it, from above where possible, the fingertips kept off the ground),
+//! best first.
 //!
 //! Frames: the sampler works in the object's model frame (m); poses are in the robot base
 //! frame. The TCP convention is ms2-plan's: +z approaches, y closes.
