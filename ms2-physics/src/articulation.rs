@@ -213,11 +213,13 @@ impl World {
                         })?
                         .user_data(id.0 as u128)
                         .build();
-                    colliders.push(self.sim.colliders.insert_with_parent(
+                    let collider = self.sim.colliders.insert_with_parent(
                         collider,
                         handle,
                         &mut self.sim.bodies,
-                    ));
+                    );
+                    self.register_patch_collider(collider, material.torsional_patch_radius_m);
+                    colliders.push(collider);
                     shapes.push(spec);
                 }
                 for v in &link.visuals {

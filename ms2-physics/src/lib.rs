@@ -67,6 +67,8 @@ pub mod shape;
 #[cfg(feature = "rapier")]
 pub mod state;
 pub mod state_layout;
+#[cfg(feature = "rapier")]
+mod torsional;
 pub mod urdf;
 #[cfg(feature = "rapier")]
 pub mod world;
@@ -84,7 +86,9 @@ pub use math::Pose3;
 pub use mesh::{connected_components, per_part_hulls, MeshCollision, MeshError, MeshPart};
 #[cfg(feature = "rapier")]
 pub use panda::{add_panda, add_panda_from_file, add_panda_from_urdf};
-pub use panda::{PandaOptions, PANDA_FINGER_FRICTION};
+pub use panda::{
+    PandaOptions, GRIPPER_PAD_PATCH_RADIUS_M, PANDA_FINGER_FRICTION, PANDA_FINGER_MATERIAL,
+};
 pub use shape::{MassSpec, Material, ShapeDesc, ShapeSpec, VisualShape};
 pub use state_layout::{StateField, StateQuantity};
 pub use urdf::{parse_urdf_file, parse_urdf_str, UrdfLoadOptions};

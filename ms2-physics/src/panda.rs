@@ -14,6 +14,20 @@ use crate::{
 /// Friction coefficient of the finger pads (ManiSkill2 uses 2.0 so grasps hold).
 pub const PANDA_FINGER_FRICTION: f32 = 2.0;
 
+/// Torsional patch radius of the finger pads (m): ManiSkill2 gives its grippers' pads
+/// `patch_radius = min_patch_radius = 0.1`, so an object held off its centre does not pivot
+/// between them (see [`Material::torsional_patch_radius_m`]).
+pub const GRIPPER_PAD_PATCH_RADIUS_M: f32 = 0.1;
+
+/// The finger pads' material: friction [`PANDA_FINGER_FRICTION`], no restitution, torsional
+/// patch radius [`GRIPPER_PAD_PATCH_RADIUS_M`] (ManiSkill2's `gripper` material and pad links).
+pub const PANDA_FINGER_MATERIAL: Material = Material {
+    static_friction: PANDA_FINGER_FRICTION,
+    dynamic_friction: PANDA_FINGER_FRICTION,
+    restitution: 0.0,
+    torsional_patch_radius_m: GRIPPER_PAD_PATCH_RADIUS_M,
+};
+
 /// How to add a Panda to a world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PandaOptions {
@@ -39,7 +53,7 @@ impl Default for PandaOptions {
             qpos: ms2_assets::PANDA_REST_QPOS.map(|q| q as f32),
             arm_drive: DriveParams::MANISKILL2_ARM,
             gripper_drive: DriveParams::MANISKILL2_ARM,
-            finger_material: Material::new(PANDA_FINGER_FRICTION, 0.0),
+            finger_material: PANDA_FINGER_MATERIAL,
             link_material: Material::default(),
         }
     }

@@ -208,6 +208,13 @@ pub struct Material {
     pub dynamic_friction: f32,
     /// Restitution in `[0, 1]`.
     pub restitution: f32,
+    /// Radius (m, ≥ 0) of the contact patch that resists twisting about the contact normal
+    /// (PhysX's torsional patch radius): a body touching this shape with normal force `N`
+    /// cannot spin against it about the normal while the friction torque it needs stays
+    /// below `μ · N · r`. rapier's point contacts have no such torque, so a curved object
+    /// pinched off its centre would pivot between the fingers; 0 (the default) adds nothing.
+    /// See [`World::step`](crate::World::step).
+    pub torsional_patch_radius_m: f32,
 }
 
 impl Default for Material {
@@ -217,6 +224,7 @@ impl Default for Material {
             static_friction: 1.0,
             dynamic_friction: 1.0,
             restitution: 0.0,
+            torsional_patch_radius_m: 0.0,
         }
     }
 }
@@ -228,6 +236,7 @@ impl Material {
             static_friction: friction,
             dynamic_friction: friction,
             restitution,
+            torsional_patch_radius_m: 0.0,
         }
     }
 
@@ -238,6 +247,13 @@ impl Material {
                 name: "friction",
                 value: format!("{}/{}", self.static_friction, self.dynamic_friction),
                 expected: "finite coefficients >= 0",
+            });
+        }
+        if !ok(self.torsional_patch_radius_m) {
+            return Err(PhysicsError::InvalidParameter {
+                name: "torsional_patch_radius_m",
+                value: self.torsional_patch_radius_m.to_string(),
+                expected: "a finite radius >= 0 in metres",
             });
         }
         if !(self.restitution.is_finite() && (0.0..=1.0).contains(&self.restitution)) {

@@ -87,6 +87,8 @@ pub struct World {
     pub(crate) articulations: Vec<Articulation>,
     pub(crate) ground: Option<BodyId>,
     pub(crate) forced: Vec<RigidBodyHandle>,
+    /// Colliders whose contacts carry torsional friction (see [`crate::torsional`]).
+    pub(crate) patch_colliders: Vec<crate::torsional::PatchCollider>,
     /// Bumped by every change that a state vector does not capture (added bodies, gains,
     /// materials, ...): snapshots of an older generation are never restored.
     pub(crate) generation: u64,
@@ -140,6 +142,7 @@ impl World {
             articulations: Vec::new(),
             ground: None,
             forced: Vec::new(),
+            patch_colliders: Vec::new(),
             generation: 0,
             snapshots: Mutex::new(SnapshotCache::default()),
             cold_template: None,
@@ -258,13 +261,14 @@ impl World {
         let handle = self.sim.bodies.insert(rb);
         let id = BodyId(self.table.len() as u32);
         let mut colliders = Vec::with_capacity(builders.len());
-        for b in builders {
+        for (b, spec) in builders.into_iter().zip(&desc.shapes) {
             let c = b.user_data(id.0 as u128).build();
-            colliders.push(
-                self.sim
-                    .colliders
-                    .insert_with_parent(c, handle, &mut self.sim.bodies),
-            );
+            let collider = self
+                .sim
+                .colliders
+                .insert_with_parent(c, handle, &mut self.sim.bodies);
+            self.register_patch_collider(collider, spec.material.torsional_patch_radius_m);
+            colliders.push(collider);
         }
         self.table.push(BodyEntry {
             name: desc.name,
@@ -285,10 +289,15 @@ impl World {
     /// Advances the simulation by one time step.
     ///
     /// Forces and torques applied with [`apply_force`](World::apply_force) and
-    /// [`apply_torque`](World::apply_torque) act during this step only.
+    /// [`apply_torque`](World::apply_torque) act during this step only. Contacts of shapes with
+    /// a [`Material::torsional_patch_radius_m`](crate::Material::torsional_patch_radius_m) first
+    /// get their torsional friction impulses, from the normal impulses of the previous step.
     pub fn step(&mut self) {
         self.ensure_cold_template();
         self.wake_bodies_touching_moving_kinematics();
+        if !self.patch_colliders.is_empty() {
+            self.apply_torsional_friction();
+        }
         let gravity = vec_from_na(&self.config.gravity);
         let sim = &mut self.sim;
         self.pipeline.step(

@@ -20,7 +20,8 @@ use crate::demos_common::{demo_error_to_py, episode_from_py, episode_to_py, in_p
 /// `target_control_mode` (`None` = each episode's own) converts actions closed-loop;
 /// `use_env_states` restores the recorded states after every step; `use_first_env_state`
 /// restores `env_states[0]` after the reset (also when converting); `record_obs` collects the
-/// observations of `env_kwargs["obs_mode"]`; `max_retry` retries failed conversions.
+/// observations of `env_kwargs["obs_mode"]`; `max_retry` retries failed conversions;
+/// `track_hand_only` converts by the source's hand path alone (no in-hand correction).
 ///
 /// Returns one dict per episode, in order: the replayed episode (keys as `solve_episodes`'s, in
 /// the target control mode), `"attempts"`, and `"obs"` (a tree of `[T+1, ...]` arrays, only with
@@ -28,7 +29,7 @@ use crate::demos_common::{demo_error_to_py, episode_from_py, episode_to_py, in_p
 #[pyfunction]
 #[pyo3(signature = (env_id, episodes, env_kwargs=None, target_control_mode=None,
                     use_env_states=false, record_obs=false, max_retry=0, num_workers=1,
-                    use_first_env_state=false))]
+                    use_first_env_state=false, track_hand_only=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn replay_episodes<'py>(
     py: Python<'py>,
@@ -41,6 +42,7 @@ pub fn replay_episodes<'py>(
     max_retry: u32,
     num_workers: usize,
     use_first_env_state: bool,
+    track_hand_only: bool,
 ) -> PyResult<Bound<'py, PyList>> {
     let cfg = config_from_kwargs(&env_id, env_kwargs)?;
     let sources: Vec<DemoEpisode> = episodes
@@ -53,6 +55,7 @@ pub fn replay_episodes<'py>(
         use_first_env_state,
         record_obs,
         max_retry,
+        track_hand_only,
     };
     let results: Vec<Result<ReplayedEpisode, _>> =
         in_pool(py, num_workers, sources.len(), |cancel| {

@@ -137,6 +137,16 @@ impl NativeEnv {
         self.read(|env| env.episode_seed())
     }
 
+    /// The current episode's asset model id (`None` for tasks without a model set).
+    fn model_id(&self) -> PyResult<Option<String>> {
+        self.read(|env| env.task().and_then(|t| t.model_id().map(str::to_owned)))
+    }
+
+    /// The scale of the current episode's model (`None` where the task does not scale models).
+    fn model_scale(&self) -> PyResult<Option<f64>> {
+        self.read(|env| env.task().and_then(|t| t.model_scale()))
+    }
+
     /// Episode length limit in env steps.
     fn max_episode_steps(&self) -> PyResult<u32> {
         self.read(|env| env.max_episode_steps())

@@ -172,6 +172,29 @@ def test_converted_trajectories_succeed(demo_file, target, capsys):
         assert back.output.name == f"PickCube-v0.none.{target}.none.pd_joint_pos.h5"
 
 
+def test_track_hand_only_converts_by_the_hand_path_alone(demo_file, capsys):
+    # The default conversion moves the hand so the held cube follows the source's cube; with
+    # --track-hand-only (ManiSkill2's converter) the hand follows the source's hand: both
+    # succeed on PickCube, with different actions while the cube is held.
+    corrected = replay(demo_file, target_control_mode="pd_ee_delta_pose", count=2, progress=False)
+    assert corrected.num_succeeded == 2
+    argv = ["replay", "--traj-path", str(demo_file), "-c", "pd_ee_delta_pose", "--save-traj"]
+    assert main([*argv, "--count", "2", "--track-hand-only", "-q"]) == 0
+    assert "2 succeeded (100.0 %)" in capsys.readouterr().out
+    hand_only = replay_output_path(demo_file, None, "pd_ee_delta_pose")
+    with open_trajectory(hand_only) as traj:
+        hand_actions = [traj.read_episode(i)["actions"] for i in range(2)]
+    replay(
+        demo_file, target_control_mode="pd_ee_delta_pose", count=2, save_traj=True, progress=False
+    )
+    with open_trajectory(hand_only) as traj:
+        held_actions = [traj.read_episode(i)["actions"] for i in range(2)]
+    assert any(
+        a.shape != b.shape or not np.array_equal(a, b)
+        for a, b in zip(hand_actions, held_actions, strict=True)
+    )
+
+
 def test_replayed_state_dict_observations_are_nested_groups(demo_file):
     replay(demo_file, obs_mode="state_dict", save_traj=True, count=1, progress=False)
     out = replay_output_path(demo_file, "state_dict", "pd_joint_pos")

@@ -117,6 +117,32 @@ def test_model_ids_keyword_and_per_episode_choice():
     assert_obs_equal(a, b)
 
 
+def test_model_id_and_scale_name_the_episode_s_model():
+    # ManiSkill2's env.unwrapped.model_id / model_scale: the model drawn for the episode.
+    env = gym.make("PickSingleYCB-v0", obs_mode="state_dict")
+    seen = {}
+    for seed in range(10):
+        obs, _ = env.reset(seed=seed)
+        model_id = env.unwrapped.model_id
+        assert model_id in {mid for mid, *_ in MODELS}
+        assert env.unwrapped.model_scale == 1.0
+        height = next(h for mid, _, _, h, _ in MODELS if mid == model_id)
+        # The drawn model is the one in the scene: its centre of mass sits at half its height.
+        assert abs(obs["extra"]["obj_pose"][2] - height / 2) < 0.006, (seed, model_id)
+        seen[seed] = model_id
+    assert len(set(seen.values())) >= 2
+    env.reset(seed=3)
+    assert env.unwrapped.model_id == seen[3]
+    only = gym.make("PickSingleEGAD-v0", model_ids=["bar_c"])
+    only.reset(seed=0)
+    assert only.unwrapped.model_id == "bar_c"
+    cube = gym.make("PickCube-v0")
+    cube.reset(seed=0)
+    assert not hasattr(cube.unwrapped, "model_id")
+    with pytest.raises(AttributeError, match="PickCube-v0"):
+        _ = cube.unwrapped.model_scale
+
+
 def test_state_round_trip():
     env = gym.make("PickSingleEGAD-v0", obs_mode="state").unwrapped
     env.reset(seed=2)

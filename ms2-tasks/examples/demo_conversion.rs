@@ -8,6 +8,8 @@
 //! cargo run -p ms2-tasks --release --example demo_conversion -- PickCube-v0 20
 //! cargo run -p ms2-tasks --release --example demo_conversion -- StackCube-v0 100 \
 //!     pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos --max-retry 1 --source scripted
+//! cargo run -p ms2-tasks --release --example demo_conversion -- PickSingleYCB-v0 0 \
+//!     pd_ee_delta_pose --seeds 6,23,58
 //! ```
 //! Episodes run in parallel on rayon's pool (`RAYON_NUM_THREADS`); times are CPU-seconds per
 //! episode summed over threads divided by the episode count.
@@ -51,8 +53,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         control_mode: Some("pd_joint_pos".to_owned()),
         ..EnvConfig::new(env_id)
     };
+    // `--seeds 6,23,58` converts those seeds instead of 0..n.
+    let seeds: Vec<u64> = match flag("--seeds") {
+        Some(list) => list.split(',').map(str::parse).collect::<Result<_, _>>()?,
+        None => (0..n).collect(),
+    };
+    let n = seeds.len() as u64;
     let start = Instant::now();
-    let sources: Vec<Result<DemoEpisode, DemoError>> = (0..n)
+    let sources: Vec<Result<DemoEpisode, DemoError>> = seeds
         .into_par_iter()
         .map(|seed| {
             if use_solution {

@@ -114,6 +114,19 @@ pub trait Task: Any + Send {
     /// The shaped reward of the current state, given its evaluation.
     fn dense_reward(&self, scene: &TaskScene, eval: &Evaluation) -> f64;
 
+    /// The asset model of the current episode, for tasks that draw one per episode from a
+    /// model set (ManiSkill2's `env.model_id`: PickSingleYCB/EGAD, TurnFaucet, OpenCabinet*);
+    /// `None` for the others. Default: `None`.
+    fn model_id(&self) -> Option<&str> {
+        None
+    }
+
+    /// The scale applied to [`Task::model_id`]'s model this episode (ManiSkill2's
+    /// `env.model_scale`), where the task scales its models. Default: `None`.
+    fn model_scale(&self) -> Option<f64> {
+        None
+    }
+
     /// Task state appended to the simulation state (e.g. the goal position).
     fn task_state(&self) -> Vec<f32> {
         Vec::new()

@@ -155,7 +155,7 @@ fn every_shape_stands_on_the_ground() {
         let start = ms2_tasks::geometry::pose_xyz_yaw([-0.19, 0.05, 0.0], 0.7);
         let (mut world, task, object) = kit_world(seed, &start);
         let name = task.target_shape().name;
-        if !seen.insert(name) {
+        if !seen.insert(name.clone()) {
             continue;
         }
         run(world.as_mut(), 1.0);

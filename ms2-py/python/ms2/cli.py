@@ -308,6 +308,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         count=args.count,
         progress=not args.quiet,
         use_first_env_state=args.use_first_env_state,
+        track_hand_only=args.track_hand_only,
         discard_timeout=args.discard_timeout,
         vis=args.vis,
     )
@@ -371,6 +372,11 @@ def add_replay_arguments(p: argparse.ArgumentParser) -> None:
         "-w", "--num-workers", "--num-procs", type=int, default=1, help="native worker threads"
     )
     p.add_argument("--max-retry", type=int, default=0, help="retries of a failed conversion")
+    p.add_argument(
+        "--track-hand-only",
+        action="store_true",
+        help="convert by the source's hand path alone (no in-hand correction; ManiSkill2's way)",
+    )
     p.add_argument(
         "--discard-timeout",
         action="store_true",

@@ -379,6 +379,7 @@ def replay(
     use_first_env_state: bool = False,
     discard_timeout: bool = False,
     vis: bool = False,
+    track_hand_only: bool = False,
 ) -> ReplayResult:
     """Replays (and optionally converts) the episodes of ``traj_path``.
 
@@ -403,6 +404,9 @@ def replay(
         save_video: write one MP4 per episode to ``X.<obs_mode>.<control_mode>.videos/``.
         num_workers: native worker threads.
         max_retry: further attempts for a failed conversion.
+        track_hand_only: convert by the source's hand path alone, as ManiSkill2 does. By
+            default, while both robots hold the same object, the hand is moved so that the
+            converted object follows the source's object (grasps differ by a millimetre).
         allow_failure: also save episodes that do not succeed at their last step.
         count: replay only the first ``count`` episodes.
         progress: show a progress bar.
@@ -486,6 +490,7 @@ def replay(
                             max_retry,
                             num_workers,
                             use_first_env_state=use_first_env_state or any(foreign),
+                            track_hand_only=track_hand_only,
                         )
                     except (ValueError, TypeError) as e:
                         ids = [int(src["episode_id"]) for src in sources]

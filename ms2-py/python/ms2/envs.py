@@ -322,6 +322,25 @@ class Ms2Env(gym.Env):
         return self._native.episode_seed()
 
     @property
+    def model_id(self) -> str:
+        """The asset model of the current episode (ManiSkill2's ``env.model_id``) in the tasks
+        that draw one per episode: PickSingleYCB/EGAD, TurnFaucet, OpenCabinetDrawer/Door.
+        Other tasks raise ``AttributeError``, as ManiSkill2's envs without the attribute do."""
+        model_id = self._native.model_id()
+        if model_id is None:
+            raise AttributeError(f"{self.env_id} has no model_id: it does not draw asset models")
+        return model_id
+
+    @property
+    def model_scale(self) -> float:
+        """The scale of the current episode's model (ManiSkill2's ``env.model_scale``) in
+        PickSingleYCB/EGAD; ``AttributeError`` elsewhere."""
+        scale = self._native.model_scale()
+        if scale is None:
+            raise AttributeError(f"{self.env_id} has no model_scale: it does not scale models")
+        return scale
+
+    @property
     def max_episode_steps(self) -> int:
         """The native episode limit in env steps."""
         return self._native.max_episode_steps()

@@ -34,7 +34,7 @@ use crate::seeding::EpisodeRng;
 use crate::sensors::{CameraConfig, CameraMount};
 
 use super::gripper_arm::GRASP_MIN_IMPULSE;
-use ms2_physics::PANDA_FINGER_FRICTION;
+use ms2_physics::PANDA_FINGER_MATERIAL;
 
 /// Number of planar base dofs (x, y, yaw) left out of the observation's `qpos` / `qvel`.
 pub const PLANAR_BASE_DOF: usize = 3;
@@ -277,11 +277,7 @@ impl MobilePandaAgent {
     ) -> Result<Self, EnvError> {
         let robot = mobile_robot_config(variant)?;
         let desc = mobile_panda_desc(variant)?;
-        let finger_material = Material {
-            static_friction: PANDA_FINGER_FRICTION,
-            dynamic_friction: PANDA_FINGER_FRICTION,
-            restitution: 0.0,
-        };
+        let finger_material = PANDA_FINGER_MATERIAL;
         let rest = rest_qpos(variant, 0.0, 0.0, 0.0);
         let options = ArticulationOptions {
             root_pose: Pose3::identity(),

@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 
 use ms2_control::{ControlMode, ControlTiming, RobotConfig};
 use ms2_physics::{
-    parse_urdf_str, ArticulationDesc, DriveParams, Material, UrdfLoadOptions, PANDA_FINGER_FRICTION,
+    parse_urdf_str, ArticulationDesc, DriveParams, UrdfLoadOptions, PANDA_FINGER_MATERIAL,
 };
 
 use super::gripper_arm::{GripperArmAgent, GripperArmModel};
@@ -103,11 +103,7 @@ const PANDA_MODEL_DATA: GripperArmModel = GripperArmModel {
     finger_opens_with_qpos: true,
     arm_drive: DriveParams::MANISKILL2_ARM,
     gripper_drive: DriveParams::MANISKILL2_ARM,
-    finger_material: Material {
-        static_friction: PANDA_FINGER_FRICTION,
-        dynamic_friction: PANDA_FINGER_FRICTION,
-        restitution: 0.0,
-    },
+    finger_material: PANDA_FINGER_MATERIAL,
 };
 
 /// The Panda's controller configuration (parsed once per process).

@@ -12,7 +12,7 @@
 use std::sync::OnceLock;
 
 use ms2_control::{ControlMode, RobotConfig};
-use ms2_physics::{DriveParams, Material};
+use ms2_physics::{DriveParams, Material, GRIPPER_PAD_PATCH_RADIUS_M};
 
 use super::gripper_arm::{GripperArmAgent, GripperArmModel};
 use super::panda::parse_robot_urdf;
@@ -65,6 +65,7 @@ pub static XMATE3_MODEL: GripperArmModel = GripperArmModel {
         static_friction: XMATE3_PAD_FRICTION,
         dynamic_friction: XMATE3_PAD_FRICTION,
         restitution: 0.0,
+        torsional_patch_radius_m: GRIPPER_PAD_PATCH_RADIUS_M,
     },
 };
 

@@ -2,6 +2,7 @@
 //! recorded states, recording observations, or converting its actions closed-loop to another
 //! control mode (the ManiSkill2 paper, Sec. 2.2).
 
+use super::in_hand::InHandCorrection;
 use super::source_targets::SourceJointTargets;
 use super::{DemoEpisode, DemoError, EpisodeRecorder, StateRecording};
 use crate::adapters::snapshot_articulation;
@@ -43,6 +44,9 @@ pub struct ReplayOptions {
     /// [`TRAILING_TOLERANCE_M`]` / k` away from the recorded one (trading the source's timing
     /// for its path).
     pub max_retry: u32,
+    /// Convert by the source's hand path alone: no in-hand correction (see
+    /// [`replay_episode`]). ManiSkill2's converter works this way.
+    pub track_hand_only: bool,
 }
 
 /// The result of [`replay_episode`].
@@ -74,7 +78,10 @@ pub struct ReplayedEpisode {
 ///   more target steps toward the same `q̄_src(t)` follow (at most
 ///   [`MAX_EXTRA_STEPS_PER_SOURCE_STEP`]). A failed converted episode is retried up to
 ///   `opts.max_retry` times with a stricter "reached" test (see [`ReplayOptions::max_retry`]);
-///   failed sources are not retried. A converted episode ends as soon as it has been
+///   failed sources are not retried. While the target robot and the source hold the same
+///   object, the source's joint targets are corrected so that the target's object follows the
+///   source's object rather than its hand (the grasps differ by a millimetre or so; see
+///   `in_hand.rs`), unless `opts.track_hand_only`. A converted episode ends as soon as it has been
 ///   successful for as many consecutive steps as the source's final run of successful steps
 ///   (the rest of the source's actions are not stepped).
 ///
@@ -240,6 +247,11 @@ fn convert_once(
     let mut obs = ObsLog::new(record_obs, first_obs);
     let mut targets = SourceJointTargets::new(cfg, env, source)?;
     let dof = targets.dof();
+    let in_hand = if opts.track_hand_only {
+        None
+    } else {
+        InHandCorrection::new(env)
+    };
     let mut desired = Vec::new();
     // A successful source ends after a run of successful steps; a converted episode that
     // reaches such a run ends there too, as a demonstration does (the source's remaining
@@ -259,6 +271,9 @@ fn convert_once(
     'source_steps: for t in 0..source.actions.len() {
         desired = targets.targets(source, t)?;
         debug_assert_eq!(desired.len(), dof);
+        if let Some(in_hand) = &in_hand {
+            in_hand.correct(env, &mut targets, source, t, &mut desired)?;
+        }
         for extra in 0..=MAX_EXTRA_STEPS_PER_SOURCE_STEP {
             let reached = step_toward(env, &mut recorder, &mut obs, &desired, source, t)?;
             if solved(&recorder) {

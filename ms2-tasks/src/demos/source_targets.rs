@@ -127,6 +127,15 @@ impl SourceJointTargets {
         Ok(())
     }
 
+    /// The env holding recorded state `t` of `source` (state env of the source mode).
+    pub(crate) fn recorded_env(
+        &mut self,
+        source: &DemoEpisode,
+        t: usize,
+    ) -> Result<&Env, DemoError> {
+        self.recorded_state(source, t)
+    }
+
     /// The world position (m) of the TCP in recorded state `t`.
     pub(crate) fn recorded_tcp_position(
         &mut self,

@@ -43,19 +43,7 @@ impl TcpOracle {
         let scene = env
             .task_scene()
             .ok_or_else(|| no("the env has no robot".to_owned()))?;
-        let robot = RobotConfig::panda(ms2_assets::PANDA_URDF).map_err(|e| no(e.to_string()))?;
-        let chain = robot.tcp_chain().map_err(|e| no(e.to_string()))?;
-        let names = scene.world.joint_names(scene.agent.articulation())?;
-        let chain_to_articulation = chain
-            .joint_names()
-            .iter()
-            .map(|n| {
-                names
-                    .iter()
-                    .position(|m| m == n)
-                    .ok_or_else(|| no(format!("joint {n} not in the articulation")))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let (chain, chain_to_articulation) = panda_tcp_chain(scene).map_err(no)?;
         let ik = DlsIk::new(IkOptions {
             max_iterations: 50,
             position_tolerance_m: 1e-4,
@@ -100,6 +88,30 @@ impl TcpOracle {
             Err(_) => vec![0.0; env.action_space().size()],
         }
     }
+}
+
+/// The Panda's TCP chain and, for each of its joints, the dof index in `scene`'s articulation;
+/// an error saying why when the robot is not a Panda.
+pub(crate) fn panda_tcp_chain(
+    scene: &crate::task::TaskScene,
+) -> Result<(KinematicChain, Vec<usize>), String> {
+    let robot = RobotConfig::panda(ms2_assets::PANDA_URDF).map_err(|e| e.to_string())?;
+    let chain = robot.tcp_chain().map_err(|e| e.to_string())?;
+    let names = scene
+        .world
+        .joint_names(scene.agent.articulation())
+        .map_err(|e| e.to_string())?;
+    let chain_to_articulation = chain
+        .joint_names()
+        .iter()
+        .map(|n| {
+            names
+                .iter()
+                .position(|m| m == n)
+                .ok_or_else(|| format!("joint {n} not in the articulation"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((chain, chain_to_articulation))
 }
 
 /// A pose of the TCP pointing straight down (TCP z = −world z) with yaw `yaw` (rad) about

@@ -191,6 +191,10 @@ const CAMERA_VIEWS: [(&str, [f32; 3], [f32; 3]); 2] = [
 ];
 
 impl Task for TurnFaucet {
+    fn model_id(&self) -> Option<&str> {
+        Some(&self.model_id)
+    }
+
     fn max_dense_reward(&self) -> f64 {
         MAX_DENSE_REWARD
     }

@@ -1,7 +1,10 @@
 //! `AssemblingKits-v0`: put a shape into the slot carved for it in a kit board.
 //!
-//! - Scene, drawn anew at every reset from the episode's seed (procedural kits; ManiSkill2's
-//!   kit files are not read yet): a static board of half size
+//! - Scene, drawn anew at every reset from the episode's seed. With ManiSkill2's kit data in
+//!   the asset directory (`assembling_kits/`, see [`super::kit_files`]) an episode of its list:
+//!   its board (drawn as its mesh, colliding as convex pieces carved around its slots), its
+//!   objects (their convex pieces) and spawn position. Otherwise a procedural kit: a static board
+//!   of half size
 //!   [`BOARD_HALF_SIZE`] (top at 2 cm) with [`SLOTS`] slots in a row along y, each the outline
 //!   of one of [`SHAPES`] (convex 2D outlines) grown by [`CLEARANCE`] and cut through the whole
 //!   board; the board is the convex pieces around the slots ([`kit_shapes::carve_board`]), each
@@ -24,6 +27,7 @@ use rand::seq::SliceRandom;
 use rand::Rng;
 
 use super::common::{hex_rgba, AssemblyParts, CameraView};
+use super::kit_files::{KitFiles, FILE_BOARD_Z};
 use super::kit_shapes::{self, prism_mesh, prism_points, Outline};
 use crate::error::EnvError;
 use crate::families::rigid::common::body_pose;
@@ -67,22 +71,25 @@ const GRIPPER_WIDTH: f64 = 0.08;
 #[derive(Debug, Clone, PartialEq)]
 pub struct KitShape {
     /// Name, for the actor.
-    pub name: &'static str,
+    pub name: String,
     /// The outline (m, shape frame).
     pub outline: Outline,
     /// Smallest turn (rad) that maps the shape onto itself (`TAU` if none).
     pub symmetry: f32,
     /// Linear RGBA colour.
     pub rgba: [f32; 4],
+    /// Height (m) of the shape above its frame (its bottom face).
+    pub height: f32,
 }
 
 /// The shapes kits are made of (convex outlines of 3.4 to 4.8 cm across).
 pub fn shapes() -> Vec<KitShape> {
-    let shape = |name, outline, symmetry, hex| KitShape {
-        name,
+    let shape = |name: &str, outline, symmetry, hex| KitShape {
+        name: name.to_owned(),
         outline,
         symmetry,
         rgba: hex_rgba(hex),
+        height: SHAPE_HEIGHT,
     };
     vec![
         shape(
@@ -208,6 +215,22 @@ pub fn pose_yaw(pose: &Pose3) -> f32 {
     pose.rotation.euler_angles().2
 }
 
+/// `outline` as convex pieces whose faces have at most
+/// [`ms2_physics::mesh::CONTACT_FACE_VERTICES`] vertices: itself, or the wedges from its centroid
+/// to each edge (see [`prism_desc`]).
+fn wedges(outline: &Outline) -> Vec<Outline> {
+    let n = outline.vertices.len();
+    if n <= ms2_physics::mesh::CONTACT_FACE_VERTICES {
+        return vec![outline.clone()];
+    }
+    let c = outline.vertices.iter().sum::<Vector2<f32>>() / n as f32;
+    (0..n)
+        .map(|i| Outline {
+            vertices: vec![c, outline.vertices[i], outline.vertices[(i + 1) % n]],
+        })
+        .collect()
+}
+
 /// A prism actor desc: `outline` extruded between `z0` and `z1` (m), colliding exactly where
 /// drawn (its collision hulls and its closed triangle mesh have the same corners). An outline
 /// of more than four vertices collides as the wedges from its centroid to each edge: rapier's
@@ -221,18 +244,7 @@ fn prism_desc(
     rgba: [f32; 4],
 ) -> ActorDesc {
     let (vertices, indices) = prism_mesh(outline, z0, z1);
-    let n = outline.vertices.len();
-    let hulls: Vec<Outline> = if n <= ms2_physics::mesh::CONTACT_FACE_VERTICES {
-        vec![outline.clone()]
-    } else {
-        let c = outline.vertices.iter().sum::<Vector2<f32>>() / n as f32;
-        (0..n)
-            .map(|i| Outline {
-                vertices: vec![c, outline.vertices[i], outline.vertices[(i + 1) % n]],
-            })
-            .collect()
-    };
-    hulls
+    wedges(outline)
         .iter()
         .fold(desc, |desc, hull| {
             desc.with_shape(ShapeSpec::new(ShapeDesc::ConvexHull {
@@ -246,10 +258,31 @@ fn prism_desc(
         })
 }
 
+/// Where the episodes' kits come from.
+#[derive(Debug, Clone, Default)]
+pub enum KitSource {
+    /// [`Kit::sample`] (no data needed).
+    #[default]
+    Procedural,
+    /// ManiSkill2's kit data.
+    Files(KitFiles),
+}
+
+/// A box around the board for planners: centre (m, world) and half extents (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoardBox {
+    /// Centre (m, world).
+    pub center: Vector3<f32>,
+    /// Half extents along world x, y, z (m).
+    pub half_extents: Vector3<f32>,
+}
+
 /// `AssemblingKits-v0` (see the module docs).
 #[derive(Debug, Clone, Default)]
 pub struct AssemblingKits {
-    /// The episode's kit.
+    /// Where kits come from.
+    pub source: KitSource,
+    /// The episode's procedural kit (`None` for an episode of ManiSkill2's data).
     pub kit: Option<Kit>,
     /// The board's body.
     pub board: Option<BodyId>,
@@ -259,12 +292,26 @@ pub struct AssemblingKits {
     pub others: Vec<BodyId>,
     /// Where the shape to place started (m, world).
     pub obj_init_pos: Vector3<f32>,
+    /// The shape to place.
+    pub target: Option<KitShape>,
+    /// Its goal pose (world): in its slot.
+    pub goal: Pose3,
+    /// The shapes of [`AssemblingKits::others`] and their poses in their slots (world).
+    pub others_placed: Vec<(KitShape, Pose3)>,
+    /// Where the shape to place spawns in an episode of ManiSkill2's data (m, world).
+    pub spawn: Option<Vector3<f32>>,
+    /// A box around the board.
+    pub board_box: Option<BoardBox>,
 }
 
 impl AssemblingKits {
-    /// The episode's kit.
-    pub fn kit(&self) -> &Kit {
-        self.kit.as_ref().expect("build ran before use")
+    /// The task reading ManiSkill2's kit data when the asset directory has it (else
+    /// procedural kits). Errors: the data is there but unreadable.
+    pub fn discover() -> Result<Self, EnvError> {
+        Ok(Self {
+            source: KitFiles::discover()?.map_or(KitSource::Procedural, KitSource::Files),
+            ..Self::default()
+        })
     }
 
     /// The shape to place.
@@ -272,14 +319,26 @@ impl AssemblingKits {
         self.object.expect("build ran before use")
     }
 
+    /// The episode's procedural kit (panics for an episode of ManiSkill2's data).
+    pub fn kit(&self) -> &Kit {
+        self.kit
+            .as_ref()
+            .expect("build ran before use, with procedural kits")
+    }
+
     /// The shape to place's description.
     pub fn target_shape(&self) -> KitShape {
-        shapes().swap_remove(self.kit().slot_shapes[self.kit().target])
+        self.target.clone().expect("build ran before use")
     }
 
     /// The shape's goal pose (world): in its slot.
     pub fn goal_pose(&self) -> Pose3 {
-        self.kit().slot_pose(self.kit().target)
+        self.goal
+    }
+
+    /// A box around the board, for planners.
+    pub fn board_box(&self) -> BoardBox {
+        self.board_box.expect("build ran before use")
     }
 
     /// The xy distance (m), yaw error (rad) and height (m) of the shape from its goal.
@@ -296,30 +355,13 @@ impl AssemblingKits {
     }
 }
 
-/// ManiSkill2's camera placements of this task, `(uid, eye, target)` (m, world).
-const CAMERA_VIEWS: [CameraView; 2] = [
-    ("base_camera", [0.2, 0.0, 0.4], [0.0, 0.0, 0.0]),
-    ("render_camera", [0.3, 0.3, 0.8], [0.0, 0.0, 0.1]),
-];
-
-impl AssemblyParts for AssemblingKits {
-    const MAX_DENSE_REWARD: f64 = MAX_DENSE_REWARD;
-    const CAMERA_VIEWS: &'static [CameraView] = &CAMERA_VIEWS;
-    const HAND_TURNED: bool = false;
-    const PREDICTION_DISTANCE: Option<f32> = Some(PREDICTION_DISTANCE);
-
-    /// The common settings with contacts between convex hulls by the separating-axis test
-    /// (parry 0.31's GJK puts phantom contacts between a shape and the board pieces around its
-    /// slot, see `ms2_physics::convex_contact`).
-    fn solver_config(defaults: SolverConfig) -> SolverConfig {
-        SolverConfig {
-            prediction_distance: PREDICTION_DISTANCE,
-            sat_convex_contacts: true,
-            ..defaults
-        }
-    }
-
-    fn build(&mut self, world: &mut dyn RigidWorld, rng: &mut EpisodeRng) -> Result<(), EnvError> {
+impl AssemblingKits {
+    /// Builds a procedural kit drawn from `rng`.
+    fn build_procedural(
+        &mut self,
+        world: &mut dyn RigidWorld,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
         let kit = Kit::sample(rng);
         let shapes = shapes();
         let pieces = kit_shapes::carve_board(BOARD_HALF_SIZE, &kit.slot_outlines(&shapes))
@@ -349,24 +391,192 @@ impl AssemblyParts for AssemblingKits {
         self.object = Some(bodies[kit.target]);
         bodies.remove(kit.target);
         self.others = bodies;
+        self.target = Some(shapes[kit.slot_shapes[kit.target]].clone());
+        self.goal = kit.slot_pose(kit.target);
+        self.others_placed = (0..SLOTS)
+            .filter(|&i| i != kit.target)
+            .map(|i| (shapes[kit.slot_shapes[i]].clone(), kit.slot_pose(i)))
+            .collect();
+        self.spawn = None;
+        self.board_box = Some(BoardBox {
+            center: Vector3::new(0.0, 0.0, BOARD_HALF_HEIGHT),
+            half_extents: Vector3::new(BOARD_HALF_SIZE[0], BOARD_HALF_SIZE[1], BOARD_HALF_HEIGHT),
+        });
         self.kit = Some(kit);
         Ok(())
     }
 
-    fn place(&mut self, scene: &mut TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
-        let world = scene.world.as_mut();
-        let kit = self.kit().clone();
-        let mut others = self.others.iter();
-        for i in (0..SLOTS).filter(|&i| i != kit.target) {
-            if let Some(&body) = others.next() {
-                world.set_body_pose(body, &kit.slot_pose(i))?;
+    /// Builds an episode of ManiSkill2's kit data drawn from `rng`: its board (drawn as the
+    /// file's mesh; colliding as the box of that mesh minus every slot of the kit, each its
+    /// object's outline grown by [`CLEARANCE`], cut into convex pieces: rapier's contacts with
+    /// the triangle mesh caught shapes on the slot's edges, and the solution solved 1 of 6
+    /// fixture seeds against 6 of 6 with the pieces), the object to place and the objects in
+    /// their slots.
+    fn build_from_files(
+        &mut self,
+        files: &KitFiles,
+        world: &mut dyn RigidWorld,
+        rng: &mut EpisodeRng,
+    ) -> Result<(), EnvError> {
+        let episode = files.episodes()[rng.random_range(0..files.episodes().len())].clone();
+        let slots = files.kit_slots(episode.kit)?;
+        let slot_of = |id: u32| {
+            slots.iter().find(|s| s.object_id == id).ok_or_else(|| {
+                EnvError::Asset(format!(
+                    "AssemblingKits data {}: kit {} has no slot for object {id}",
+                    files.root().display(),
+                    episode.kit
+                ))
+            })
+        };
+        let (vertices, indices) = files.board_mesh(episode.kit)?;
+        let lo = vertices
+            .iter()
+            .fold(Vector3::repeat(f32::MAX), |m, p| m.inf(&p.coords));
+        let hi = vertices
+            .iter()
+            .fold(Vector3::repeat(f32::MIN), |m, p| m.sup(&p.coords));
+        let brown = [0.278, 0.209, 0.169, 1.0];
+        // Collision: the board's box minus every slot of the kit (its object's outline grown
+        // by the clearance), cut into convex pieces as the procedural boards are. Drawn: the
+        // file's mesh.
+        let centre = ((lo + hi) / 2.0).xy();
+        let mut slot_outlines = Vec::with_capacity(slots.len());
+        for slot in &slots {
+            let outline = files.object(slot.object_id)?.outline;
+            slot_outlines.push(
+                outline
+                    .grown(CLEARANCE)
+                    .placed(Vector2::new(slot.pos[0], slot.pos[1]) - centre, slot.rot),
+            );
+        }
+        let half = ((hi - lo) / 2.0).xy();
+        let pieces = kit_shapes::carve_board([half.x, half.y], &slot_outlines).map_err(|e| {
+            EnvError::Asset(format!(
+                "AssemblingKits data {}: kit {} cannot be carved: {e}",
+                files.root().display(),
+                episode.kit
+            ))
+        })?;
+        let mut board = ActorDesc::new("kit", ActorKind::Static)
+            .with_pose(Pose3::translation(0.0, 0.0, FILE_BOARD_Z))
+            .with_visual(VisualShape {
+                shape: ShapeDesc::TriMesh { vertices, indices },
+                pose_body_from_shape: Pose3::identity(),
+                rgba: brown,
+            });
+        for piece in &pieces {
+            let piece = piece.placed(centre, 0.0);
+            for hull in wedges(&piece) {
+                board = board.with_shape(ShapeSpec::new(ShapeDesc::ConvexHull {
+                    points: prism_points(&hull, lo.z, hi.z),
+                }));
             }
         }
-        let x = rng.random_range(-0.2..-0.12);
-        let y = rng.random_range(-0.12..0.12);
+        self.board = Some(world.add_actor(board)?);
+        self.board_box = Some(BoardBox {
+            center: (lo + hi) / 2.0 + Vector3::new(0.0, 0.0, FILE_BOARD_Z),
+            half_extents: (hi - lo) / 2.0,
+        });
+        let mut load = |id: u32| -> Result<(BodyId, KitShape), EnvError> {
+            let object = files.object(id)?;
+            let [r, g, b] = files.colors()[rng.random_range(0..files.colors().len())];
+            let rgba = [r, g, b, 1.0];
+            let mut desc = ActorDesc::new(format!("obj_{id:02}"), ActorKind::Dynamic);
+            for piece in &object.pieces {
+                desc = desc.with_shape(ShapeSpec::new(ShapeDesc::ConvexHull {
+                    points: piece.clone(),
+                }));
+            }
+            for (vertices, indices) in &object.visual {
+                desc = desc.with_visual(VisualShape {
+                    shape: ShapeDesc::TriMesh {
+                        vertices: vertices.clone(),
+                        indices: indices.clone(),
+                    },
+                    pose_body_from_shape: Pose3::identity(),
+                    rgba,
+                });
+            }
+            let shape = KitShape {
+                name: format!("{id:02}"),
+                outline: object.outline,
+                symmetry: object.symmetry,
+                rgba,
+                height: object.height,
+            };
+            Ok((world.add_actor(desc)?, shape))
+        };
+        let (object, target) = load(episode.obj_to_place)?;
+        let mut others = Vec::with_capacity(episode.obj_in_place.len());
+        let mut others_placed = Vec::with_capacity(episode.obj_in_place.len());
+        for &id in &episode.obj_in_place {
+            let (body, shape) = load(id)?;
+            let slot = slot_of(id)?;
+            others.push(body);
+            others_placed.push((shape, pose_xyz_yaw(slot.pos, slot.rot)));
+        }
+        let goal_slot = slot_of(episode.obj_to_place)?;
+        self.goal = pose_xyz_yaw(goal_slot.pos, goal_slot.rot);
+        self.object = Some(object);
+        self.target = Some(target);
+        self.others = others;
+        self.others_placed = others_placed;
+        self.spawn = Some(Vector3::from(episode.spawn_pos));
+        self.kit = None;
+        Ok(())
+    }
+}
+
+/// ManiSkill2's camera placements of this task, `(uid, eye, target)` (m, world).
+const CAMERA_VIEWS: [CameraView; 2] = [
+    ("base_camera", [0.2, 0.0, 0.4], [0.0, 0.0, 0.0]),
+    ("render_camera", [0.3, 0.3, 0.8], [0.0, 0.0, 0.1]),
+];
+
+impl AssemblyParts for AssemblingKits {
+    const MAX_DENSE_REWARD: f64 = MAX_DENSE_REWARD;
+    const CAMERA_VIEWS: &'static [CameraView] = &CAMERA_VIEWS;
+    const HAND_TURNED: bool = false;
+    const PREDICTION_DISTANCE: Option<f32> = Some(PREDICTION_DISTANCE);
+
+    /// The common settings with contacts between convex hulls by the separating-axis test
+    /// (parry 0.31's GJK puts phantom contacts between a shape and the board pieces around its
+    /// slot, see `ms2_physics::convex_contact`).
+    fn solver_config(defaults: SolverConfig) -> SolverConfig {
+        SolverConfig {
+            prediction_distance: PREDICTION_DISTANCE,
+            sat_convex_contacts: true,
+            ..defaults
+        }
+    }
+
+    fn build(&mut self, world: &mut dyn RigidWorld, rng: &mut EpisodeRng) -> Result<(), EnvError> {
+        match &self.source {
+            KitSource::Procedural => self.build_procedural(world, rng),
+            KitSource::Files(files) => {
+                let files = files.clone();
+                self.build_from_files(&files, world, rng)
+            }
+        }
+    }
+
+    fn place(&mut self, scene: &mut TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
+        let world = scene.world.as_mut();
+        for (&body, (_, pose)) in self.others.iter().zip(&self.others_placed) {
+            world.set_body_pose(body, pose)?;
+        }
+        let (x, y, z) = match self.spawn {
+            Some(p) => (p.x, p.y, p.z),
+            None => (
+                rng.random_range(-0.2..-0.12),
+                rng.random_range(-0.12..0.12),
+                0.0,
+            ),
+        };
         let yaw = rng.random_range(0.0..TAU);
-        world.set_body_pose(self.object(), &pose_xyz_yaw([x, y, 0.0], yaw))?;
-        self.obj_init_pos = Vector3::new(x, y, 0.0);
+        world.set_body_pose(self.object(), &pose_xyz_yaw([x, y, z], yaw))?;
+        self.obj_init_pos = Vector3::new(x, y, z);
         Ok(())
     }
 

@@ -8,7 +8,7 @@ use std::f32::consts::FRAC_PI_2;
 
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 
-use super::assembling_kits::{pose_yaw, yaw_error, AssemblingKits, SHAPE_HEIGHT};
+use super::assembling_kits::{pose_yaw, yaw_error, AssemblingKits};
 use super::common::AssemblyTask;
 use crate::env::Env;
 use crate::error::EnvError;
@@ -25,8 +25,8 @@ const MAX_STEP: f32 = 0.04;
 const LOWER_STEP: f32 = 0.004;
 /// Largest TCP turn (rad) per control step.
 const MAX_TURN: f32 = 0.25;
-/// Height (m, shape frame) of the TCP when grasping: 1.5 cm below the shape's top.
-const GRASP_HEIGHT: f32 = SHAPE_HEIGHT - 0.015;
+/// Depth (m) of the TCP below the shape's top when grasping.
+const GRASP_BELOW_TOP: f32 = 0.015;
 /// Height (m) above the grasp from which the hand descends.
 const APPROACH_HEIGHT: f32 = 0.08;
 /// Height (m) of the shape's bottom while carried to its slot.
@@ -149,7 +149,7 @@ impl ScriptedPolicy for KitPolicy {
             nearest_symmetric_yaw(tcp_yaw(&tcp), across + FRAC_PI_2, std::f32::consts::PI)
         });
         let grasp = top_down_tcp_pose(
-            shape.translation.vector + Vector3::new(0.0, 0.0, GRASP_HEIGHT),
+            shape.translation.vector + Vector3::new(0.0, 0.0, kit_shape.height - GRASP_BELOW_TOP),
             grasp_yaw,
         );
         let err = |target: &Pose3| {

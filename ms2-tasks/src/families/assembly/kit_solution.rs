@@ -9,9 +9,7 @@
 use ms2_plan::OrientedBox;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector2, Vector3};
 
-use super::assembling_kits::{
-    pose_yaw, AssemblingKits, KitShape, BOARD_HALF_HEIGHT, BOARD_HALF_SIZE, SHAPE_HEIGHT,
-};
+use super::assembling_kits::{pose_yaw, AssemblingKits, KitShape};
 use super::common::AssemblyTask;
 use super::kit_policy::nearest_symmetric_yaw;
 use super::solutions::{InsertionSolution, InsertionWorld};
@@ -19,9 +17,9 @@ use crate::demos::solutions::SolveError;
 use crate::env::Env;
 use crate::families::rigid::common::body_pose;
 
-/// Height (m, shape frame) of the grasp: 6 mm below the shape's top (the fingers stay above
+/// Depth (m) of the grasp below the shape's top (the fingers stay above
 /// the board when the shape is in its slot).
-const GRASP_HEIGHT: f64 = SHAPE_HEIGHT as f64 - 0.006;
+const GRASP_BELOW_TOP: f64 = 0.006;
 
 /// The solution of `AssemblingKits-v0`.
 pub const ASSEMBLING_KITS: InsertionSolution = InsertionSolution {
@@ -52,11 +50,11 @@ fn box_of(shape: &KitShape) -> (Vector3<f64>, f64, Vector3<f64>) {
         Vector3::new(
             f64::from(centre.x),
             f64::from(centre.y),
-            0.5 * f64::from(SHAPE_HEIGHT),
+            0.5 * f64::from(shape.height),
         ),
         f64::from(across),
         Vector3::new(
-            0.5 * f64::from(SHAPE_HEIGHT),
+            0.5 * f64::from(shape.height),
             0.5 * f64::from(a1 - a0),
             0.5 * f64::from(b1 - b0),
         ),
@@ -93,7 +91,6 @@ fn sense_assembling_kits(env: &Env) -> Result<InsertionWorld, SolveError> {
         .ok_or_else(|| SolveError::Sensing("not an AssemblingKits task".to_owned()))?;
     let world = scene.world.as_ref();
     let base_from_world = scene.agent.base_pose().inverse().cast::<f64>();
-    let shapes = super::assembling_kits::shapes();
     // A shape's box (base frame) with the shape's frame at `pose` (world). The whole pose,
     // tilt included: a shape grasped near its top hangs a few degrees tilted in the hand, and
     // lining up only its centre and yaw left its bottom ~1.5 mm off, on the slot's rim.
@@ -124,26 +121,19 @@ fn sense_assembling_kits(env: &Env) -> Result<InsertionWorld, SolveError> {
         UnitQuaternion::from_axis_angle(&Vector3::z_axis(), f64::from(slot_yaw)),
     );
     let inserted = boxed(&target, &inserted_shape).pose_base_from_box;
+    let board_box = task.board_box();
     let board = OrientedBox {
         pose_base_from_box: base_from_world
-            * Isometry3::translation(0.0, 0.0, f64::from(BOARD_HALF_HEIGHT)),
-        half_extents: Vector3::new(
-            f64::from(BOARD_HALF_SIZE[0]),
-            f64::from(BOARD_HALF_SIZE[1]),
-            f64::from(BOARD_HALF_HEIGHT),
-        ),
+            * Isometry3::from_parts(
+                Translation3::from(board_box.center.cast::<f64>()),
+                UnitQuaternion::identity(),
+            ),
+        half_extents: board_box.half_extents.cast::<f64>(),
     };
-    let kit = task.kit();
     let mut obstacles = vec![("board".to_owned(), board)];
-    let mut others = task.others.iter();
-    for i in (0..kit.slot_shapes.len()).filter(|&i| i != kit.target) {
-        if let Some(&body) = others.next() {
-            let pose = body_pose(world, body).cast::<f64>();
-            obstacles.push((
-                format!("kit_shape_{i}"),
-                boxed(&shapes[kit.slot_shapes[i]], &pose),
-            ));
-        }
+    for (i, (&body, (shape, _))) in task.others.iter().zip(&task.others_placed).enumerate() {
+        let pose = body_pose(world, body).cast::<f64>();
+        obstacles.push((format!("kit_shape_{i}"), boxed(shape, &pose)));
     }
     let (centre, _, _) = box_of(&target);
     Ok(InsertionWorld {
@@ -151,9 +141,13 @@ fn sense_assembling_kits(env: &Env) -> Result<InsertionWorld, SolveError> {
         obstacles,
         inserted,
         // The box's x points down: the grasp is up from the box's centre.
-        grasp_point: Vector3::new(centre.z - GRASP_HEIGHT, 0.0, 0.0),
+        grasp_point: Vector3::new(
+            centre.z - (f64::from(target.height) - GRASP_BELOW_TOP),
+            0.0,
+            0.0,
+        ),
         grasps: grasps_from_above(),
-        entry_distance: 2.0 * f64::from(BOARD_HALF_HEIGHT),
+        entry_distance: 2.0 * f64::from(board_box.half_extents.z),
         aligned: 0.0005,
         insert_segment: 0.01,
     })

@@ -11,6 +11,7 @@
 
 pub mod assembling_kits;
 pub mod common;
+pub mod kit_files;
 pub mod kit_policy;
 pub mod kit_shapes;
 #[cfg(feature = "demos")]
@@ -103,7 +104,9 @@ pub fn register(r: &mut Registrar) {
     r.add(registration);
 
     let registration = TaskRegistration::new(ASSEMBLING_KITS, |_| {
-        Ok(Box::<AssemblyTask<AssemblingKits>>::default())
+        Ok(Box::new(AssemblyTask {
+            parts: AssemblingKits::discover()?,
+        }))
     })
     .scripted(kit_policy::kit_policy);
     #[cfg(feature = "demos")]

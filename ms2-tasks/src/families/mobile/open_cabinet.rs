@@ -329,6 +329,10 @@ fn grasp_orientations(
 }
 
 impl Task for OpenCabinet {
+    fn model_id(&self) -> Option<&str> {
+        Some(&self.model_id)
+    }
+
     fn max_dense_reward(&self) -> f64 {
         MAX_DENSE_REWARD
     }

@@ -258,6 +258,14 @@ pub(crate) fn evaluate_placement(
 }
 
 impl Task for PickSingle {
+    fn model_id(&self) -> Option<&str> {
+        Some(&self.model_id)
+    }
+
+    fn model_scale(&self) -> Option<f64> {
+        self.model_scale.map(f64::from)
+    }
+
     fn max_dense_reward(&self) -> f64 {
         MAX_DENSE_REWARD
     }
