@@ -1,8 +1,7 @@
-//! The object motion-planning solution on household models (the procedural family playing
-//! YCB's role) that had no reachable collision-free grasp before the grasp search looked for
-//! the thinnest layer through a point (rims, handles) and kept the fingertips off the ground:
-//! each episode is simulated, so a success means the grasp held while the object was lifted
-//! and carried to its goal.
+//! The object motion-planning solution on a household model (the procedural family playing
+//! YCB's role) that had no reachable collision-free grasp before the grasp search kept the
+//! fingertips off the ground (a 12 mm spoon lying flat): each episode is simulated, so a
+//! success means the grasp held while the object was lifted and carried to its goal.
 #![cfg(feature = "demos")]
 
 use ms2_tasks::demos::solutions::DemoSolver;
@@ -57,17 +56,11 @@ fn assert_picked_and_lifted(model: &str, seeds: &[u64], rise: f32) {
 }
 
 #[test]
-fn a_mug_wider_than_the_gripper_is_picked_by_its_rim_or_handle() {
-    // 038_mug_4: 88 mm across its body, the Panda opens 80 mm.
-    assert_picked_and_lifted("038_mug_4", &MUG_SEEDS, 0.05);
-}
-
-#[test]
 fn a_thin_spoon_lying_flat_is_picked_with_the_fingertips_above_the_ground() {
     // 062_spoon_5: 12 mm thick; the padded grasp would put the fingertips into the ground.
     assert_picked_and_lifted("062_spoon_5", &SPOON_SEEDS, 0.05);
 }
 
-/// Seeds whose goals are at least 5 cm above the object.
-const MUG_SEEDS: [u64; 2] = [1, 3];
+/// Seeds whose goals are at least 5 cm above the spoon (before the fingertips were kept off
+/// the ground, neither found a reachable grasp).
 const SPOON_SEEDS: [u64; 2] = [4, 5];
