@@ -116,11 +116,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 Ok(r) => {
                     let ever = r.episode.success.iter().any(|&s| s);
                     failed_seeds.push(format!(
-                        "{} ({} steps vs {}{})",
+                        "{} ({} steps vs {}{}{})",
                         ep.episode_seed,
                         r.episode.actions.len(),
                         ep.actions.len(),
-                        if ever { ", succeeded earlier" } else { "" }
+                        if ever { ", succeeded earlier" } else { "" },
+                        if gripper_closings(ep) > 1 {
+                            ", the source grasped again"
+                        } else {
+                            ""
+                        }
                     ));
                     steps += r.episode.actions.len();
                 }
@@ -139,4 +144,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     Ok(())
+}
+
+/// How many times the source's gripper action goes from opening to closing (its last action
+/// component: > 0 opens, < 0 closes).
+fn gripper_closings(ep: &DemoEpisode) -> usize {
+    let closed: Vec<bool> = ep
+        .actions
+        .iter()
+        .map(|a| a.last().is_some_and(|&g| g < 0.0))
+        .collect();
+    closed.windows(2).filter(|w| !w[0] && w[1]).count() + usize::from(closed.first() == Some(&true))
 }
