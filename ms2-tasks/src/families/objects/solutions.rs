@@ -100,8 +100,6 @@ const PICK_ATTEMPTS: u64 = 3;
 const DROPPED_DISTANCE: f64 = 0.08;
 /// Env steps the gripper is given to open after a missed grasp.
 const OPEN_STEPS: u32 = 6;
-/// Finger position (m) below which the closed gripper holds nothing.
-const EMPTY_FINGER: f64 = 0.001;
 /// Smallest finger opening (m) the planning robot is given (closed fingers touch each other,
 /// which the planner would count as a self-collision).
 const MIN_PLANNED_FINGER: f32 = 0.004;
@@ -379,21 +377,13 @@ impl Run<'_> {
         Ok(holding)
     }
 
-    /// Whether the target rose with the hand after [`Run::lift`] (its centre of mass at least
-    /// half the lift above where `before` saw it) with something between the fingers.
+    /// Whether the target rose with the hand after [`Run::lift`]: its centre of mass at least
+    /// half the lift above where `before` saw it (held between the pads, or wedged between
+    /// fully closed fingers, as a thin cylinder can be).
     fn holds(&self, env: &Env, before: &ObjectScene) -> Result<bool, SolveError> {
         let now = (self.sense)(env)?;
-        let scene = env
-            .task_scene()
-            .ok_or_else(|| SolveError::Sensing("the env has no robot".to_owned()))?;
-        let finger = scene
-            .agent
-            .qpos(scene.world.as_ref())
-            .get(ARM_DOF)
-            .copied()
-            .unwrap_or(0.0);
         let rose = now.target.com_world.z - before.target.com_world.z;
-        Ok(f64::from(finger) > EMPTY_FINGER && rose > 0.5 * LIFT_HEIGHT)
+        Ok(rose > 0.5 * LIFT_HEIGHT)
     }
 
     /// Lifts the hand straight up by [`LIFT_HEIGHT`] (the held object rides along; the
