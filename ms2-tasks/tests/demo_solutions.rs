@@ -2,7 +2,11 @@
 //! episodes are consistent: every recorded state is reproduced by restoring the previous one
 //! and stepping the recorded action.
 
-use ms2_tasks::demos::solutions::{solution_env_ids, solve_episode, DemoSolver};
+use ms2_plan::KinematicRobot;
+use ms2_tasks::demos::solutions::{
+    gripper_closings, solution_env_ids, solve_episode, DemoSolver, Gripper, JointTargetDriver,
+    Solution, SolveError, SolveTimings,
+};
 use ms2_tasks::demos::{replay_episode, DemoEpisode, DemoError, ReplayOptions};
 use ms2_tasks::{make_env, EnvConfig};
 
@@ -198,4 +202,62 @@ fn conversion_follows_the_held_object_into_the_half_millimetre_receptacle() {
         );
         assert_eq!(converted.attempts, 1);
     }
+}
+
+/// PickCube's solution, preceded by a closed-and-opened gripper when the planners are seeded
+/// with the episode seed itself (as a missed grasp recovered within the episode would look).
+struct RegraspOnFirstPlan;
+
+impl Solution for RegraspOnFirstPlan {
+    fn run(
+        &self,
+        driver: &mut JointTargetDriver<'_>,
+        panda: &KinematicRobot,
+        seed: u64,
+        timings: &mut SolveTimings,
+    ) -> Result<(), SolveError> {
+        if seed == driver.env().episode_seed() {
+            driver.hold(3, Gripper::Closed)?;
+            driver.hold(3, Gripper::Open)?;
+        }
+        pick_cube_solution().run(driver, panda, seed, timings)
+    }
+
+    fn prefers_single_grasp(&self) -> bool {
+        true
+    }
+}
+
+fn pick_cube_solution() -> &'static dyn Solution {
+    ms2_tasks::registry::registration("PickCube-v0")
+        .unwrap()
+        .solution
+        .unwrap()
+}
+
+#[test]
+fn a_solution_preferring_single_grasps_is_planned_again_without_the_regrasp() {
+    let cfg = EnvConfig::new("PickCube-v0");
+    let plain = solve_episode(&cfg, 3).unwrap();
+    assert!(plain.succeeded());
+    assert_eq!(gripper_closings(&plain), 1);
+    static REGRASP: RegraspOnFirstPlan = RegraspOnFirstPlan;
+    let mut solver = DemoSolver::with_solution(&cfg, &REGRASP).unwrap();
+    let (episode, _) = solver.solve(3).unwrap();
+    assert!(episode.succeeded(), "{:?}", episode.info);
+    assert_eq!(episode.episode_seed, 3);
+    // The first plan closed twice; the kept one is a later plan that closes once.
+    assert_eq!(gripper_closings(&episode), 1);
+    assert!(episode.actions[..6].iter().all(|a| a[a.len() - 1] > 0.0));
+}
+
+#[test]
+fn gripper_closings_count_open_to_close_turns() {
+    let episode = |grips: &[f32]| DemoEpisode {
+        actions: grips.iter().map(|&g| vec![0.0, g]).collect(),
+        ..solve_episode(&EnvConfig::new("PickCube-v0"), 0).unwrap()
+    };
+    assert_eq!(gripper_closings(&episode(&[1.0, 1.0, -1.0, -1.0])), 1);
+    assert_eq!(gripper_closings(&episode(&[-1.0, 1.0, -1.0])), 2);
+    assert_eq!(gripper_closings(&episode(&[1.0, 1.0])), 0);
 }

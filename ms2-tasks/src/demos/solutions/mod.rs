@@ -50,6 +50,31 @@ pub trait Solution: Sync {
         seed: u64,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError>;
+
+    /// Whether [`DemoSolver::solve`] should plan an episode again from its reset, with other
+    /// planner seeds (at most [`SINGLE_GRASP_PLANS`] plans in all), when the solution succeeded
+    /// only by grasping again within the episode (its gripper closed more than once), and keep
+    /// the first plan that succeeds with one grasp. A missed grasp that the solution recovered
+    /// from is a chaotic event: a demonstration that contains one is replayed faithfully but
+    /// converts poorly to other control modes (the converted grasp may hold where the source's
+    /// slipped). Default: `false`.
+    fn prefers_single_grasp(&self) -> bool {
+        false
+    }
+}
+
+/// Plans per episode when a solution [prefers single grasps](Solution::prefers_single_grasp).
+pub const SINGLE_GRASP_PLANS: u64 = 3;
+
+/// How many times `episode`'s gripper action turns from opening to closing (its last action
+/// component: > 0 opens, < 0 closes), a closing first action included.
+pub fn gripper_closings(episode: &DemoEpisode) -> usize {
+    let closed: Vec<bool> = episode
+        .actions
+        .iter()
+        .map(|a| a.last().is_some_and(|&g| g < 0.0))
+        .collect();
+    closed.windows(2).filter(|w| !w[0] && w[1]).count() + usize::from(closed.first() == Some(&true))
 }
 
 /// Why a solution stopped early (internal; mapped to [`DemoError`] or a failed episode).
@@ -83,6 +108,15 @@ pub struct SolveTimings {
     pub planning_queries: u32,
     /// Total time of the episode, env reset and simulation included.
     pub total_seconds: f64,
+}
+
+impl SolveTimings {
+    /// Adds `other`'s times and queries (an episode planned again).
+    pub fn accumulate(&mut self, other: &SolveTimings) {
+        self.planning_seconds += other.planning_seconds;
+        self.planning_queries += other.planning_queries;
+        self.total_seconds += other.total_seconds;
+    }
 }
 
 /// Env ids that have a motion-planning solution.
@@ -128,6 +162,15 @@ impl DemoSolver {
             .ok()
             .and_then(|r| r.solution)
             .ok_or_else(no_solution)?;
+        Self::with_solution(cfg, solution)
+    }
+
+    /// A solver running `solution` (e.g. one wrapping a registered solution) in an env made
+    /// from `cfg`; errors as [`DemoSolver::new`] except [`DemoError::NoSolution`].
+    pub fn with_solution(
+        cfg: &EnvConfig,
+        solution: &'static dyn Solution,
+    ) -> Result<Self, DemoError> {
         if let Some(mode) = cfg.control_mode.as_deref() {
             if mode != CONTROL_MODE {
                 return Err(DemoError::Env(EnvError::InvalidConfig(format!(
@@ -160,13 +203,41 @@ impl DemoSolver {
     /// # Errors
     /// [`DemoError::Planning`] if a planning query fails, [`DemoError::Env`] if the env fails.
     pub fn solve(&mut self, seed: u64) -> Result<(DemoEpisode, SolveTimings), DemoError> {
+        let first = self.solve_with(seed, seed)?;
+        if !self.solution.prefers_single_grasp()
+            || !first.0.succeeded()
+            || gripper_closings(&first.0) <= 1
+        {
+            return Ok(first);
+        }
+        let mut timings = first.1;
+        for k in 1..SINGLE_GRASP_PLANS {
+            // Another planner stream for the same scene (the episode seed is unchanged).
+            let planning_seed = seed ^ (k << 56);
+            let Ok((episode, t)) = self.solve_with(seed, planning_seed) else {
+                continue;
+            };
+            timings.accumulate(&t);
+            if episode.succeeded() && gripper_closings(&episode) <= 1 {
+                return Ok((episode, timings));
+            }
+        }
+        Ok((first.0, timings))
+    }
+
+    /// One plan of episode `seed` with the planners seeded by `planning_seed`.
+    fn solve_with(
+        &mut self,
+        seed: u64,
+        planning_seed: u64,
+    ) -> Result<(DemoEpisode, SolveTimings), DemoError> {
         let t0 = Instant::now();
         let mut timings = SolveTimings::default();
         let mut driver =
             JointTargetDriver::start(&mut self.env, seed).map_err(|e| to_demo(e, seed))?;
         match self
             .solution
-            .run(&mut driver, self.panda, seed, &mut timings)
+            .run(&mut driver, self.panda, planning_seed, &mut timings)
         {
             Ok(()) | Err(SolveError::OutOfSteps) => {}
             Err(e) => return Err(to_demo(e, seed)),
