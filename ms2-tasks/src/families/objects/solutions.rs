@@ -9,14 +9,14 @@
 use std::sync::Arc;
 
 use ms2_plan::{
-    reachable_grasps, AttachedObject, CheckerOptions, CollisionScene, GraspPose, GripperSpec,
-    KinematicRobot, MotionPlanner, PlanError, PlannerConfig, PlanningRobot,
+    reachable_grasps, AttachedObject, CheckerOptions, CollisionScene, GraspCandidate, GraspPose,
+    GripperSpec, KinematicRobot, MotionPlanner, PlanError, PlannerConfig, PlanningRobot,
 };
 use nalgebra::{Isometry3, Translation3, Vector3};
 use rand::SeedableRng;
 
 use super::grasping::{
-    grasp_poses, object_shape, sample_antipodal, PoseOptions, DEFAULT_POSE_OPTIONS,
+    grasp_poses, object_shape, sample_antipodal, GraspSite, DEFAULT_POSE_OPTIONS,
 };
 use super::model_db::ObjectModel;
 use super::pick_clutter::PickClutter;
@@ -72,6 +72,12 @@ const CONE_ANGLE: f64 = 0.45;
 const GRASP_BATCH: usize = 24;
 /// Most grasp poses tried.
 const MAX_GRASP_POSES: usize = 480;
+/// Grasp plans at most per pick: the first, then one from the pre-grasp when the target
+/// moved (a rocking fruit, a can rolling, a nudge).
+const TRACK_ROUNDS: u64 = 2;
+/// Distance (m) the target may move from where its grasp was planned before the grasp is
+/// planned again (from the pre-grasp), or (half of it) followed by the descent.
+const TRACK_TOLERANCE: f64 = 0.004;
 /// Pre-grasp distance (m) back along the approach.
 const PRE_GRASP_DISTANCE: f64 = 0.05;
 /// Height (m) above the ground of the lifted object's lowest point before it is carried (the
@@ -94,8 +100,6 @@ const PICK_ATTEMPTS: u64 = 3;
 const DROPPED_DISTANCE: f64 = 0.08;
 /// Env steps the gripper is given to open after a missed grasp.
 const OPEN_STEPS: u32 = 6;
-/// Finger position (m) below which the closed gripper holds nothing.
-const EMPTY_FINGER: f64 = 0.001;
 /// Smallest finger opening (m) the planning robot is given (closed fingers touch each other,
 /// which the planner would count as a self-collision).
 const MIN_PLANNED_FINGER: f32 = 0.004;
@@ -110,12 +114,6 @@ const PAUSE_STEPS: u32 = 3;
 const SUCCESS_STEPS: usize = 3;
 /// Fraction of the joint speed and acceleration limits used.
 const SPEED_SCALE: f64 = 0.5;
-/// The pose options tried after [`DEFAULT_POSE_OPTIONS`]: contacts at the fingertips (thin,
-/// low objects the padded pose would push into the ground).
-const TIP_POSE_OPTIONS: PoseOptions = PoseOptions {
-    pad_depth: 0.0,
-    ..DEFAULT_POSE_OPTIONS
-};
 
 impl Solution for ObjectPickSolution {
     /// Yes: a demonstration whose first grasp missed and was recovered converts poorly (of the
@@ -223,9 +221,55 @@ impl Run<'_> {
         Ok(scene)
     }
 
-    /// Samples antipodal grasps, keeps the first batch of poses with a reachable,
-    /// collision-free grasp and pre-grasp (open fingers clear of the object), reaches the
-    /// pre-grasp, descends and closes.
+    /// Samples antipodal grasps of `target` and keeps the first batch of poses with a
+    /// reachable, collision-free grasp and pre-grasp (open fingers clear of the object) in
+    /// `scene`, from configuration `start`. `draw` varies the samples.
+    fn choose_grasp(
+        &self,
+        scene: &CollisionScene,
+        target: &SensedObject,
+        start: &[f64],
+        draw: u64,
+    ) -> Result<GraspCandidate, SolveError> {
+        let mut rng =
+            rand_chacha::ChaCha8Rng::seed_from_u64(self.seed.wrapping_mul(31).wrapping_add(draw));
+        let lines = sample_antipodal(
+            &target.model.pieces,
+            GRASP_SAMPLES,
+            MAX_GRASP_WIDTH,
+            CONE_ANGLE,
+            &mut rng,
+        );
+        let site = GraspSite {
+            pose_base_from_object: self.base_from_world * target.pose_world_from_object,
+            com: (self.base_from_world * nalgebra::Point3::from(target.com_world)).coords,
+            ground_z: -self.base_from_world.inverse().translation.vector.z,
+        };
+        let tcp_now = self.panda.tcp_pose(start);
+        let mut poses: Vec<GraspPose> = grasp_poses(&lines, &site, &tcp_now, &DEFAULT_POSE_OPTIONS);
+        poses.truncate(MAX_GRASP_POSES);
+        let mut last = PlanError::NoGraspFound { candidates: 0 };
+        for batch in poses.chunks(GRASP_BATCH) {
+            match reachable_grasps(
+                self.panda,
+                scene,
+                None,
+                batch.iter().copied(),
+                &self.gripper,
+                start,
+                CheckerOptions::default(),
+            ) {
+                Ok(mut found) => return Ok(found.swap_remove(0)),
+                Err(e) => last = e,
+            }
+        }
+        Err(plan_error("grasp")(last))
+    }
+
+    /// Reaches the pre-grasp of a reachable, collision-free grasp (see
+    /// [`Run::choose_grasp`]), descends and closes. A target that moved more than
+    /// [`TRACK_TOLERANCE`] meanwhile is grasped anew from the pre-grasp; one that moved less
+    /// is followed by the descent.
     fn pick(
         &self,
         driver: &mut JointTargetDriver<'_>,
@@ -233,74 +277,54 @@ impl Run<'_> {
         attempt: u64,
         timings: &mut SolveTimings,
     ) -> Result<(), SolveError> {
-        let mut objects = vec![&sensed.target];
-        objects.extend(sensed.obstacles.iter());
-        let scene = self.scene(&objects)?;
-        self.clear_start(driver, &scene, timings)?;
-        let start = driver.arm_target().to_vec();
-        let target = &sensed.target;
-        let grasp = timings.time(|| {
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(
-                self.seed.wrapping_mul(31).wrapping_add(attempt),
-            );
-            let lines = sample_antipodal(
-                &target.model.pieces,
-                GRASP_SAMPLES,
-                MAX_GRASP_WIDTH,
-                CONE_ANGLE,
-                &mut rng,
-            );
-            let pose_base = self.base_from_world * target.pose_world_from_object;
-            let com = (self.base_from_world * nalgebra::Point3::from(target.com_world)).coords;
-            let tcp_now = self.panda.tcp_pose(&start);
-            let mut poses: Vec<GraspPose> =
-                grasp_poses(&lines, &pose_base, &com, &tcp_now, &DEFAULT_POSE_OPTIONS);
-            poses.truncate(MAX_GRASP_POSES);
-            poses.extend(
-                grasp_poses(&lines, &pose_base, &com, &tcp_now, &TIP_POSE_OPTIONS)
-                    .into_iter()
-                    .take(MAX_GRASP_POSES / 2),
-            );
-            let mut last = PlanError::NoGraspFound { candidates: 0 };
-            for batch in poses.chunks(GRASP_BATCH) {
-                match reachable_grasps(
-                    self.panda,
-                    &scene,
-                    None,
-                    batch.iter().copied(),
-                    &self.gripper,
-                    &start,
-                    CheckerOptions::default(),
-                ) {
-                    Ok(mut found) => return Ok(found.swap_remove(0)),
-                    Err(e) => last = e,
+        let mut sensed = sensed.clone();
+        let mut planned: Option<(GraspCandidate, CollisionScene, Vector3<f64>)> = None;
+        for round in 0..TRACK_ROUNDS {
+            if let Some((_, _, aim)) = &planned {
+                sensed = (self.sense)(driver.env())?;
+                if (sensed.target.com_world - aim).norm() <= TRACK_TOLERANCE {
+                    break;
                 }
             }
-            Err(plan_error("grasp")(last))
-        })?;
+            let mut objects = vec![&sensed.target];
+            objects.extend(sensed.obstacles.iter());
+            let scene = self.scene(&objects)?;
+            self.clear_start(driver, &scene, timings)?;
+            let start = driver.arm_target().to_vec();
+            let draw = attempt.wrapping_add(1000 * round);
+            let target = &sensed.target;
+            let grasp = timings.time(|| self.choose_grasp(&scene, target, &start, draw))?;
+            let mut planner = self.planner(self.panda, 0)?;
+            let pre_grasp_pose = grasp.grasp.pre_grasp_pose(PRE_GRASP_DISTANCE);
+            let reach = timings.time(|| {
+                planner
+                    .plan_screw(&scene, &start, &pre_grasp_pose)
+                    .or_else(|_| match &grasp.pre_grasp_configuration {
+                        Some(q) => planner.plan_to_configuration(&scene, &start, q),
+                        None => planner.plan_to_pose(&scene, &start, &pre_grasp_pose),
+                    })
+                    .map_err(plan_error("reach"))
+            })?;
+            driver.follow(&reach.trajectory, Gripper::Open)?;
+            planned = Some((grasp, scene, sensed.target.com_world));
+        }
+        let Some((grasp, mut approach_scene, aim)) = planned else {
+            return Err(SolveError::Sensing("no grasp was planned".to_owned()));
+        };
+        // A target that slid a little since is followed.
+        let mut grasp_pose = grasp.grasp.pose_base_from_tcp;
+        let now = (self.sense)(driver.env())?.target.com_world;
+        let slid = Vector3::new(now.x - aim.x, now.y - aim.y, 0.0);
+        if slid.norm() > 0.5 * TRACK_TOLERANCE {
+            grasp_pose = Translation3::from(self.base_from_world.rotation * slid) * grasp_pose;
+        }
         let mut planner = self.planner(self.panda, 0)?;
-        let pre_grasp_pose = grasp.grasp.pre_grasp_pose(PRE_GRASP_DISTANCE);
-        let reach = timings.time(|| {
-            planner
-                .plan_screw(&scene, &start, &pre_grasp_pose)
-                .or_else(|_| match &grasp.pre_grasp_configuration {
-                    Some(q) => planner.plan_to_configuration(&scene, &start, q),
-                    None => planner.plan_to_pose(&scene, &start, &pre_grasp_pose),
-                })
-                .map_err(plan_error("reach"))
-        })?;
-        driver.follow(&reach.trajectory, Gripper::Open)?;
-        let mut approach_scene = scene;
         for finger in &self.gripper.touch_links {
-            approach_scene.allow_collision(finger.clone(), target.name.clone());
+            approach_scene.allow_collision(finger.clone(), sensed.target.name.clone());
         }
         let descend = timings.time(|| {
             planner
-                .plan_screw(
-                    &approach_scene,
-                    driver.arm_target(),
-                    &grasp.grasp.pose_base_from_tcp,
-                )
+                .plan_screw(&approach_scene, driver.arm_target(), &grasp_pose)
                 .or_else(|_| {
                     planner.plan_to_configuration(
                         &approach_scene,
@@ -360,21 +384,13 @@ impl Run<'_> {
         Ok(holding)
     }
 
-    /// Whether the target rose with the hand after [`Run::lift`] (its centre of mass at least
-    /// half the lift above where `before` saw it) with something between the fingers.
+    /// Whether the target rose with the hand after [`Run::lift`]: its centre of mass at least
+    /// half the lift above where `before` saw it (held between the pads, or wedged between
+    /// fully closed fingers, as a thin cylinder can be).
     fn holds(&self, env: &Env, before: &ObjectScene) -> Result<bool, SolveError> {
         let now = (self.sense)(env)?;
-        let scene = env
-            .task_scene()
-            .ok_or_else(|| SolveError::Sensing("the env has no robot".to_owned()))?;
-        let finger = scene
-            .agent
-            .qpos(scene.world.as_ref())
-            .get(ARM_DOF)
-            .copied()
-            .unwrap_or(0.0);
         let rose = now.target.com_world.z - before.target.com_world.z;
-        Ok(f64::from(finger) > EMPTY_FINGER && rose > 0.5 * LIFT_HEIGHT)
+        Ok(rose > 0.5 * LIFT_HEIGHT)
     }
 
     /// Lifts the hand straight up by [`LIFT_HEIGHT`] (the held object rides along; the
