@@ -16,7 +16,7 @@
 
 use std::time::Instant;
 
-use ms2_tasks::demos::solutions::{solution_env_ids, solve_episode};
+use ms2_tasks::demos::solutions::{gripper_closings, solution_env_ids, solve_episode};
 use ms2_tasks::demos::{replay_episode, scripted_episode, DemoEpisode, DemoError, ReplayOptions};
 use ms2_tasks::EnvConfig;
 use rayon::prelude::*;
@@ -144,15 +144,4 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     Ok(())
-}
-
-/// How many times the source's gripper action goes from opening to closing (its last action
-/// component: > 0 opens, < 0 closes).
-fn gripper_closings(ep: &DemoEpisode) -> usize {
-    let closed: Vec<bool> = ep
-        .actions
-        .iter()
-        .map(|a| a.last().is_some_and(|&g| g < 0.0))
-        .collect();
-    closed.windows(2).filter(|w| !w[0] && w[1]).count() + usize::from(closed.first() == Some(&true))
 }

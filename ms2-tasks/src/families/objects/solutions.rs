@@ -28,7 +28,7 @@ use crate::demos::solutions::{Solution, SolveError, SolveTimings};
 use crate::env::Env;
 use crate::families::rigid::common::body_pose;
 use crate::families::rigid::solutions::{
-    move_to_pose, plan_error, tilted_about, GOAL_SLACK_FRACTIONS, SHOULDER_HEIGHT,
+    move_to_pose, plan_error, reach_pre_grasp, tilted_about, GOAL_SLACK_FRACTIONS, SHOULDER_HEIGHT,
 };
 
 /// An object seen through privileged state.
@@ -295,14 +295,8 @@ impl Run<'_> {
             let target = &sensed.target;
             let grasp = timings.time(|| self.choose_grasp(&scene, target, &start, draw))?;
             let mut planner = self.planner(self.panda, 0)?;
-            let pre_grasp_pose = grasp.grasp.pre_grasp_pose(PRE_GRASP_DISTANCE);
             let reach = timings.time(|| {
-                planner
-                    .plan_screw(&scene, &start, &pre_grasp_pose)
-                    .or_else(|_| match &grasp.pre_grasp_configuration {
-                        Some(q) => planner.plan_to_configuration(&scene, &start, q),
-                        None => planner.plan_to_pose(&scene, &start, &pre_grasp_pose),
-                    })
+                reach_pre_grasp(&mut planner, &scene, &start, &grasp, PRE_GRASP_DISTANCE)
                     .map_err(plan_error("reach"))
             })?;
             driver.follow(&reach.trajectory, Gripper::Open)?;

@@ -9,8 +9,8 @@ use std::time::Instant;
 
 use ms2_plan::{
     box_grasp_poses, parry3d::shape::SharedShape, reachable_grasps, AttachedObject, CheckerOptions,
-    CollisionScene, GraspKind, GraspPose, GripperSpec, KinematicRobot, MotionPlanner, OrientedBox,
-    PlanError, PlannedMotion, PlannerConfig, PlanningRobot,
+    CollisionScene, GraspCandidate, GraspKind, GraspPose, GripperSpec, KinematicRobot,
+    MotionPlanner, OrientedBox, PlanError, PlannedMotion, PlannerConfig, PlanningRobot,
 };
 use nalgebra::{Isometry3, Translation3, Vector3};
 
@@ -275,14 +275,8 @@ impl CubeTaskSolution {
             .map_err(plan_error("grasp"))
         })?;
         let mut planner = planning.planner(panda, 0)?;
-        let pre_grasp_pose = grasp.grasp.pre_grasp_pose(PRE_GRASP_DISTANCE);
         let reach = timings.time(|| {
-            planner
-                .plan_screw(&scene, &start, &pre_grasp_pose)
-                .or_else(|_| match &grasp.pre_grasp_configuration {
-                    Some(q) => planner.plan_to_configuration(&scene, &start, q),
-                    None => planner.plan_to_pose(&scene, &start, &pre_grasp_pose),
-                })
+            reach_pre_grasp(&mut planner, &scene, &start, &grasp, PRE_GRASP_DISTANCE)
                 .map_err(plan_error("reach"))
         })?;
         let ajar = Gripper::Ajar(approach_finger_opening(&cube, &panda.tcp_pose(&start)));
@@ -465,6 +459,25 @@ pub(crate) fn move_to_pose(
     planner
         .plan_screw(scene, start, pose_base_from_tcp)
         .or_else(|_| planner.plan_to_pose(scene, start, pose_base_from_tcp))
+}
+
+/// Plans from `start` to `grasp`'s pre-grasp pose, `distance` metres back along its approach:
+/// a screw motion, else RRT-Connect to the pre-grasp configuration the grasp search found (or,
+/// without one, to a collision-free IK solution of the pose).
+pub(crate) fn reach_pre_grasp(
+    planner: &mut MotionPlanner<'_, KinematicRobot>,
+    scene: &CollisionScene,
+    start: &[f64],
+    grasp: &GraspCandidate,
+    distance: f64,
+) -> Result<PlannedMotion, PlanError> {
+    let pre_grasp_pose = grasp.grasp.pre_grasp_pose(distance);
+    planner
+        .plan_screw(scene, start, &pre_grasp_pose)
+        .or_else(|_| match &grasp.pre_grasp_configuration {
+            Some(q) => planner.plan_to_configuration(scene, start, q),
+            None => planner.plan_to_pose(scene, start, &pre_grasp_pose),
+        })
 }
 
 /// Height (m) of the Panda's shoulder (joint 2) above its base: the centre of its reach.
