@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use ms2_tasks::demos::solutions::{gripper_closings, solution_env_ids, solve_episode};
 use ms2_tasks::demos::{replay_episode, scripted_episode, DemoEpisode, DemoError, ReplayOptions};
-use ms2_tasks::EnvConfig;
+use ms2_tasks::{EnvConfig, InfoValue};
 use rayon::prelude::*;
 
 const DEFAULT_TARGETS: &str = "pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos";
@@ -116,7 +116,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 Ok(r) => {
                     let ever = r.episode.success.iter().any(|&s| s);
                     failed_seeds.push(format!(
-                        "{} ({} steps vs {}{}{})",
+                        "{} ({} steps vs {}{}{}; final {})",
                         ep.episode_seed,
                         r.episode.actions.len(),
                         ep.actions.len(),
@@ -125,7 +125,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                             ", the source grasped again"
                         } else {
                             ""
-                        }
+                        },
+                        final_info(&r.episode.info)
                     ));
                     steps += r.episode.actions.len();
                 }
@@ -144,4 +145,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     Ok(())
+}
+
+/// The final info's terms other than `success` and `elapsed_steps`, e.g.
+/// `obj_to_goal_dist=0.031 is_robot_static=false`.
+fn final_info(info: &ms2_tasks::Info) -> String {
+    info.iter()
+        .filter(|(k, _)| k != "success" && k != "elapsed_steps")
+        .map(|(k, v)| match v {
+            InfoValue::Bool(b) => format!("{k}={b}"),
+            InfoValue::F64(x) => format!("{k}={x:.3}"),
+            InfoValue::I64(i) => format!("{k}={i}"),
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
 }
