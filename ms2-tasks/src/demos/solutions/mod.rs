@@ -18,6 +18,7 @@
 
 pub mod driver;
 pub mod planning_geometry;
+pub mod quality;
 pub mod scene;
 
 use std::sync::OnceLock;
@@ -32,6 +33,7 @@ use crate::env::{make_env, Env};
 use crate::error::EnvError;
 use crate::registry;
 pub use driver::{Gripper, JointTargetDriver, CONTROL_MODE};
+pub use quality::Cleanliness;
 pub use scene::{SensedCube, SensedState};
 
 /// A task's motion-planning solution, registered with the task
@@ -53,17 +55,18 @@ pub trait Solution: Sync {
 
     /// Whether [`DemoSolver::solve`] should plan an episode again from its reset, with other
     /// planner seeds (at most [`SINGLE_GRASP_PLANS`] plans in all), when the solution succeeded
-    /// only by grasping again within the episode (its gripper closed more than once), and keep
-    /// the first plan that succeeds with one grasp. A missed grasp that the solution recovered
-    /// from is a chaotic event: a demonstration that contains one is replayed faithfully but
-    /// converts poorly to other control modes (the converted grasp may hold where the source's
-    /// slipped). Default: `false`.
+    /// but not [cleanly](Cleanliness): by grasping again within the episode (its gripper
+    /// closed more than once), or after an object moved before the grasp. It keeps the first
+    /// plan of the best rank. Such events are chaotic: a demonstration that contains one is
+    /// replayed faithfully but converts poorly to other control modes (the converted grasp may
+    /// hold where the source's slipped, or close on another part of a nudged object).
+    /// Default: `false`.
     fn prefers_single_grasp(&self) -> bool {
         false
     }
 }
 
-/// Plans per episode when a solution [prefers single grasps](Solution::prefers_single_grasp).
+/// Plans per episode when a solution [prefers clean grasps](Solution::prefers_single_grasp).
 pub const SINGLE_GRASP_PLANS: u64 = 3;
 
 /// How many times `episode`'s gripper action turns from opening to closing (its last action
@@ -204,25 +207,30 @@ impl DemoSolver {
     /// [`DemoError::Planning`] if a planning query fails, [`DemoError::Env`] if the env fails.
     pub fn solve(&mut self, seed: u64) -> Result<(DemoEpisode, SolveTimings), DemoError> {
         let first = self.solve_with(seed, seed)?;
-        if !self.solution.prefers_single_grasp()
-            || !first.0.succeeded()
-            || gripper_closings(&first.0) <= 1
-        {
+        if !self.solution.prefers_single_grasp() || !first.0.succeeded() {
             return Ok(first);
         }
-        let mut timings = first.1;
+        let mut rank = Cleanliness::of(&mut self.env, &first.0)?;
+        let (mut best, mut timings) = first;
         for k in 1..SINGLE_GRASP_PLANS {
+            if rank == Cleanliness::Clean {
+                break;
+            }
             // Another planner stream for the same scene (the episode seed is unchanged).
             let planning_seed = seed ^ (k << 56);
             let Ok((episode, t)) = self.solve_with(seed, planning_seed) else {
                 continue;
             };
             timings.accumulate(&t);
-            if episode.succeeded() && gripper_closings(&episode) <= 1 {
-                return Ok((episode, timings));
+            if !episode.succeeded() {
+                continue;
+            }
+            let r = Cleanliness::of(&mut self.env, &episode)?;
+            if r > rank {
+                (best, rank) = (episode, r);
             }
         }
-        Ok((first.0, timings))
+        Ok((best, timings))
     }
 
     /// One plan of episode `seed` with the planners seeded by `planning_seed`.

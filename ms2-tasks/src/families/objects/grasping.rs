@@ -259,7 +259,7 @@ pub const DEFAULT_POSE_OPTIONS: PoseOptions = PoseOptions {
     min_pad_depth: -0.007,
     ground_clearance: 0.0015,
     fingertips: PANDA_FINGERTIPS,
-    com_weight: 8.0,
+    com_weight: 20.0,
 };
 
 /// Where the object to grasp is (robot base frame).

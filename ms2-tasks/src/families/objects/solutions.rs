@@ -78,6 +78,11 @@ const TRACK_ROUNDS: u64 = 2;
 /// Distance (m) the target may move from where its grasp was planned before the grasp is
 /// planned again (from the pre-grasp), or (half of it) followed by the descent.
 const TRACK_TOLERANCE: f64 = 0.004;
+/// Clearance (m) the reach to the pre-grasp keeps from the objects, when it can: a hand that
+/// brushes the target on its way moves it unpredictably, and a demonstration that does so
+/// cannot be followed by another controller (the first plan with this margin wins, else one
+/// without).
+const REACH_MARGIN: f64 = 0.01;
 /// Pre-grasp distance (m) back along the approach.
 const PRE_GRASP_DISTANCE: f64 = 0.05;
 /// Height (m) above the ground of the lifted object's lowest point before it is carried (the
@@ -188,7 +193,21 @@ impl Run<'_> {
         robot: &'r KinematicRobot,
         phase: u64,
     ) -> Result<MotionPlanner<'r, KinematicRobot>, SolveError> {
+        self.planner_with_margin(robot, phase, 0.0)
+    }
+
+    /// [`Run::planner`] keeping `margin` metres between every two bodies.
+    fn planner_with_margin<'r>(
+        &self,
+        robot: &'r KinematicRobot,
+        phase: u64,
+        margin: f64,
+    ) -> Result<MotionPlanner<'r, KinematicRobot>, SolveError> {
         let config = PlannerConfig {
+            checker: CheckerOptions {
+                margin,
+                ..CheckerOptions::default()
+            },
             seed: self.seed.wrapping_mul(16).wrapping_add(phase),
             control_frequency: self.control_frequency,
             velocity_scale: SPEED_SCALE,
@@ -294,9 +313,13 @@ impl Run<'_> {
             let draw = attempt.wrapping_add(1000 * round);
             let target = &sensed.target;
             let grasp = timings.time(|| self.choose_grasp(&scene, target, &start, draw))?;
+            let mut careful = self.planner_with_margin(self.panda, 0, REACH_MARGIN)?;
             let mut planner = self.planner(self.panda, 0)?;
             let reach = timings.time(|| {
-                reach_pre_grasp(&mut planner, &scene, &start, &grasp, PRE_GRASP_DISTANCE)
+                reach_pre_grasp(&mut careful, &scene, &start, &grasp, PRE_GRASP_DISTANCE)
+                    .or_else(|_| {
+                        reach_pre_grasp(&mut planner, &scene, &start, &grasp, PRE_GRASP_DISTANCE)
+                    })
                     .map_err(plan_error("reach"))
             })?;
             driver.follow(&reach.trajectory, Gripper::Open)?;
