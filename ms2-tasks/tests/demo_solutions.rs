@@ -4,8 +4,8 @@
 
 use ms2_plan::KinematicRobot;
 use ms2_tasks::demos::solutions::{
-    gripper_closings, solution_env_ids, solve_episode, DemoSolver, Gripper, JointTargetDriver,
-    Solution, SolveError, SolveTimings,
+    gripper_closings, solution_env_ids, solve_episode, Cleanliness, DemoSolver, Gripper,
+    JointTargetDriver, Solution, SolveError, SolveTimings,
 };
 use ms2_tasks::demos::{replay_episode, DemoEpisode, DemoError, ReplayOptions};
 use ms2_tasks::{make_env, EnvConfig};
@@ -260,4 +260,132 @@ fn gripper_closings_count_open_to_close_turns() {
     assert_eq!(gripper_closings(&episode(&[1.0, 1.0, -1.0, -1.0])), 1);
     assert_eq!(gripper_closings(&episode(&[-1.0, 1.0, -1.0])), 2);
     assert_eq!(gripper_closings(&episode(&[1.0, 1.0])), 0);
+}
+
+/// The index of `episode`'s first closing gripper action.
+fn first_close(episode: &DemoEpisode) -> usize {
+    episode
+        .actions
+        .iter()
+        .position(|a| a[a.len() - 1] < 0.0)
+        .expect("the episode closes its gripper")
+}
+
+/// `episode` with its cube (PickCube's only free body: the state's first 3 floats are its
+/// position) moved by `dx` metres along world x in states `range`.
+fn with_cube_moved(episode: &DemoEpisode, range: std::ops::Range<usize>, dx: f32) -> DemoEpisode {
+    let mut moved = episode.clone();
+    for state in &mut moved.env_states[range] {
+        state[0] += dx;
+    }
+    moved
+}
+
+#[test]
+fn cleanliness_ranks_regrasps_slips_disturbed_objects_and_clean_episodes() {
+    let cfg = EnvConfig::new("PickCube-v0");
+    let episode = solve_episode(&cfg, 3).unwrap();
+    assert!(episode.succeeded());
+    let mut env = make_env(&EnvConfig {
+        control_mode: Some("pd_joint_pos".to_owned()),
+        ..cfg
+    })
+    .unwrap();
+    env.reset(Some(3), false).unwrap();
+    assert_eq!(
+        Cleanliness::of(&mut env, &episode).unwrap(),
+        Cleanliness::Clean
+    );
+    let close = first_close(&episode);
+    // The cube pushed 1 cm before the grasp; 2 mm is below the threshold.
+    let nudged = with_cube_moved(&episode, close..close + 1, 0.01);
+    assert_eq!(
+        Cleanliness::of(&mut env, &nudged).unwrap(),
+        Cleanliness::Disturbed
+    );
+    let barely = with_cube_moved(&episode, close..close + 1, 0.002);
+    assert_eq!(
+        Cleanliness::of(&mut env, &barely).unwrap(),
+        Cleanliness::Clean
+    );
+    // After the grasp the cube moves with the hand: that is not a disturbance.
+    let carried = with_cube_moved(&episode, close + 1..episode.env_states.len(), 0.05);
+    assert_eq!(
+        Cleanliness::of(&mut env, &carried).unwrap(),
+        Cleanliness::Clean
+    );
+    // The held cube sliding 1 mm per step in the hand once the grasp settled.
+    let mut sliding = episode.clone();
+    let settled = close + ms2_tasks::demos::solutions::quality::GRASP_SETTLE_STEPS;
+    for (k, state) in sliding.env_states[settled..].iter_mut().enumerate() {
+        state[0] += 0.001 * k as f32;
+    }
+    assert_eq!(
+        Cleanliness::of(&mut env, &sliding).unwrap(),
+        Cleanliness::Slipping
+    );
+    let mut regrasped = episode.clone();
+    for a in &mut regrasped.actions[..2] {
+        *a.last_mut().unwrap() = -1.0;
+    }
+    assert_eq!(
+        Cleanliness::of(&mut env, &regrasped).unwrap(),
+        Cleanliness::Regrasped
+    );
+    assert!(Cleanliness::Regrasped < Cleanliness::Slipping);
+    assert!(Cleanliness::Slipping < Cleanliness::Disturbed);
+    assert!(Cleanliness::Disturbed < Cleanliness::Clean);
+}
+
+/// The world TCP position of `env` in `state`.
+fn tcp_at(env: &mut ms2_tasks::Env, state: &[f32]) -> nalgebra::Vector3<f32> {
+    env.set_state(state).unwrap();
+    let scene = env.task_scene().unwrap();
+    scene
+        .agent
+        .tcp_pose(scene.world.as_ref())
+        .translation
+        .vector
+}
+
+#[test]
+fn conversion_approaches_the_object_where_the_source_hand_was_relative_to_it() {
+    // A source whose recorded cube sits 8 mm further along x than the cube the converted run
+    // finds (the cube was nudged in the source run): approaching, the converted hand keeps the
+    // source's hand-to-cube offset, so it closes 8 mm short of the source's hand along x. By
+    // the hand path alone it closes where the source's hand did.
+    let cfg = EnvConfig::new("PickCube-v0");
+    let source = solve_episode(&cfg, 3).unwrap();
+    let shifted = with_cube_moved(&source, 1..first_close(&source) + 1, 0.008);
+    let mut env = make_env(&EnvConfig {
+        control_mode: Some("pd_ee_delta_pose".to_owned()),
+        ..cfg.clone()
+    })
+    .unwrap();
+    env.reset(Some(3), false).unwrap();
+    let mut source_env = make_env(&EnvConfig {
+        control_mode: Some("pd_joint_pos".to_owned()),
+        ..cfg.clone()
+    })
+    .unwrap();
+    source_env.reset(Some(3), false).unwrap();
+    let source_close = first_close(&source);
+    let source_tcp = tcp_at(&mut source_env, &source.env_states[source_close]);
+    for track_hand_only in [false, true] {
+        let opts = ReplayOptions {
+            target_control_mode: Some("pd_ee_delta_pose".to_owned()),
+            track_hand_only,
+            ..ReplayOptions::default()
+        };
+        let converted = replay_episode(&cfg, &shifted, &opts).unwrap().episode;
+        let close = first_close(&converted);
+        let tcp = tcp_at(&mut env, &converted.env_states[close]);
+        let expected_dx = if track_hand_only { 0.0 } else { -0.008 };
+        let off = tcp - source_tcp;
+        assert!(
+            (off.x - expected_dx).abs() < 0.002 && off.y.abs() < 0.002,
+            "track_hand_only {track_hand_only}: the converted hand closed {off:?} from the \
+             source's (expected x {expected_dx})"
+        );
+    }
 }

@@ -13,7 +13,7 @@
 //! * [`DemoError`] — everything that can go wrong while making or replaying demonstrations.
 
 mod episode;
-mod in_hand;
+mod object_following;
 mod replay;
 mod scripted;
 pub mod solutions;

@@ -1,23 +1,37 @@
-//! [`InHandCorrection`]: during a conversion, moves the target robot's hand so that an object it
-//! holds follows the source episode's object, not just the source's hand.
+//! [`ObjectFollowing`]: during a conversion, moves the target robot's hand relative to the
+//! object it approaches or holds, so that the object follows the source episode's object, not
+//! just the source's hand.
 //!
-//! Replaying the source's joint targets reproduces the source's *hand* path. Two grasps of the
-//! same object never end up exactly alike, though: contact is sensitive to micrometres, so the
-//! converted robot may hold the object a millimetre or a degree off the source's grasp. Carried
-//! along the source's hand path, the object then arrives off by the same amount, which is
-//! enough to miss PlugCharger's 0.5 mm or AssemblingKits' 1.5 mm clearance.
+//! Replaying the source's joint targets reproduces the source's *hand* path. Two runs never
+//! treat an object exactly alike, though: a fruit rolls on, a bottle tips when a finger brushes
+//! it, and contact is sensitive to micrometres. Following the source's hand then closes the
+//! fingers on another part of the object (or beside it), or carries a grasped object a
+//! millimetre or a degree off the source's, which is enough to miss PlugCharger's 0.5 mm or
+//! AssemblingKits' 1.5 mm clearance. Two corrections of the commanded TCP pose, each solved by
+//! IK seeded at the source's joint targets:
 //!
-//! While both robots hold the same object (ManiSkill2's grasp test on both fingers), the
-//! correction compares the two in-hand transforms, `H = X_tcp⁻¹ · X_object`, and shifts the
-//! commanded TCP pose by `C = H_source · H_target⁻¹` (TCP frame): the target hand goes where it
-//! must for *its* object to take the source's object's pose. The corrected arm joint targets
-//! come from IK seeded at the source's targets. Differences larger than a slipped grasp
-//! ([`MAX_CORRECTION_M`], [`MAX_CORRECTION_RAD`]) are left alone: the grasps are then not the
-//! same grasp, and following the object would drag the hand far from the source's path.
+//! * **Approach** (the source's gripper is not closing and the target holds nothing): the
+//!   object nearest the source's TCP (centre of mass within [`APPROACH_RADIUS_M`]) has pose
+//!   `X_s` in the source and `X_t` in the target; the TCP goes to `X_t · X_s⁻¹ · X_tcp` (world
+//!   frame), i.e. where it is relative to the source's object. An object turned by more than
+//!   [`MAX_APPROACH_RAD`] (a rolling fruit, whose turn says little about where to grasp it) is
+//!   followed by translation only. While the source's fingers close and the target's have not
+//!   grasped yet, the last approach correction is held.
+//! * **In hand** (both robots hold the same object: ManiSkill2's grasp test on the target's
+//!   fingers, the source's fingers still squeezing): the two in-hand transforms
+//!   `H = X_tcp⁻¹ · X_object` are compared and the TCP shifted by `C = H_source · H_target⁻¹`
+//!   (TCP frame): the target hand goes where it must for *its* object to take the source's
+//!   object's pose.
+//!
+//! Differences larger than these corrections are for ([`MAX_APPROACH_M`], [`MAX_CORRECTION_M`],
+//! [`MAX_CORRECTION_RAD`]) are left alone: the runs are then not doing the same thing, and
+//! following the object would drag the hand far from the source's path. Differences below
+//! [`MIN_APPROACH_M`] / [`MIN_APPROACH_RAD`] are not corrected on approach either, so that a
+//! conversion whose objects match the source's keeps the source's exact hand path.
 
 use ms2_control::{DlsIk, IkOptions, KinematicChain};
 use ms2_physics::{BodyId, BodyKind};
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Translation3};
 
 use super::source_targets::SourceJointTargets;
 use super::{DemoEpisode, DemoError};
@@ -32,6 +46,28 @@ pub const MAX_CORRECTION_M: f64 = 0.015;
 /// Largest in-hand rotation (rad) that is corrected.
 pub const MAX_CORRECTION_RAD: f64 = 0.2;
 
+/// Largest distance (m) from the source's TCP to an object's centre of mass for the approach
+/// correction to follow that object.
+pub const APPROACH_RADIUS_M: f64 = 0.15;
+
+/// Largest object displacement (m) the approach correction follows.
+pub const MAX_APPROACH_M: f64 = 0.03;
+
+/// Largest object turn (rad) the approach correction follows with the turn; beyond it, by
+/// translation only.
+pub const MAX_APPROACH_RAD: f64 = 0.4;
+
+/// Largest linear (m/s) and angular (rad/s) speeds of an object at rest, whose pose the
+/// approach correction follows.
+pub const APPROACH_REST_M_PER_S: f32 = 0.02;
+/// See [`APPROACH_REST_M_PER_S`].
+pub const APPROACH_REST_RAD_PER_S: f32 = 0.2;
+
+/// Object displacements (m, rad) below which the approach is not corrected.
+pub const MIN_APPROACH_M: f64 = 1e-3;
+/// See [`MIN_APPROACH_M`].
+pub const MIN_APPROACH_RAD: f64 = 0.02;
+
 /// Largest angle (degrees) between a finger's push and its opening direction for the object to
 /// count as held (ManiSkill2's `check_grasp` default).
 const GRASP_MAX_ANGLE_DEG: f32 = 85.0;
@@ -39,15 +75,29 @@ const GRASP_MAX_ANGLE_DEG: f32 = 85.0;
 /// How far (m) below its position a finger's target must be for the finger to squeeze.
 const SQUEEZE_M: f64 = 1e-3;
 
-/// The TCP chain, its IK and the map from chain joints to articulation dofs.
-pub(crate) struct InHandCorrection {
+/// What [`ObjectFollowing::correct`] did at a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Correction {
+    /// The joint targets were left as they were.
+    None,
+    /// The hand was moved relative to the approached object.
+    Approach,
+    /// The hand was moved relative to the held object.
+    InHand,
+}
+
+/// The TCP chain, its IK, the map from chain joints to articulation dofs, and the approach
+/// correction held while the fingers close.
+pub(crate) struct ObjectFollowing {
     chain: KinematicChain,
     ik: DlsIk,
     chain_to_articulation: Vec<usize>,
+    /// World-frame correction `X_t · X_s⁻¹` of the latest approach step.
+    held_approach: Option<Isometry3<f64>>,
 }
 
-impl InHandCorrection {
-    /// The correction for `env`'s robot, or `None` when its joints are not the Panda's (the
+impl ObjectFollowing {
+    /// The corrections for `env`'s robot, or `None` when its joints are not the Panda's (the
     /// only arm whose kinematic chain the conversion knows).
     pub(crate) fn new(env: &Env) -> Option<Self> {
         let (chain, chain_to_articulation) = panda_tcp_chain(env.task_scene()?).ok()?;
@@ -61,36 +111,31 @@ impl InHandCorrection {
             chain,
             ik,
             chain_to_articulation,
+            held_approach: None,
         })
     }
 
-    /// Corrects `desired` (articulation joint targets for source step `t`) in place when the
-    /// target robot and the source (recorded state `t`) hold the same object; returns whether
-    /// it did.
+    /// Corrects `desired` (articulation joint targets for source step `t`) in place, comparing
+    /// the target env with the source's recorded state `t`.
     pub(crate) fn correct(
-        &self,
+        &mut self,
         env: &Env,
         targets: &mut SourceJointTargets,
         source: &DemoEpisode,
         t: usize,
         desired: &mut [f64],
-    ) -> Result<bool, DemoError> {
+    ) -> Result<Correction, DemoError> {
         let Some(scene) = env.task_scene() else {
-            return Ok(false);
+            return Ok(Correction::None);
         };
-        let Some(object) = held_object(scene) else {
-            return Ok(false);
-        };
-        let Some(h_target) = in_hand_transform(scene, object) else {
-            return Ok(false);
-        };
+        let held = held_object(scene);
         let source_env = targets.recorded_env(source, t)?;
         let source_scene = source_env
             .task_scene()
             .expect("the source env is made like the target env");
         // The recorded state has no contact impulses (a restored state, not a stepped one), so
-        // the source's grasp is read from its fingers: both still squeezed (their targets
-        // below their positions) on an object that sits between them.
+        // the source's grasp is read from its fingers: both squeezed (their targets below their
+        // positions).
         let source_qpos = source_scene
             .world
             .qpos(source_scene.agent.articulation())
@@ -100,36 +145,149 @@ impl InHandCorrection {
             .zip(&source_qpos)
             .skip(ARM_DOF)
             .all(|(&target, &q)| target < f64::from(q) - SQUEEZE_M);
-        if !squeezing {
-            return Ok(false);
+        match (held, squeezing) {
+            (Some(object), true) => {
+                self.held_approach = None;
+                let (Some(h_target), Some(h_source)) = (
+                    in_hand_transform(scene, object),
+                    in_hand_transform(source_scene, object),
+                ) else {
+                    return Ok(Correction::None);
+                };
+                let c = h_source * h_target.inverse();
+                if c.translation.vector.norm() > MAX_CORRECTION_M
+                    || c.rotation.angle() > MAX_CORRECTION_RAD
+                {
+                    return Ok(Correction::None);
+                }
+                Ok(if self.move_tcp(desired, |tcp| tcp * c) {
+                    Correction::InHand
+                } else {
+                    Correction::None
+                })
+            }
+            (Some(_), false) => {
+                self.held_approach = None;
+                Ok(Correction::None)
+            }
+            (None, false) => {
+                if let Some(update) = approach_correction(scene, source_scene) {
+                    self.held_approach = update;
+                }
+                self.apply_approach(scene, desired)
+            }
+            (None, true) => self.apply_approach(scene, desired),
         }
-        let Some(h_source) = in_hand_transform(source_scene, object) else {
-            return Ok(false);
+    }
+
+    /// Moves the TCP of `desired` by the held approach correction (world frame).
+    fn apply_approach(
+        &self,
+        scene: &TaskScene,
+        desired: &mut [f64],
+    ) -> Result<Correction, DemoError> {
+        let Some(c_world) = self.held_approach else {
+            return Ok(Correction::None);
         };
-        let correction = h_source * h_target.inverse();
-        if correction.translation.vector.norm() > MAX_CORRECTION_M
-            || correction.rotation.angle() > MAX_CORRECTION_RAD
-        {
-            return Ok(false);
-        }
+        // The chain's frame is the robot's base: X_world_base = X_world_tcp · FK(q)⁻¹.
+        let world = scene.world.as_ref();
+        let qpos = world
+            .qpos(scene.agent.articulation())
+            .map_err(|e| DemoError::Env(e.into()))?;
+        let q_now: Vec<f64> = self
+            .chain_to_articulation
+            .iter()
+            .map(|&i| f64::from(qpos[i]))
+            .collect();
+        let Ok(base_from_tcp) = self.chain.forward_kinematics(&q_now) else {
+            return Ok(Correction::None);
+        };
+        let world_from_tcp: Isometry3<f64> = scene.agent.tcp_pose(world).cast();
+        let world_from_base = world_from_tcp * base_from_tcp.inverse();
+        let c_base = world_from_base.inverse() * c_world * world_from_base;
+        Ok(if self.move_tcp(desired, |tcp| c_base * tcp) {
+            Correction::Approach
+        } else {
+            Correction::None
+        })
+    }
+
+    /// Replaces the arm joints of `desired` by IK to `goal(FK(desired))` (base frame); false
+    /// (and `desired` untouched) when FK or IK fails.
+    fn move_tcp(
+        &self,
+        desired: &mut [f64],
+        goal: impl Fn(Isometry3<f64>) -> Isometry3<f64>,
+    ) -> bool {
         let q_arm: Vec<f64> = self
             .chain_to_articulation
             .iter()
             .map(|&i| desired[i])
             .collect();
         let Ok(tcp) = self.chain.forward_kinematics(&q_arm) else {
-            return Ok(false);
+            return false;
         };
-        let goal = tcp * correction;
-        let corrected = match self.ik.solve(&self.chain, &goal, &q_arm, None) {
-            Ok(sol) => sol.q,
-            Err(_) => return Ok(false),
+        let Ok(sol) = self.ik.solve(&self.chain, &goal(tcp), &q_arm, None) else {
+            return false;
         };
         for (k, &i) in self.chain_to_articulation.iter().enumerate() {
-            desired[i] = corrected[k];
+            desired[i] = sol.q[k];
         }
-        Ok(true)
+        true
     }
+}
+
+/// The world-frame correction `X_t · X_s⁻¹` (translation only for a turn beyond
+/// [`MAX_APPROACH_RAD`]) of the dynamic body (not a robot link) nearest the source's TCP, when there is one within
+/// [`APPROACH_RADIUS_M`] that moved between [`MIN_APPROACH_M`] and [`MAX_APPROACH_M`] (or turned
+/// more than [`MIN_APPROACH_RAD`]).
+///
+/// `None` (keep the previous correction) while that object moves in either run
+/// ([`APPROACH_REST_M_PER_S`], [`APPROACH_REST_RAD_PER_S`]): a sliding or rolling object's
+/// pose says little about where it will be when the fingers close.
+fn approach_correction(target: &TaskScene, source: &TaskScene) -> Option<Option<Isometry3<f64>>> {
+    let (wt, ws) = (target.world.as_ref(), source.world.as_ref());
+    let tcp: Isometry3<f64> = source.agent.tcp_pose(ws).cast();
+    let robot = source.agent.articulation();
+    let links = ws.link_names(robot).map_or(0, |names| names.len());
+    let robot_links: Vec<BodyId> = (0..links)
+        .filter_map(|i| ws.link_body(robot, i).ok())
+        .collect();
+    let Some((_, body, x_s, x_t)) = ws
+        .bodies()
+        .into_iter()
+        .filter(|b| !robot_links.contains(b))
+        .filter(|&b| matches!(ws.body_kind(b), Ok(BodyKind::Dynamic)))
+        .filter_map(|b| {
+            let x_s: Isometry3<f64> = ws.body_pose(b).ok()?.cast();
+            let x_t: Isometry3<f64> = wt.body_pose(b).ok()?.cast();
+            let d = (x_s.translation.vector - tcp.translation.vector).norm();
+            (d <= APPROACH_RADIUS_M).then_some((d, b, x_s, x_t))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+    else {
+        return Some(None);
+    };
+    let at_rest = |w: &dyn crate::rigid_world::RigidWorld| {
+        w.body_linear_velocity(body)
+            .is_ok_and(|v| v.norm() <= APPROACH_REST_M_PER_S)
+            && w.body_angular_velocity(body)
+                .is_ok_and(|v| v.norm() <= APPROACH_REST_RAD_PER_S)
+    };
+    if !at_rest(wt) || !at_rest(ws) {
+        return None;
+    }
+    let shift = x_t.translation.vector - x_s.translation.vector;
+    let turn = x_t.rotation * x_s.rotation.inverse();
+    if shift.norm() > MAX_APPROACH_M
+        || (shift.norm() < MIN_APPROACH_M && turn.angle() < MIN_APPROACH_RAD)
+    {
+        return Some(None);
+    }
+    if turn.angle() > MAX_APPROACH_RAD {
+        return Some(Some(Translation3::from(shift).into()));
+    }
+    Some(Some(x_t * x_s.inverse()))
 }
 
 /// The dynamic body both fingers of `scene`'s robot grasp, if any.

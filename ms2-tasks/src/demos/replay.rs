@@ -2,7 +2,7 @@
 //! recorded states, recording observations, or converting its actions closed-loop to another
 //! control mode (the ManiSkill2 paper, Sec. 2.2).
 
-use super::in_hand::InHandCorrection;
+use super::object_following::ObjectFollowing;
 use super::source_targets::SourceJointTargets;
 use super::{DemoEpisode, DemoError, EpisodeRecorder, StateRecording};
 use crate::adapters::snapshot_articulation;
@@ -78,10 +78,12 @@ pub struct ReplayedEpisode {
 ///   more target steps toward the same `q̄_src(t)` follow (at most
 ///   [`MAX_EXTRA_STEPS_PER_SOURCE_STEP`]). A failed converted episode is retried up to
 ///   `opts.max_retry` times with a stricter "reached" test (see [`ReplayOptions::max_retry`]);
-///   failed sources are not retried. While the target robot and the source hold the same
-///   object, the source's joint targets are corrected so that the target's object follows the
+///   failed sources are not retried. Unless `opts.track_hand_only`, the source's joint targets
+///   are corrected relative to the object the hands approach or hold: approaching an object at
+///   rest that sits elsewhere than in the source, the hand keeps the source hand's pose
+///   relative to it; while both robots hold the same object, the target's object follows the
 ///   source's object rather than its hand (the grasps differ by a millimetre or so; see
-///   `in_hand.rs`), unless `opts.track_hand_only`. A converted episode ends as soon as it has been
+///   `object_following.rs`). A converted episode ends as soon as it has been
 ///   successful for as many consecutive steps as the source's final run of successful steps
 ///   (the rest of the source's actions are not stepped).
 ///
@@ -247,10 +249,10 @@ fn convert_once(
     let mut obs = ObsLog::new(record_obs, first_obs);
     let mut targets = SourceJointTargets::new(cfg, env, source)?;
     let dof = targets.dof();
-    let in_hand = if opts.track_hand_only {
+    let mut following = if opts.track_hand_only {
         None
     } else {
-        InHandCorrection::new(env)
+        ObjectFollowing::new(env)
     };
     let mut desired = Vec::new();
     // A successful source ends after a run of successful steps; a converted episode that
@@ -271,8 +273,8 @@ fn convert_once(
     'source_steps: for t in 0..source.actions.len() {
         desired = targets.targets(source, t)?;
         debug_assert_eq!(desired.len(), dof);
-        if let Some(in_hand) = &in_hand {
-            in_hand.correct(env, &mut targets, source, t, &mut desired)?;
+        if let Some(following) = &mut following {
+            following.correct(env, &mut targets, source, t, &mut desired)?;
         }
         for extra in 0..=MAX_EXTRA_STEPS_PER_SOURCE_STEP {
             let reached = step_toward(env, &mut recorder, &mut obs, &desired, source, t)?;
