@@ -63,10 +63,14 @@ fn main() -> Result<(), EnvError> {
             if step % every == 0 || out.terminated {
                 let q = scene.agent.qpos(world);
                 let tcp = scene.agent.tcp_pose(world);
-                let d = (tcp.translation.vector - task.handle_center(world).coords).norm();
+                let off = tcp.translation.vector - task.handle_center(world).coords;
+                let d = off.norm();
                 let eval = env.evaluate();
                 println!(
-                    "  {step:3} d {d:.3} fingers {:.3} frac {frac:.2} v {:.2} w {:.2} base [{:.2} {:.2} {:.2} lift {:.2}] act {:?}",
+                    "  {step:3} d {d:.3} off [{:.3} {:.3} {:.3}] fingers {:.3} frac {frac:.2} v {:.2} w {:.2} base [{:.2} {:.2} {:.2} lift {:.2}] act {:?}",
+                    off.x,
+                    off.y,
+                    off.z,
                     q[q.len() - 1] + q[q.len() - 2],
                     real(&eval.terms, "link_vel_norm"),
                     real(&eval.terms, "link_ang_vel_norm"),

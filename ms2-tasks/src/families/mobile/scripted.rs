@@ -30,10 +30,13 @@ const ARM_VEL_GAIN: f32 = 10.0;
 const STANDOFF: f32 = 0.12;
 /// How deep (m) the TCP goes past the handle's centre along the approach.
 const DEPTH: f32 = 0.0;
-/// Clearance (m) per finger between the open fingers and the handle across the closing
-/// direction: the gripper opens only this much wider than the handle, so the fingers fit a
+/// Least clearance (m) per finger between the open fingers and the handle across the closing
+/// direction: the gripper opens only this much wider than a thin handle, so the fingers fit a
 /// recessed handle's slot (6 cm wide around a 1.4 cm bar on the procedural cabinets).
 const FINGER_CLEARANCE: f32 = 0.0035;
+/// Clearance per finger as a fraction of the handle's width, when more than
+/// [`FINGER_CLEARANCE`] (wide handles such as knobs get more room).
+const FINGER_CLEARANCE_FRACTION: f32 = 0.25;
 /// Largest TCP advance (m) per step while approaching.
 const MAX_STEP: f32 = 0.05;
 /// Opening advance per step: m for drawers, rad for doors.
@@ -230,8 +233,9 @@ impl OpenCabinetPolicy {
 }
 
 /// The gripper action (normalised, ManiSkill2's [-1, 1] over [`GRIPPER_CLOSED`],
-/// [`GRIPPER_OPEN`] m per finger) that opens each finger [`FINGER_CLEARANCE`] beyond the half
-/// width of `handle` across the closing direction of `grasp_in_link` (at most fully open).
+/// [`GRIPPER_OPEN`] m per finger) that opens each finger a clearance ([`FINGER_CLEARANCE`],
+/// [`FINGER_CLEARANCE_FRACTION`]) beyond the half width of `handle` across the closing
+/// direction of `grasp_in_link` (at most fully open).
 fn open_action(handle: &HandleGeometry, grasp_in_link: &UnitQuaternion<f32>) -> f32 {
     let closing = grasp_in_link * Vector3::y();
     let (lo, hi) = handle
@@ -242,7 +246,9 @@ fn open_action(handle: &HandleGeometry, grasp_in_link: &UnitQuaternion<f32>) -> 
             (lo.min(s), hi.max(s))
         });
     let (closed, fully_open) = (GRIPPER_CLOSED as f32, GRIPPER_OPEN as f32);
-    let finger = ((hi - lo) / 2.0 + FINGER_CLEARANCE).min(fully_open);
+    let width = hi - lo;
+    let clearance = FINGER_CLEARANCE.max(FINGER_CLEARANCE_FRACTION * width);
+    let finger = (width / 2.0 + clearance).min(fully_open);
     if !finger.is_finite() {
         return 1.0;
     }
