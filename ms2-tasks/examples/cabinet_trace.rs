@@ -19,7 +19,10 @@ fn real(info: &Info, key: &str) -> f64 {
 
 fn main() -> Result<(), EnvError> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let id = args.first().cloned().unwrap_or("OpenCabinetDrawer-v1".into());
+    let id = args
+        .first()
+        .cloned()
+        .unwrap_or("OpenCabinetDrawer-v1".into());
     let mode = args
         .get(1)
         .cloned()
