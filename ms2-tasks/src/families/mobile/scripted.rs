@@ -5,7 +5,9 @@
 //! for a drawer, an arc about the hinge for a door), solves IK over the whole chain (base x, y,
 //! yaw, lift and the arm), drives the base towards the solution's base joints by velocity and
 //! sends the arm the solution's joints. The grasp orientation is ManiSkill2's (approach into the
-//! front, fingers closing across the handle).
+//! front, fingers closing across the handle); while reaching, the gripper opens only a little
+//! wider than the handle (a recessed handle's slot does not fit the fully open fingers), and
+//! each pull step starts from the handle's grasp pose, not from the lagging TCP.
 
 use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 
