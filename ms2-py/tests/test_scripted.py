@@ -16,11 +16,10 @@ MIN_SUCCESS_RATE = 0.8
 #: obstacle reach replays a joint-space plan (pd_ee_delta_pose: 23/30, docs/tasks.md).
 SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
 #: Known failures, documented in docs/tasks.md: PickSingleYCB-v0 (6/10 on seeds 0-9 since
-#: every reset rebuilds the scene: wide bowls, long tools; issue #16), OpenCabinetDrawer-v1
-#: (7/10 on seeds 0-9 in its default base_pd_joint_vel_arm_pd_joint_vel, 37/50 in
-#: ..._pd_joint_pos; issue #19), PickClutterYCB-v0 (20/30 on seeds 0-29 in pd_ee_delta_pose:
-#: neighbours in the way of its top-down grasp; issue #16).
-KNOWN_FAILING = {"PickSingleYCB-v0", "OpenCabinetDrawer-v1", "PickClutterYCB-v0"}
+#: every reset rebuilds the scene: wide bowls, long tools; issue #16), PickClutterYCB-v0
+#: (20/30 on seeds 0-29 in pd_ee_delta_pose: neighbours in the way of its top-down grasp;
+#: issue #16).
+KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0"}
 
 
 def test_scripted_policy_success_rate(env_id):

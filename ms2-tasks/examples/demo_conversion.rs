@@ -1,5 +1,6 @@
-//! Demonstration conversion rates and cost: records `pd_joint_pos` source episodes (the
-//! motion-planning solution when the env has one, else the scripted oracle), keeps the
+//! Demonstration conversion rates and cost: records `pd_joint_pos` source episodes
+//! (`base_pd_joint_vel_arm_pd_joint_pos` on the mobile robots; the motion-planning solution
+//! when the env has one, else the scripted oracle), keeps the
 //! successful ones and converts each to the target control modes with
 //! `ms2_tasks::demos::replay_episode`, printing the conversion success rate and the seconds per
 //! converted episode of each target mode, plus seconds per source episode.
@@ -10,6 +11,8 @@
 //!     pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos --max-retry 1 --source scripted
 //! cargo run -p ms2-tasks --release --example demo_conversion -- PickSingleYCB-v0 0 \
 //!     pd_ee_delta_pose --seeds 6,23,58
+//! cargo run -p ms2-tasks --release --example demo_conversion -- OpenCabinetDrawer-v1 200 \
+//!     base_pd_joint_vel_arm_pd_ee_delta_pose --source scripted
 //! ```
 //! Episodes run in parallel on rayon's pool (`RAYON_NUM_THREADS`); times are CPU-seconds per
 //! episode summed over threads divided by the episode count.
@@ -48,9 +51,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         None => solution_env_ids().contains(&env_id),
     };
+    // The mobile robots name their modes after the base's.
+    let mobile_prefix = "base_pd_joint_vel_arm_";
+    let spec = ms2_tasks::task_spec(env_id)?;
+    let step_limit = spec.max_episode_steps as usize;
+    let source_mode = if spec.default_control_mode.starts_with(mobile_prefix) {
+        format!("{mobile_prefix}pd_joint_pos")
+    } else {
+        "pd_joint_pos".to_owned()
+    };
     let cfg = EnvConfig {
         obs_mode: "state".to_owned(),
-        control_mode: Some("pd_joint_pos".to_owned()),
+        control_mode: Some(source_mode),
         ..EnvConfig::new(env_id)
     };
     // `--seeds 6,23,58` converts those seeds instead of 0..n.
@@ -105,12 +117,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect();
         let secs = start.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
         let mut ok = 0;
+        // Successful conversions longer than the env's episode limit.
+        let mut over_limit = 0;
         let mut steps = 0usize;
         let mut failed_seeds = Vec::new();
         for (ep, r) in sources.iter().zip(&results) {
             match r {
                 Ok(r) if r.episode.succeeded() => {
                     ok += 1;
+                    over_limit += usize::from(r.episode.actions.len() > step_limit);
                     steps += r.episode.actions.len();
                 }
                 Ok(r) => {
@@ -136,7 +151,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let src_steps: usize = sources.iter().map(|e| e.actions.len()).sum();
         println!(
             "  -> {target:<26} {ok}/{} succeeded ({:.1} %), {:.3} s per converted episode, \
-             {:.3} target steps per source step; failed seeds: {:?}",
+             {:.3} target steps per source step, {over_limit} successes longer than the \
+             {step_limit}-step limit; failed seeds: {:?}",
             sources.len(),
             100.0 * ok as f64 / sources.len().max(1) as f64,
             secs / sources.len().max(1) as f64,

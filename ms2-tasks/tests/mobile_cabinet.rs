@@ -1,6 +1,6 @@
 //! `OpenCabinetDrawer-v1` / `OpenCabinetDoor-v1`: ManiSkill2's observation dims, the robot's
-//! start around the cabinet, the target drawer opening when it is pulled (simulated), and
-//! get/set_state round trips.
+//! start around the cabinet, the target drawer opening when it is pulled (simulated),
+//! get/set_state round trips, the scripted oracle and the conversion of its episodes.
 
 use ms2_tasks::families::mobile::OpenCabinet;
 use ms2_tasks::{make_env, Env, EnvConfig, ObsValue};
@@ -139,6 +139,43 @@ fn scripted_oracle_opens_cabinets() {
             ok += usize::from(success);
         }
         eprintln!("{id}: {ok}/{seeds}");
-        assert!(ok * 2 >= seeds as usize, "{id}: {ok}/{seeds}");
+        // Issue #19's floors: drawers 80 %, doors 70 % (measured: docs/tasks.md).
+        assert!(ok * 10 >= seeds as usize * 7, "{id}: {ok}/{seeds}");
+    }
+}
+
+/// An oracle episode recorded in `base_pd_joint_vel_arm_pd_joint_pos` converts to
+/// `base_pd_joint_vel_arm_pd_ee_delta_pose` and still opens the cabinet: the base's velocity
+/// actions are re-derived from the recorded base joints (the robot starts 1.6-1.8 m away, so
+/// nothing succeeds without the base following).
+#[test]
+fn oracle_episodes_convert_to_ee_delta_pose() {
+    use ms2_tasks::demos::{replay_episode, scripted_episode, ReplayOptions};
+    for id in ["OpenCabinetDrawer-v1", "OpenCabinetDoor-v1"] {
+        let cfg = EnvConfig {
+            obs_mode: "state".to_owned(),
+            control_mode: Some("base_pd_joint_vel_arm_pd_joint_pos".to_owned()),
+            ..EnvConfig::new(id)
+        };
+        let source = scripted_episode(&cfg, 0).unwrap();
+        assert!(source.succeeded(), "{id}: the source episode fails");
+        let target = "base_pd_joint_vel_arm_pd_ee_delta_pose";
+        let converted = replay_episode(
+            &cfg,
+            &source,
+            &ReplayOptions {
+                target_control_mode: Some(target.to_owned()),
+                ..ReplayOptions::default()
+            },
+        )
+        .unwrap();
+        let ep = &converted.episode;
+        assert_eq!(ep.control_mode, target);
+        assert!(
+            ep.succeeded(),
+            "{id}: the conversion fails ({} steps, source {})",
+            ep.actions.len(),
+            source.actions.len()
+        );
     }
 }

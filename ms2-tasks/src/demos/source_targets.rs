@@ -6,6 +6,7 @@ use ms2_control::{Articulation, CombinedController, ControlMode, ControlTiming, 
 use super::replay::restore_init_state;
 use super::{DemoEpisode, DemoError, StateRecording};
 use crate::adapters::snapshot_articulation;
+use crate::agents::mobile_panda::{mobile_robot_config, MobilePandaAgent};
 use crate::config::EnvConfig;
 use crate::env::{make_env, Env};
 use crate::error::EnvError;
@@ -31,6 +32,9 @@ pub(crate) struct SourceJointTargets {
     state_env_step: usize,
     articulation: ms2_control::PerfectTrackingArticulation,
     action_f64: Vec<f64>,
+    /// Dofs of a velocity-driven mobile base (the `base` part; empty for a fixed robot): their
+    /// targets are the joint positions recorded after the step.
+    base_joints: Vec<usize>,
 }
 
 impl SourceJointTargets {
@@ -58,8 +62,15 @@ impl SourceJointTargets {
             .task_scene()
             .ok_or_else(|| unsupported(source, cfg, "the env has no robot"))?;
         let articulation = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation());
-        let robot = RobotConfig::panda(ms2_assets::PANDA_URDF)
-            .map_err(|e| DemoError::Env(EnvError::Controller(e.into())))?;
+        let panda;
+        let robot: &RobotConfig = match scene.agent.downcast_ref::<MobilePandaAgent>() {
+            Some(mobile) => mobile_robot_config(mobile.variant())?,
+            None => {
+                panda = RobotConfig::panda(ms2_assets::PANDA_URDF)
+                    .map_err(|e| DemoError::Env(EnvError::Controller(e.into())))?;
+                &panda
+            }
+        };
         let timing = ControlTiming {
             control_freq_hz: cfg.control_freq,
             sim_freq_hz: cfg.sim_freq,
@@ -68,6 +79,10 @@ impl SourceJointTargets {
             .build_controller(mode, &articulation, timing)
             .map_err(|e| DemoError::Env(EnvError::Controller(e.into())))?;
         let action_f64 = vec![0.0; controller.action_dim()];
+        let base_joints = controller
+            .part(BASE_PART)
+            .map(|p| p.joint_indices().to_vec())
+            .unwrap_or_default();
         let mut this = Self {
             controller,
             needs_state,
@@ -76,6 +91,7 @@ impl SourceJointTargets {
             state_env_step: 0,
             articulation,
             action_f64,
+            base_joints,
         };
         this.place_at(source, 0)?;
         this.controller.reset(&mut this.articulation);
@@ -153,9 +169,11 @@ impl SourceJointTargets {
             .vector)
     }
 
-    /// The joint targets (articulation dof order: 7 arm joints in rad, 2 fingers in m) that
-    /// `source.actions[t]` commands from the state recorded before step `t`. Call for
-    /// `t = 0, 1, ...` in order (target-accumulating source modes keep their targets).
+    /// The joint targets (articulation dof order: 7 arm joints in rad, 2 fingers in m; a mobile
+    /// robot's base joints first, in m and rad) that `source.actions[t]` commands from the state
+    /// recorded before step `t`; the base's velocity-driven joints get the positions recorded
+    /// after step `t`. Call for `t = 0, 1, ...` in order (target-accumulating source modes keep
+    /// their targets).
     pub(crate) fn targets(
         &mut self,
         source: &DemoEpisode,
@@ -168,7 +186,17 @@ impl SourceJointTargets {
         self.controller
             .set_action(&mut self.articulation, &self.action_f64)
             .map_err(|e| DemoError::Env(EnvError::Controller(e.into())))?;
-        let targets = self.controller.position_targets();
+        let mut targets = self.controller.position_targets();
+        if !self.base_joints.is_empty() {
+            let after = self.recorded_state(source, t + 1)?;
+            let scene = after
+                .task_scene()
+                .expect("state env was made like the target env");
+            let q = snapshot_articulation(scene.world.as_ref(), scene.agent.articulation()).qpos;
+            for &i in &self.base_joints {
+                targets[i] = targets[i].or(Some(q[i]));
+            }
+        }
         targets
             .iter()
             .enumerate()
@@ -191,6 +219,9 @@ impl SourceJointTargets {
         self.articulation.dof()
     }
 }
+
+/// The controller part of a mobile robot's base.
+const BASE_PART: &str = "base";
 
 fn unsupported(source: &DemoEpisode, cfg: &EnvConfig, why: &str) -> DemoError {
     DemoError::UnsupportedConversion {

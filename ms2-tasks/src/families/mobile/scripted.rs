@@ -5,15 +5,19 @@
 //! for a drawer, an arc about the hinge for a door), solves IK over the whole chain (base x, y,
 //! yaw, lift and the arm), drives the base towards the solution's base joints by velocity and
 //! sends the arm the solution's joints. The grasp orientation is ManiSkill2's (approach into the
-//! front, fingers closing across the handle).
+//! front, fingers closing across the handle); while reaching, the gripper opens only a little
+//! wider than the handle (a recessed handle's slot does not fit the fully open fingers), and
+//! each pull step starts from the handle's grasp pose, not from the lagging TCP.
 
 use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 
+use super::handles::HandleGeometry;
 use super::open_cabinet::{CabinetTarget, OpenCabinet};
 use crate::agents::mobile_panda::{mobile_robot_config, Variant};
 use crate::env::Env;
 use crate::error::EnvError;
 use crate::geometry::{wrap_angle, Pose3};
+use crate::scripted::oracle::{GRIPPER_CLOSED, GRIPPER_OPEN};
 use crate::scripted::{no_policy, ScriptedPolicy};
 
 /// The control modes the oracle drives: absolute arm joint targets, or (the tasks' default)
@@ -27,7 +31,14 @@ const ARM_VEL_GAIN: f32 = 10.0;
 /// Standoff (m) in front of the handle before going in.
 const STANDOFF: f32 = 0.12;
 /// How deep (m) the TCP goes past the handle's centre along the approach.
-const DEPTH: f32 = 0.005;
+const DEPTH: f32 = 0.0;
+/// Least clearance (m) per finger between the open fingers and the handle across the closing
+/// direction: the gripper opens only this much wider than a thin handle, so the fingers fit a
+/// recessed handle's slot (6 cm wide around a 1.4 cm bar on the procedural cabinets).
+const FINGER_CLEARANCE: f32 = 0.0035;
+/// Clearance per finger as a fraction of the handle's width, when more than
+/// [`FINGER_CLEARANCE`] (wide handles such as knobs get more room).
+const FINGER_CLEARANCE_FRACTION: f32 = 0.25;
 /// Largest TCP advance (m) per step while approaching.
 const MAX_STEP: f32 = 0.05;
 /// Opening advance per step: m for drawers, rad for doors.
@@ -53,6 +64,8 @@ pub struct OpenCabinetPolicy {
     steps: u32,
     /// The grasp orientation (link frame) chosen at the first step.
     grasp_in_link: Option<UnitQuaternion<f32>>,
+    /// The gripper action that opens the fingers around the handle (set with the grasp).
+    open_action: f32,
 }
 
 /// The cabinet oracle for `env` (an error in another control mode).
@@ -68,6 +81,7 @@ pub fn policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
         phase: Phase::Standoff,
         steps: 0,
         grasp_in_link: None,
+        open_action: 1.0,
     }))
 }
 
@@ -76,6 +90,7 @@ impl ScriptedPolicy for OpenCabinetPolicy {
         self.phase = Phase::Standoff;
         self.steps = 0;
         self.grasp_in_link = None;
+        self.open_action = 1.0;
     }
 
     fn act(&mut self, env: &Env) -> Vec<f32> {
@@ -93,18 +108,26 @@ impl OpenCabinetPolicy {
         let t = task.target_link();
         let link_pose = task.target_link_pose(world);
         let tcp = scene.agent.tcp_pose(world);
-        let grasp_in_link = *self.grasp_in_link.get_or_insert_with(|| {
-            // The grasp orientation nearer the hand's current one.
-            let hand = tcp.rotation;
-            *t.grasp_in_link
-                .iter()
-                .min_by(|a, b| {
-                    let da = hand.angle_to(&(link_pose.rotation * **a));
-                    let db = hand.angle_to(&(link_pose.rotation * **b));
-                    da.total_cmp(&db)
-                })
-                .expect("two grasps")
-        });
+        let grasp_in_link = match self.grasp_in_link {
+            Some(g) => g,
+            None => {
+                // The grasp orientation nearer the hand's current one.
+                let hand = tcp.rotation;
+                let g = *t
+                    .grasp_in_link
+                    .iter()
+                    .min_by(|a, b| {
+                        let da = hand.angle_to(&(link_pose.rotation * **a));
+                        let db = hand.angle_to(&(link_pose.rotation * **b));
+                        da.total_cmp(&db)
+                    })
+                    .expect("two grasps");
+                self.grasp_in_link = Some(g);
+                self.open_action = open_action(&t.handle, &g);
+                g
+            }
+        };
+        let open = self.open_action;
         let grasp_rot = link_pose.rotation * grasp_in_link;
         let approach = grasp_rot * Vector3::z();
         let handle = link_pose * t.handle.center();
@@ -125,7 +148,7 @@ impl OpenCabinetPolicy {
                 {
                     self.next(Phase::Approach);
                 }
-                (goal, 1.0)
+                (goal, open)
             }
             Phase::Approach => {
                 if (tcp.translation.vector - on_handle.translation.vector).norm() < 0.008
@@ -133,7 +156,7 @@ impl OpenCabinetPolicy {
                 {
                     self.next(Phase::Close);
                 }
-                (limited(&tcp, &on_handle), 1.0)
+                (limited(&tcp, &on_handle), open)
             }
             Phase::Close => {
                 if self.steps > 6 {
@@ -145,7 +168,7 @@ impl OpenCabinetPolicy {
                 if task.link_qpos(world) >= task.target_qpos + 0.01 * span(t.limits) {
                     self.next(Phase::Hold);
                 }
-                (pulled(task, world, &tcp), -1.0)
+                (pulled(task, world, &on_handle), -1.0)
             }
             Phase::Hold => (tcp, -1.0),
         };
@@ -209,6 +232,29 @@ impl OpenCabinetPolicy {
         action[11] = gripper;
         action
     }
+}
+
+/// The gripper action (normalised, ManiSkill2's [-1, 1] over [`GRIPPER_CLOSED`],
+/// [`GRIPPER_OPEN`] m per finger) that opens each finger a clearance ([`FINGER_CLEARANCE`],
+/// [`FINGER_CLEARANCE_FRACTION`]) beyond the half width of `handle` across the closing
+/// direction of `grasp_in_link` (at most fully open).
+fn open_action(handle: &HandleGeometry, grasp_in_link: &UnitQuaternion<f32>) -> f32 {
+    let closing = grasp_in_link * Vector3::y();
+    let (lo, hi) = handle
+        .points
+        .iter()
+        .map(|p| p.coords.dot(&closing))
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(s), hi.max(s))
+        });
+    let (closed, fully_open) = (GRIPPER_CLOSED as f32, GRIPPER_OPEN as f32);
+    let width = hi - lo;
+    let clearance = FINGER_CLEARANCE.max(FINGER_CLEARANCE_FRACTION * width);
+    let finger = (width / 2.0 + clearance).min(fully_open);
+    if !finger.is_finite() {
+        return 1.0;
+    }
+    2.0 * (finger - closed) / (fully_open - closed) - 1.0
 }
 
 /// The joint range (m or rad).
