@@ -148,6 +148,7 @@ fn scripted_oracle_opens_cabinets() {
 /// `base_pd_joint_vel_arm_pd_ee_delta_pose` and still opens the cabinet: the base's velocity
 /// actions are re-derived from the recorded base joints (the robot starts 1.6-1.8 m away, so
 /// nothing succeeds without the base following).
+#[cfg(feature = "demos")]
 #[test]
 fn oracle_episodes_convert_to_ee_delta_pose() {
     use ms2_tasks::demos::{replay_episode, scripted_episode, ReplayOptions};
