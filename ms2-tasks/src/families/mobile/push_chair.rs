@@ -17,11 +17,12 @@
 //! - Robot start: on a ring around the chair of radius U(0.8, 1.2) m, at angle
 //!   `chair_init_ori + π` ± 0.2π (behind the chair's back), facing the chair ± 0.05π; lift
 //!   0.9 m, arms at rest.
-//! - Joint dynamics per episode (drawn after the chair's pose): the seat swivel (the joint
-//!   whose parent link is a `helper`) gets drive damping U(5, 15) N·m·s/rad (stiffness 0), as
-//!   ManiSkill2 (its friction stays the model's 0.1 N·m); casters and wheels keep
-//!   the model's near-free dynamics (ManiSkill2's U(0, 0.5) damping would brake a 3 cm wheel
-//!   with up to 17 N at 1 m/s, see docs/assets.md).
+//! - Joint dynamics per episode (drawn after the chair's pose, in dof order), ManiSkill2's
+//!   drive damping (stiffness 0): the seat swivel (the joint whose parent link is a `helper`)
+//!   U(5, 15) N·m·s/rad, every other joint (casters, wheels) U(0, 0.5) N·m·s/rad, which brakes
+//!   the wheels (0.25 N·m·s/rad on a 3 cm wheel resists 0.1 m/s with 28 N, more than a
+//!   wheel's friction, about 10 N, can hold): the chair mostly slides, and stops when the push stops. Joint
+//!   friction stays the model's (ms2-physics sets it per articulation, not per episode).
 //! - Success: the chair's root within 0.15 m of the goal (xy), tilted less than 0.05π from
 //!   upright, static (root speed ≤ 0.1 m/s, angular speed ≤ 0.2 rad/s, from its velocities;
 //!   ManiSkill2 differences its pose over the control step).
@@ -382,9 +383,7 @@ impl Task for PushChair {
             turn * rest_rotation,
         );
         self.set_chair_pose(world, &pose, &qpos)?;
-        if let Some(dof) = self.swivel_dof {
-            draw_swivel_damping(world, self.chair(), dof, rng)?;
-        }
+        draw_joint_damping(world, self.chair(), self.swivel_dof, rng)?;
         Ok(())
     }
 
@@ -522,22 +521,30 @@ impl Task for PushChair {
     }
 }
 
-/// Per-episode drive damping of the seat swivel: U(5, 15) N·m·s/rad, stiffness 0 (ManiSkill2).
-fn draw_swivel_damping(
+/// Per-episode drive damping (stiffness 0) of the chair's own joints, in dof order
+/// (ManiSkill2's): the seat swivel (`swivel`) U(5, 15) N·m·s/rad, every other joint (casters,
+/// wheels) U(0, 0.5).
+fn draw_joint_damping(
     world: &mut dyn RigidWorld,
     art: ArticulationId,
-    dof: usize,
+    swivel: Option<usize>,
     rng: &mut EpisodeRng,
 ) -> Result<(), EnvError> {
-    let damping = rng.random_range(5.0..=15.0);
-    world.set_drive(
-        art,
-        dof,
-        DriveParams {
-            stiffness: 0.0,
-            damping,
-            force_limit: f32::MAX,
-        },
-    )?;
+    for dof in FLOATING_JOINTS.len()..world.dof(art)? {
+        let damping = if Some(dof) == swivel {
+            rng.random_range(5.0..=15.0)
+        } else {
+            rng.random_range(0.0..=0.5)
+        };
+        world.set_drive(
+            art,
+            dof,
+            DriveParams {
+                stiffness: 0.0,
+                damping,
+                force_limit: f32::MAX,
+            },
+        )?;
+    }
     Ok(())
 }
