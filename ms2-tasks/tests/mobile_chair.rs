@@ -1,5 +1,5 @@
 //! `PushChair-v1`: ManiSkill2's observation dims, the seeded reset distribution (chair around
-//! the goal facing it, the robot behind the chair's back), the chair rolling when the base
+//! the goal facing it, the robot behind the chair's back), the chair moving when the base
 //! drives into it (simulated), the success check on chairs put at the goal through the state
 //! vector (upright: success; tilted: none), and get/set_state round trips.
 
@@ -134,9 +134,10 @@ fn reset_distribution_is_maniskill2_and_seeded() {
     }
 }
 
-/// Drives the base forward (0.5 m/s, facing the chair) into the chair.
+/// Lowers the lift (the torso, the robot's colliding body, then spans the chair's back), then
+/// drives the base forward at 0.3 m/s (it faces the chair) into the chair.
 #[test]
-fn the_chair_rolls_when_the_base_drives_into_it() {
+fn the_chair_moves_when_the_base_drives_into_it() {
     let mut e = env("state", None);
     e.reset(Some(2), false).unwrap();
     let start = {
@@ -144,7 +145,19 @@ fn the_chair_rolls_when_the_base_drives_into_it() {
         task(&e).chair_pose(world).translation.vector
     };
     let mut a = vec![0.0_f32; e.action_space().low.len()];
-    a[0] = 1.0;
+    a[3] = -1.0;
+    for _ in 0..40 {
+        e.step(&a).unwrap();
+    }
+    let lowered = {
+        let world = e.task_scene().unwrap().world.as_ref();
+        task(&e).chair_pose(world).translation.vector
+    };
+    assert!(
+        (lowered - start).norm() < 1e-3,
+        "untouched while the lift goes down"
+    );
+    a[0] = 0.6;
     let mut pushed = None;
     for _ in 0..80 {
         let out = e.step(&a).unwrap();
@@ -258,4 +271,32 @@ fn get_and_set_state_round_trip() {
     // Stepping on reproduces the run.
     let replay = e.step(&a).unwrap().obs;
     assert_eq!(replay.as_f32().unwrap(), next.as_slice());
+}
+
+/// The scripted oracle (lift lowered, the torso pushing the chair's back along the line to the
+/// goal) succeeds on a few seeds (the 50-seed rates are in docs/tasks.md).
+#[test]
+fn scripted_oracle_pushes_the_chair_to_the_goal() {
+    let mut e = env("state", None);
+    let mut policy = ms2_tasks::make_scripted_policy(&e).unwrap();
+    let mut successes = 0;
+    for seed in 0..4 {
+        e.reset(Some(seed), false).unwrap();
+        policy.reset(&e);
+        for _ in 0..e.max_episode_steps() {
+            let out = e.step(&policy.act(&e)).unwrap();
+            if out.terminated {
+                successes += 1;
+                break;
+            }
+        }
+    }
+    assert!(successes >= 3, "{successes}/4 chairs at the goal");
+    // Another control mode than the oracle's is refused with a message naming its modes.
+    let other = env("state", Some("base_pd_joint_vel_arm_pd_ee_delta_pose"));
+    let err = ms2_tasks::make_scripted_policy(&other)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("base_pd_joint_vel_arm_pd_joint_pos"), "{err}");
 }

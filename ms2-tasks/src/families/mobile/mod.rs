@@ -6,6 +6,7 @@
 //! privileged `extra` entries, the static check, the spec defaults. [`handles`] reads handle
 //! geometry and visual names from a model's URDF. Each task is its hooks and spec.
 
+pub mod chair_oracle;
 pub mod common;
 pub mod handles;
 pub mod open_cabinet;
@@ -76,7 +77,8 @@ pub fn register(r: &mut Registrar) {
         })
         .scripted(scripted::policy),
     );
-    r.add(TaskRegistration::new(PUSH_CHAIR, |_| {
-        Ok(Box::new(PushChair::new()?))
-    }));
+    r.add(
+        TaskRegistration::new(PUSH_CHAIR, |_| Ok(Box::new(PushChair::new()?)))
+            .scripted(chair_oracle::policy),
+    );
 }
