@@ -27,8 +27,9 @@
 //!   upright, static (root speed ≤ 0.1 m/s, angular speed ≤ 0.2 rad/s, from its velocities;
 //!   ManiSkill2 differences its pose over the control step).
 //! - Dense reward (ManiSkill2's; `normalized_dense` = dense / 10): finger tips to the chair's
-//!   surface (512 samples per link), tilt, action norm, then the stages (standing, fingers
-//!   within 0.1 m, chair at the goal, static) with the chair's velocity towards the goal.
+//!   surface (512 samples per link), tilt, then the stages (standing, fingers
+//!   within 0.1 m, chair at the goal, static) with the chair's velocity towards the goal;
+//!   ManiSkill2's −1e-6 × ‖action‖ is left out (the task hooks do not see the action).
 //! - `extra` (state modes): `articulations` (13 + 2·25), `fingers_pos` (12), `fingers_vel`
 //!   (12): `state` is 131 floats in the default mode; visual modes: `left_tcp_pose`,
 //!   `right_tcp_pose`. Cameras 2 m above the base (ManiSkill2's `camera_h`), `render()` from
