@@ -113,6 +113,7 @@ PENALISED_REWARDS = {
     "PlugCharger-v0",
     "OpenCabinetDrawer-v1",
     "OpenCabinetDoor-v1",
+    "PushChair-v1",
 }
 
 

@@ -42,4 +42,13 @@ impl Evaluation {
             _ => None,
         }
     }
+
+    /// Looks up a real-valued term; `None` when absent or not a number.
+    pub fn number(&self, key: &str) -> Option<f64> {
+        match info_get(&self.terms, key) {
+            Some(InfoValue::F64(x)) => Some(x),
+            Some(InfoValue::I64(n)) => Some(n as f64),
+            _ => None,
+        }
+    }
 }

@@ -15,8 +15,9 @@ use ms2_physics::{ArticulationId, BodyId};
 use nalgebra::Vector3;
 use rand::Rng;
 
-use crate::agents::mobile_panda::MobilePandaAgent;
+use crate::agents::mobile_panda::{MobilePandaAgent, MOBILE_LIFT_START, PLANAR_BASE_DOF};
 use crate::error::EnvError;
+use crate::families::articulated::model::ModelSource;
 use crate::geometry::{pose_xyz_yaw, vectorize_pose, Pose3};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
@@ -78,16 +79,43 @@ impl BaseRing {
     }
 }
 
-/// Puts the scene's robot at `base` (x, y, yaw) with its MS1 start posture (lift 1e-4 m, arms
-/// at rest, no noise).
+/// Puts the scene's robot at `base` (x, y, yaw) with its MS1 start posture: the lift at `lift`
+/// m (ManiSkill2: 1e-4 for the cabinets, 0.9 for PushChair), arms at rest, no noise, at rest.
 pub fn place_robot(
     scene: &mut TaskScene,
     base: Pose3,
+    lift: f32,
     rng: &mut EpisodeRng,
 ) -> Result<(), EnvError> {
     let TaskScene { world, agent } = scene;
     agent.set_base_pose(base);
-    agent.initialize(world.as_mut(), rng)
+    agent.initialize(world.as_mut(), rng)?;
+    if lift != MOBILE_LIFT_START {
+        let mut q = agent.qpos(world.as_ref());
+        if let Some(h) = q.get_mut(PLANAR_BASE_DOF) {
+            *h = lift;
+        }
+        agent.set_joint_state(world.as_mut(), &q)?;
+    }
+    Ok(())
+}
+
+/// Where the MS1 models come from, read from the environment variable `var`: `train` (the
+/// default) or `test` for ms2's procedural models of that split, `partnet` for ManiSkill2's
+/// PartNet-Mobility models in the asset directory.
+pub fn model_source(var: &str) -> Result<ModelSource, EnvError> {
+    match std::env::var(var).ok().as_deref() {
+        None | Some("") | Some("train") => Ok(ModelSource::Procedural {
+            split: "train".into(),
+        }),
+        Some("test") => Ok(ModelSource::Procedural {
+            split: "test".into(),
+        }),
+        Some("partnet") => Ok(ModelSource::PartNet),
+        Some(other) => Err(EnvError::InvalidConfig(format!(
+            "{var}={other:?}: expected \"train\", \"test\" or \"partnet\""
+        ))),
+    }
 }
 
 /// ManiSkill2's actor state: position (3), quaternion wxyz (4), linear velocity (3), angular
@@ -103,17 +131,49 @@ pub fn actor_state(world: &dyn RigidWorld, body: BodyId) -> Result<[f32; 13], En
     Ok(s)
 }
 
-/// ManiSkill2's padded articulation state: the root link's actor state (13), then qpos and
-/// qvel each zero-padded to `max_dof` (13 + 2·`max_dof` values). Errors if the articulation has
-/// more dofs than `max_dof`.
+/// An articulation as ManiSkill2's MS1 observation sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ObservedArticulation {
+    /// The articulation.
+    pub art: ArticulationId,
+    /// Link index of the object's own root (0 for a fixed root; after the six dummy links of a
+    /// floating root, [`crate::families::articulated::floating`]).
+    pub root_link: usize,
+    /// The object's first own dof (0, or 6 after a floating root's dummy joints).
+    pub first_dof: usize,
+    /// Padding of qpos and qvel (ManiSkill2's `max_dof`).
+    pub max_dof: usize,
+}
+
+impl ObservedArticulation {
+    /// An articulation whose root is fixed: root link 0, every dof its own.
+    pub fn fixed(art: ArticulationId, max_dof: usize) -> Self {
+        Self {
+            art,
+            root_link: 0,
+            first_dof: 0,
+            max_dof,
+        }
+    }
+}
+
+/// ManiSkill2's padded articulation state: the root link's actor state (13), then the object's
+/// qpos and qvel each zero-padded to `max_dof` (13 + 2·`max_dof` values). Errors if the object
+/// has more dofs than `max_dof`.
 pub fn articulation_padded_state(
     world: &dyn RigidWorld,
-    art: ArticulationId,
-    max_dof: usize,
+    obs: &ObservedArticulation,
 ) -> Result<Vec<f32>, EnvError> {
-    let root = world.link_body(art, 0)?;
-    let qpos = world.qpos(art)?;
-    let qvel = world.qvel(art)?;
+    let ObservedArticulation {
+        art,
+        root_link,
+        first_dof,
+        max_dof,
+    } = *obs;
+    let root = world.link_body(art, root_link)?;
+    let own = |q: Vec<f32>| q.get(first_dof..).map(<[f32]>::to_vec).unwrap_or_default();
+    let qpos = own(world.qpos(art)?);
+    let qvel = own(world.qvel(art)?);
     if qpos.len() > max_dof {
         return Err(EnvError::InvalidConfig(format!(
             "articulation with {} dofs: expected at most {max_dof}",
@@ -131,12 +191,12 @@ pub fn articulation_padded_state(
 
 /// Appends ManiSkill2's MS1 privileged entries of `extra`, in its order: `actors` (the
 /// concatenated actor states of `actors`, when there are any), `articulations` (the padded
-/// states of `articulations`, each `(articulation, max_dof)`), `fingers_pos` (the finger tips,
-/// 3 per finger) and `fingers_vel` (the finger links' linear velocities, 3 per finger).
+/// states of `articulations`), `fingers_pos` (the finger tips, 3 per finger) and `fingers_vel`
+/// (the finger links' linear velocities, 3 per finger).
 pub fn push_privileged_extra(
     scene: &TaskScene,
     actors: &[BodyId],
-    articulations: &[(ArticulationId, usize)],
+    articulations: &[ObservedArticulation],
     extra: &mut DictBuilder,
 ) -> Result<(), EnvError> {
     let world = scene.world.as_ref();
@@ -148,8 +208,8 @@ pub fn push_privileged_extra(
         extra.push_vector("actors", &states);
     }
     let mut states = Vec::new();
-    for &(art, max_dof) in articulations {
-        states.extend(articulation_padded_state(world, art, max_dof)?);
+    for art in articulations {
+        states.extend(articulation_padded_state(world, art)?);
     }
     extra.push_vector("articulations", &states);
     let agent = mobile_agent(scene)?;

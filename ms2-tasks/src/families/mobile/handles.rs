@@ -1,5 +1,7 @@
-//! The handles of an articulated model: the visuals whose name contains `handle` (ManiSkill2's
-//! rule for cabinets), read from the model's URDF with their mesh vertices, in link frames.
+//! What ManiSkill2's MS1 tasks read from a model's visual names: the handles of an articulated
+//! model (the visuals whose name contains `handle`, ManiSkill2's rule for cabinets), read from
+//! the model's URDF with their mesh vertices in link frames, and every link's visual names
+//! (PushChair finds its wheels, seat and support by them).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -86,6 +88,26 @@ pub fn read_handles(urdf: &Path, scale: f32) -> Result<BTreeMap<String, HandleGe
         }
     }
     Ok(handles)
+}
+
+/// The visual names of every link of the model `urdf`, by link name (links without a named
+/// visual map to an empty list). Errors name the file.
+pub fn link_visual_names(urdf: &Path) -> Result<BTreeMap<String, Vec<String>>, EnvError> {
+    let bad = |what: String| EnvError::Asset(format!("{}: {what}", urdf.display()));
+    let text = std::fs::read_to_string(urdf).map_err(|e| bad(e.to_string()))?;
+    let doc = roxmltree::Document::parse(&text).map_err(|e| bad(e.to_string()))?;
+    Ok(doc
+        .descendants()
+        .filter(|n| n.has_tag_name("link"))
+        .map(|link| {
+            let names = link
+                .children()
+                .filter(|n| n.has_tag_name("visual"))
+                .filter_map(|v| v.attribute("name").map(str::to_owned))
+                .collect();
+            (link.attribute("name").unwrap_or_default().to_owned(), names)
+        })
+        .collect())
 }
 
 fn triple(s: &str) -> Result<[f32; 3], String> {

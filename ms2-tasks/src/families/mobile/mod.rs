@@ -1,18 +1,24 @@
 //! Mobile manipulation (ManiSkill2's MS1 tasks) on the mobile Pandas
-//! ([`crate::agents::mobile_panda`]): `OpenCabinetDrawer-v1`, `OpenCabinetDoor-v1`.
+//! ([`crate::agents::mobile_panda`]): `OpenCabinetDrawer-v1`, `OpenCabinetDoor-v1`
+//! ([`open_cabinet`]), `PushChair-v1` ([`push_chair`]).
 //!
 //! [`common`] is the family's shared base: the robot's start on a ring around the object, the
 //! privileged `extra` entries, the static check, the spec defaults. [`handles`] reads handle
-//! geometry from a model's URDF. Each task is its hooks and spec.
+//! geometry and visual names from a model's URDF. Each task is its hooks and spec.
 
+pub mod chair_oracle;
 pub mod common;
 pub mod handles;
 pub mod open_cabinet;
+pub mod push_chair;
 pub mod scripted;
 
 pub use open_cabinet::{CabinetTarget, OpenCabinet};
+pub use push_chair::PushChair;
 
-use common::{MS1_CONTROL_MODE, MS1_MAX_EPISODE_STEPS, MS1_OBS_MODES, SINGLE_ARM_ROBOTS};
+use common::{
+    DUAL_ARM_ROBOTS, MS1_CONTROL_MODE, MS1_MAX_EPISODE_STEPS, MS1_OBS_MODES, SINGLE_ARM_ROBOTS,
+};
 
 use crate::registry::{Registrar, TaskRegistration};
 use crate::spec::TaskSpec;
@@ -48,6 +54,15 @@ pub const OPEN_CABINET_DOOR: TaskSpec = TaskSpec {
     ..OPEN_CABINET_DRAWER
 };
 
+/// `PushChair-v1`'s spec.
+pub const PUSH_CHAIR: TaskSpec = TaskSpec {
+    env_id: "PushChair-v1",
+    summary: "push a swivel chair to the goal at the origin with a two-arm mobile Panda",
+    robots: DUAL_ARM_ROBOTS,
+    non_privileged_extra_keys: &["left_tcp_pose", "right_tcp_pose"],
+    ..OPEN_CABINET_DRAWER
+};
+
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
     r.add(
@@ -61,5 +76,9 @@ pub fn register(r: &mut Registrar) {
             Ok(Box::new(OpenCabinet::new(CabinetTarget::Door)?))
         })
         .scripted(scripted::policy),
+    );
+    r.add(
+        TaskRegistration::new(PUSH_CHAIR, |_| Ok(Box::new(PushChair::new()?)))
+            .scripted(chair_oracle::policy),
     );
 }

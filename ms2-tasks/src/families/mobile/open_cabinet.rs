@@ -30,9 +30,11 @@ use nalgebra::{Matrix3, Point3, Rotation3, UnitQuaternion, Vector3};
 use rand::Rng;
 
 use super::common::{
-    body_is_static, body_speeds, mobile_agent, place_robot, push_privileged_extra, BaseRing,
+    body_is_static, body_speeds, mobile_agent, model_source, place_robot, push_privileged_extra,
+    BaseRing, ObservedArticulation,
 };
 use super::handles::{read_handles, HandleGeometry};
+use crate::agents::mobile_panda::MOBILE_LIFT_START;
 use crate::error::EnvError;
 use crate::families::articulated::common::{
     add_articulated_object, joint_axis_world, JointDynamics,
@@ -85,18 +87,7 @@ impl CabinetTarget {
 
 /// Where the cabinet models come from, from [`CABINET_MODELS_ENV`].
 pub fn cabinet_source() -> Result<ModelSource, EnvError> {
-    match std::env::var(CABINET_MODELS_ENV).ok().as_deref() {
-        None | Some("") | Some("train") => Ok(ModelSource::Procedural {
-            split: "train".into(),
-        }),
-        Some("test") => Ok(ModelSource::Procedural {
-            split: "test".into(),
-        }),
-        Some("partnet") => Ok(ModelSource::PartNet),
-        Some(other) => Err(EnvError::InvalidConfig(format!(
-            "{CABINET_MODELS_ENV}={other:?}: expected \"train\", \"test\" or \"partnet\""
-        ))),
-    }
+    model_source(CABINET_MODELS_ENV)
 }
 
 /// A drawer or door with a handle.
@@ -448,7 +439,7 @@ impl Task for OpenCabinet {
             angle: [0.9 * PI, 1.1 * PI],
         };
         let base = ring.sample(rng);
-        place_robot(scene, base, rng)
+        place_robot(scene, base, MOBILE_LIFT_START, rng)
     }
 
     fn initialize_task(&mut self, scene: &TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
@@ -471,7 +462,12 @@ impl Task for OpenCabinet {
         };
         // An error here means a robot other than the mobile Panda: the task refuses it when
         // the env is made (its spec lists the mobile Panda only).
-        let _ = push_privileged_extra(scene, &[], &[(art, MAX_DOF)], extra);
+        let _ = push_privileged_extra(
+            scene,
+            &[],
+            &[ObservedArticulation::fixed(art, MAX_DOF)],
+            extra,
+        );
         let mut indicator = [0.0_f32; MAX_DOF];
         if let Some(t) = self.targets.get(self.target) {
             indicator[t.dof] = 1.0;
