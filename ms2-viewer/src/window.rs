@@ -291,7 +291,14 @@ impl Viewer {
         match event {
             WindowEvent::CloseRequested | WindowEvent::Destroyed => self.closed = true,
             WindowEvent::ModifiersChanged(m) => self.modifiers = m.state(),
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+            // Synthetic presses are winit's replay, on focus-in, of keys it believes held
+            // (X11, Windows): not a press the user made, so a key that acts once (save, reset,
+            // quit) would act twice.
+            WindowEvent::KeyboardInput {
+                event,
+                is_synthetic: false,
+                ..
+            } if event.state == ElementState::Pressed => {
                 if let Some(name) = key_name(&event.logical_key) {
                     self.press_key_inner(&name, event.repeat);
                 }
