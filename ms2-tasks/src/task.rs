@@ -34,6 +34,25 @@ pub struct TaskScene {
     pub agent: Box<dyn Agent>,
 }
 
+impl TaskScene {
+    /// Every dynamic body of the world that is not one of the robot's links (the task's free
+    /// objects, and the links of other articulations), in creation order.
+    pub fn free_dynamic_bodies(&self) -> Vec<ms2_physics::BodyId> {
+        let world = self.world.as_ref();
+        let robot = self.agent.articulation();
+        let links = world.link_names(robot).map_or(0, |names| names.len());
+        let robot_links: Vec<_> = (0..links)
+            .filter_map(|i| world.link_body(robot, i).ok())
+            .collect();
+        world
+            .bodies()
+            .into_iter()
+            .filter(|b| !robot_links.contains(b))
+            .filter(|&b| matches!(world.body_kind(b), Ok(ms2_physics::BodyKind::Dynamic)))
+            .collect()
+    }
+}
+
 impl std::fmt::Debug for TaskScene {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("TaskScene")

@@ -248,16 +248,9 @@ impl ObjectFollowing {
 fn approach_correction(target: &TaskScene, source: &TaskScene) -> Option<Option<Isometry3<f64>>> {
     let (wt, ws) = (target.world.as_ref(), source.world.as_ref());
     let tcp: Isometry3<f64> = source.agent.tcp_pose(ws).cast();
-    let robot = source.agent.articulation();
-    let links = ws.link_names(robot).map_or(0, |names| names.len());
-    let robot_links: Vec<BodyId> = (0..links)
-        .filter_map(|i| ws.link_body(robot, i).ok())
-        .collect();
-    let Some((_, body, x_s, x_t)) = ws
-        .bodies()
+    let Some((_, body, x_s, x_t)) = source
+        .free_dynamic_bodies()
         .into_iter()
-        .filter(|b| !robot_links.contains(b))
-        .filter(|&b| matches!(ws.body_kind(b), Ok(BodyKind::Dynamic)))
         .filter_map(|b| {
             let x_s: Isometry3<f64> = ws.body_pose(b).ok()?.cast();
             let x_t: Isometry3<f64> = wt.body_pose(b).ok()?.cast();

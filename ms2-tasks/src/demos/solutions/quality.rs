@@ -11,7 +11,7 @@
 //! it. Measured on PickSingleYCB-v0 (seeds 0-199, conversion to `pd_ee_delta_pose`): most
 //! failed conversions had a source that did one or the other.
 
-use ms2_physics::{BodyId, BodyKind};
+use ms2_physics::BodyId;
 use nalgebra::Isometry3;
 
 use super::gripper_closings;
@@ -134,16 +134,9 @@ fn free_object_poses(
         return Ok(Vec::new());
     };
     let world = scene.world.as_ref();
-    let robot = scene.agent.articulation();
-    let links = world.link_names(robot).map_or(0, |names| names.len());
-    let robot_links: Vec<BodyId> = (0..links)
-        .filter_map(|i| world.link_body(robot, i).ok())
-        .collect();
-    Ok(world
-        .bodies()
+    Ok(scene
+        .free_dynamic_bodies()
         .into_iter()
-        .filter(|b| !robot_links.contains(b))
-        .filter(|&b| matches!(world.body_kind(b), Ok(BodyKind::Dynamic)))
         .filter_map(|b| Some((b, world.body_pose(b).ok()?.cast())))
         .collect())
 }
