@@ -31,6 +31,29 @@ pub enum ModelSource {
     PartNet,
 }
 
+impl ModelSource {
+    /// The source named by the environment variable `var`: `train` (the default, also when
+    /// unset or empty) or `test` for ms2's procedural models of that split, `partnet` for
+    /// ManiSkill2's PartNet-Mobility models in the asset directory.
+    ///
+    /// # Errors
+    /// [`EnvError::InvalidConfig`] naming the variable and its value for anything else.
+    pub fn from_env(var: &str) -> Result<Self, EnvError> {
+        match std::env::var(var).ok().as_deref() {
+            None | Some("") | Some("train") => Ok(Self::Procedural {
+                split: "train".into(),
+            }),
+            Some("test") => Ok(Self::Procedural {
+                split: "test".into(),
+            }),
+            Some("partnet") => Ok(Self::PartNet),
+            Some(other) => Err(EnvError::InvalidConfig(format!(
+                "{var}={other:?}: expected \"train\", \"test\" or \"partnet\""
+            ))),
+        }
+    }
+}
+
 /// A set of models of one category: their dataset folder and info entries.
 #[derive(Clone, Debug)]
 pub struct ModelSet {
@@ -131,4 +154,40 @@ pub fn load_model(
         .unwrap_or_else(|e| e.into_inner())
         .insert(key, desc.clone());
     Ok(desc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn model_source_is_read_from_its_variable_and_bad_values_are_named() {
+        // One variable per case: tests run in parallel threads of one process.
+        assert_eq!(
+            ModelSource::from_env("MS2_TEST_MODELS_UNSET").unwrap(),
+            ModelSource::Procedural {
+                split: "train".into()
+            }
+        );
+        std::env::set_var("MS2_TEST_MODELS_TEST", "test");
+        assert_eq!(
+            ModelSource::from_env("MS2_TEST_MODELS_TEST").unwrap(),
+            ModelSource::Procedural {
+                split: "test".into()
+            }
+        );
+        std::env::set_var("MS2_TEST_MODELS_PARTNET", "partnet");
+        assert_eq!(
+            ModelSource::from_env("MS2_TEST_MODELS_PARTNET").unwrap(),
+            ModelSource::PartNet
+        );
+        std::env::set_var("MS2_TEST_MODELS_BAD", "validation");
+        let err = ModelSource::from_env("MS2_TEST_MODELS_BAD")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("MS2_TEST_MODELS_BAD") && err.contains("validation"),
+            "{err}"
+        );
+    }
 }

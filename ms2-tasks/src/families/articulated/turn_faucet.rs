@@ -52,22 +52,6 @@ pub const ROBOT_BASE: [f32; 3] = [-0.56, 0.0, 0.0];
 /// Surface points sampled per link for the distance term.
 pub const SURFACE_POINTS: usize = 256;
 
-/// Where the faucet models come from, from [`FAUCET_MODELS_ENV`].
-pub fn faucet_source() -> Result<ModelSource, EnvError> {
-    match std::env::var(FAUCET_MODELS_ENV).ok().as_deref() {
-        None | Some("") | Some("train") => Ok(ModelSource::Procedural {
-            split: "train".into(),
-        }),
-        Some("test") => Ok(ModelSource::Procedural {
-            split: "test".into(),
-        }),
-        Some("partnet") => Ok(ModelSource::PartNet),
-        Some(other) => Err(EnvError::InvalidConfig(format!(
-            "{FAUCET_MODELS_ENV}={other:?}: expected \"train\", \"test\" or \"partnet\""
-        ))),
-    }
-}
-
 /// A handle that can be turned: its link, the dof of its joint and the joint's limits.
 #[derive(Debug, Clone)]
 pub struct Switch {
@@ -112,7 +96,11 @@ pub struct TurnFaucet {
 impl TurnFaucet {
     /// The task over the models chosen by [`FAUCET_MODELS_ENV`] in the asset directory.
     pub fn new() -> Result<Self, EnvError> {
-        let models = ModelSet::open(&ms2_assets::asset_dir(), "faucet", &faucet_source()?)?;
+        let models = ModelSet::open(
+            &ms2_assets::asset_dir(),
+            "faucet",
+            &ModelSource::from_env(FAUCET_MODELS_ENV)?,
+        )?;
         Ok(Self::with_models(models))
     }
 

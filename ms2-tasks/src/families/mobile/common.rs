@@ -17,7 +17,6 @@ use rand::Rng;
 
 use crate::agents::mobile_panda::{MobilePandaAgent, MOBILE_LIFT_START, PLANAR_BASE_DOF};
 use crate::error::EnvError;
-use crate::families::articulated::model::ModelSource;
 use crate::geometry::{pose_xyz_yaw, vectorize_pose, Pose3};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
@@ -98,24 +97,6 @@ pub fn place_robot(
         agent.set_joint_state(world.as_mut(), &q)?;
     }
     Ok(())
-}
-
-/// Where the MS1 models come from, read from the environment variable `var`: `train` (the
-/// default) or `test` for ms2's procedural models of that split, `partnet` for ManiSkill2's
-/// PartNet-Mobility models in the asset directory.
-pub fn model_source(var: &str) -> Result<ModelSource, EnvError> {
-    match std::env::var(var).ok().as_deref() {
-        None | Some("") | Some("train") => Ok(ModelSource::Procedural {
-            split: "train".into(),
-        }),
-        Some("test") => Ok(ModelSource::Procedural {
-            split: "test".into(),
-        }),
-        Some("partnet") => Ok(ModelSource::PartNet),
-        Some(other) => Err(EnvError::InvalidConfig(format!(
-            "{var}={other:?}: expected \"train\", \"test\" or \"partnet\""
-        ))),
-    }
 }
 
 /// ManiSkill2's actor state: position (3), quaternion wxyz (4), linear velocity (3), angular

@@ -30,8 +30,8 @@ use nalgebra::{Matrix3, Point3, Rotation3, UnitQuaternion, Vector3};
 use rand::Rng;
 
 use super::common::{
-    body_is_static, body_speeds, mobile_agent, model_source, place_robot, push_privileged_extra,
-    BaseRing, ObservedArticulation,
+    body_is_static, body_speeds, mobile_agent, place_robot, push_privileged_extra, BaseRing,
+    ObservedArticulation,
 };
 use super::handles::{read_handles, HandleGeometry};
 use crate::agents::mobile_panda::MOBILE_LIFT_START;
@@ -87,7 +87,7 @@ impl CabinetTarget {
 
 /// Where the cabinet models come from, from [`CABINET_MODELS_ENV`].
 pub fn cabinet_source() -> Result<ModelSource, EnvError> {
-    model_source(CABINET_MODELS_ENV)
+    ModelSource::from_env(CABINET_MODELS_ENV)
 }
 
 /// A drawer or door with a handle.

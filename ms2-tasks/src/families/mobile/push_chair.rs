@@ -42,8 +42,7 @@ use nalgebra::{Point3, UnitQuaternion, Vector2, Vector3};
 use rand::Rng;
 
 use super::common::{
-    body_speeds, mobile_agent, model_source, place_robot, push_privileged_extra, BaseRing,
-    ObservedArticulation,
+    body_speeds, mobile_agent, place_robot, push_privileged_extra, BaseRing, ObservedArticulation,
 };
 use super::handles::link_visual_names;
 use crate::error::EnvError;
@@ -112,7 +111,7 @@ pub struct PushChair {
 impl PushChair {
     /// The task over the models chosen by [`CHAIR_MODELS_ENV`] in the asset directory.
     pub fn new() -> Result<Self, EnvError> {
-        let source = model_source(CHAIR_MODELS_ENV)?;
+        let source = ModelSource::from_env(CHAIR_MODELS_ENV)?;
         let models = ModelSet::open(&ms2_assets::asset_dir(), "chair", &source)?;
         Ok(Self::with_models(models, source == ModelSource::PartNet))
     }
