@@ -117,6 +117,14 @@ impl ObsValue {
         Some(node)
     }
 
+    /// The leaf array, or `None` for a dict.
+    pub fn as_array(&self) -> Option<&Array> {
+        match self {
+            ObsValue::Array(a) => Some(a),
+            ObsValue::Dict(_) => None,
+        }
+    }
+
     /// The float32 elements of a leaf array, or `None` for dicts and other element types.
     pub fn as_f32(&self) -> Option<&[f32]> {
         match self {

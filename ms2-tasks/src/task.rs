@@ -24,7 +24,7 @@ use crate::obs::{DictBuilder, ObsValue};
 use crate::particles::ParticleVisual;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
-use crate::sensors::CameraConfig;
+use crate::sensors::{CameraConfig, GoalMarker};
 
 /// What a task's hooks see: the rigid world (through the port) and the robot.
 pub struct TaskScene {
@@ -35,15 +35,30 @@ pub struct TaskScene {
 }
 
 impl TaskScene {
+    /// The bodies of the robot's links, in link order.
+    pub fn robot_link_bodies(&self) -> Vec<ms2_physics::BodyId> {
+        let world = self.world.as_ref();
+        let robot = self.agent.articulation();
+        let links = world.link_names(robot).map_or(0, |names| names.len());
+        (0..links)
+            .filter_map(|i| world.link_body(robot, i).ok())
+            .collect()
+    }
+
+    /// Whether any robot link pushed on `body` in the last physics step (a nonzero contact
+    /// impulse between them).
+    pub fn robot_touches(&self, body: ms2_physics::BodyId) -> bool {
+        let world = self.world.as_ref();
+        self.robot_link_bodies()
+            .into_iter()
+            .any(|link| world.contact_impulse_between(link, body) != nalgebra::Vector3::zeros())
+    }
+
     /// Every dynamic body of the world that is not one of the robot's links (the task's free
     /// objects, and the links of other articulations), in creation order.
     pub fn free_dynamic_bodies(&self) -> Vec<ms2_physics::BodyId> {
         let world = self.world.as_ref();
-        let robot = self.agent.articulation();
-        let links = world.link_names(robot).map_or(0, |names| names.len());
-        let robot_links: Vec<_> = (0..links)
-            .filter_map(|i| world.link_body(robot, i).ok())
-            .collect();
+        let robot_links = self.robot_link_bodies();
         world
             .bodies()
             .into_iter()
@@ -183,6 +198,12 @@ pub trait Task: Any + Send {
     /// of the task. `render_camera_cfgs` updates the result. Default: the robot's.
     fn render_camera(&self, robot_default: CameraConfig) -> CameraConfig {
         robot_default
+    }
+
+    /// The goal marker of human renders for a goal that is not an observed `extra` entry (the
+    /// spec's `goal_marker` names an observed one, drawn as [`GoalMarker::at`]). Default: none.
+    fn goal_marker(&self, _scene: &TaskScene) -> Option<GoalMarker> {
+        None
     }
 }
 

@@ -23,7 +23,7 @@ use crate::seeding::{episode_rng, EpisodeRng};
 #[cfg(feature = "render")]
 use crate::sensors::CameraConfig;
 #[cfg(feature = "render")]
-use crate::sensors::{CameraFrame, Sensors};
+use crate::sensors::{CameraFrame, GoalMarker, Sensors};
 use crate::spaces::BoxSpace;
 use crate::spec::TaskSpec;
 use crate::task::{Task, TaskScene};
@@ -195,14 +195,17 @@ impl TaskEnv {
         root.build()
     }
 
-    /// The goal marker's position (m, world): the `extra` entry `goal_key` of the state.
+    /// The goal marker of human renders: at the `extra` entry `goal_key` of the state when the
+    /// spec names one, else the task's own ([`Task::goal_marker`]).
     #[cfg(feature = "render")]
-    fn goal_position(&self, goal_key: Option<&str>) -> Option<nalgebra::Vector3<f32>> {
-        let state = goal_key.map(|_| self.observe_state_dict());
-        goal_key
-            .zip(state.as_ref())
-            .and_then(|(key, state)| state.get(&format!("extra/{key}")))
+    fn goal_marker(&self, goal_key: Option<&str>) -> Option<GoalMarker> {
+        let Some(key) = goal_key else {
+            return self.task.goal_marker(&self.scene);
+        };
+        self.observe_state_dict()
+            .get(&format!("extra/{key}"))
             .and_then(|g| g.as_f32().map(|v| nalgebra::Vector3::new(v[0], v[1], v[2])))
+            .map(GoalMarker::at)
     }
 
     /// Runs `f` on the env's sensors (built on first use) and world.
@@ -466,7 +469,7 @@ impl EnvBackend for TaskEnv {
 
     #[cfg(feature = "render")]
     fn render_human(&self, goal_key: Option<&str>) -> Result<ms2_render::CameraOutput, EnvError> {
-        let goal = self.goal_position(goal_key);
+        let goal = self.goal_marker(goal_key);
         self.with_sensors(|sensors, world| sensors.render_human(world, goal))
     }
 
@@ -476,7 +479,7 @@ impl EnvBackend for TaskEnv {
         goal_key: Option<&str>,
         f: &mut dyn FnMut(&crate::sensors::SceneView<'_>),
     ) -> Result<(), EnvError> {
-        let goal = self.goal_position(goal_key);
+        let goal = self.goal_marker(goal_key);
         self.with_sensors(|sensors, world| sensors.with_view(world, goal, f))
     }
 

@@ -300,3 +300,58 @@ fn scripted_oracle_pushes_the_chair_to_the_goal() {
         .to_string();
     assert!(err.contains("base_pd_joint_vel_arm_pd_joint_pos"), "{err}");
 }
+
+/// `render()` looks down on the goal from 4 m and marks it with ManiSkill2's red 15 cm sphere,
+/// centred in the image (the goal is the origin, right below the camera); the observation
+/// cameras never see the marker.
+#[cfg(feature = "render")]
+#[test]
+fn render_marks_the_goal_with_a_red_sphere_at_the_centre() {
+    use ms2_tasks::ArrayData;
+    let mut e = make_env(&EnvConfig {
+        obs_mode: "rgbd".to_owned(),
+        render_mode: Some("rgb_array".to_owned()),
+        ..EnvConfig::new(ID)
+    })
+    .unwrap();
+    let (obs, _) = e.reset(Some(0), false).unwrap();
+    let frame = e.render().unwrap();
+    let (h, w) = (frame.shape[0], frame.shape[1]);
+    let ArrayData::U8(rgb) = &frame.data else {
+        panic!("render() is u8 rgb")
+    };
+    let red = |p: &[u8]| p[0] > 150 && p[1] < 40 && p[2] < 40;
+    let (mut count, mut sum_x, mut sum_y) = (0usize, 0.0f64, 0.0f64);
+    for (i, p) in rgb.chunks_exact(3).enumerate() {
+        if red(p) {
+            count += 1;
+            sum_x += (i % w) as f64;
+            sum_y += (i / w) as f64;
+        }
+    }
+    // A 0.15 m sphere 4 m away with ManiSkill2's 1 rad field of view covers a disc of about
+    // 17.6 px radius (~970 px) at 512 × 512.
+    assert!((600..1400).contains(&count), "{count} red pixels");
+    let (cx, cy) = (sum_x / count as f64, sum_y / count as f64);
+    assert!(
+        (cx - w as f64 / 2.0).abs() < 3.0 && (cy - h as f64 / 2.0).abs() < 3.0,
+        "marker centred at ({cx:.1}, {cy:.1})"
+    );
+    for cam in [
+        "overhead_camera_0",
+        "overhead_camera_1",
+        "overhead_camera_2",
+    ] {
+        let image = obs
+            .get(&format!("image/{cam}/rgb"))
+            .and_then(ObsValue::as_array);
+        let Some(ArrayData::U8(img)) = image.map(|a| &a.data) else {
+            panic!("no u8 image/{cam}/rgb")
+        };
+        assert_eq!(
+            img.chunks_exact(3).filter(|p| red(p)).count(),
+            0,
+            "{cam} sees the marker"
+        );
+    }
+}

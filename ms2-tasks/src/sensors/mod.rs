@@ -37,3 +37,28 @@ pub use crate::adapters::ParticleVisual;
 
 /// Radius (m) of the goal marker sphere of human renders (ManiSkill2: the goal threshold).
 pub const GOAL_MARKER_RADIUS_M: f32 = 0.025;
+
+/// A sphere drawn at a task's goal in human renders (`render()`, the viewer) and never in
+/// observations: from the spec's `goal_marker` entry of `extra`
+/// ([`GoalMarker::at`]), or from the task's [`crate::task::Task::goal_marker`] hook for goals
+/// that are not observed (PushChair's target, ManiSkill2's red 15 cm sphere).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GoalMarker {
+    /// Centre (m, world frame).
+    pub position_world: nalgebra::Vector3<f32>,
+    /// Radius (m).
+    pub radius_m: f32,
+    /// Linear RGB colour, each channel in `[0, 1]`.
+    pub rgb: [f32; 3],
+}
+
+impl GoalMarker {
+    /// The default marker: green, [`GOAL_MARKER_RADIUS_M`], at `position_world` (m).
+    pub fn at(position_world: nalgebra::Vector3<f32>) -> Self {
+        Self {
+            position_world,
+            radius_m: GOAL_MARKER_RADIUS_M,
+            rgb: [0.0, 1.0, 0.0],
+        }
+    }
+}

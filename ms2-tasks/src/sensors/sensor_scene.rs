@@ -9,7 +9,7 @@ use ms2_render::{
 };
 use nalgebra::{Isometry3, Vector3};
 
-use super::{particle_culling, CameraConfig, CameraFrame, GOAL_MARKER_RADIUS_M};
+use super::{particle_culling, CameraConfig, CameraFrame, GoalMarker, GOAL_MARKER_RADIUS_M};
 use crate::adapters::render_scene::render_err;
 use crate::adapters::{ParticleVisual, RenderContext, WorldRenderScene};
 use crate::error::EnvError;
@@ -213,34 +213,35 @@ impl Sensors {
         }
     }
 
-    /// Shows the goal marker at `goal_world` (m, world frame) when given; callers hide it again
-    /// after drawing, so observation cameras never see it.
-    fn show_goal_marker(&mut self, goal_world: Option<Vector3<f32>>) -> Result<(), EnvError> {
-        let Some(goal) = goal_world else {
+    /// Shows `marker` when given (its pose, size and colour); callers hide it again after
+    /// drawing, so observation cameras never see it.
+    fn show_goal_marker(&mut self, marker: Option<GoalMarker>) -> Result<(), EnvError> {
+        let Some(marker) = marker else {
             return Ok(());
         };
-        let scene = self.scene.scene_mut();
-        scene
-            .set_pose(
-                self.goal_marker,
-                Isometry3::translation(goal.x, goal.y, goal.z),
-            )
+        let goal = marker.position_world;
+        let instance = self
+            .scene
+            .scene_mut()
+            .instance_mut(self.goal_marker)
             .map_err(render_err)?;
-        scene
-            .set_visible(self.goal_marker, true)
-            .map_err(render_err)
+        instance.pose_world_from_mesh = Isometry3::translation(goal.x, goal.y, goal.z);
+        instance.scale = Vector3::repeat(marker.radius_m);
+        instance.material = Material::color(marker.rgb[0], marker.rgb[1], marker.rgb[2]);
+        instance.visible = true;
+        Ok(())
     }
 
-    /// Renders the human view (render camera) with the goal marker at `goal_world` (m) when
+    /// Renders the human view (render camera) with `goal_marker` when
     /// given; the marker is hidden again afterwards, so observation cameras never see it.
     pub fn render_human(
         &mut self,
         world: &dyn RigidWorld,
-        goal_world: Option<Vector3<f32>>,
+        goal_marker: Option<GoalMarker>,
     ) -> Result<CameraOutput, EnvError> {
         self.scene.sync_poses(world)?;
         let camera = self.render_camera.camera_at(world, self.robot)?;
-        self.show_goal_marker(goal_world)?;
+        self.show_goal_marker(goal_marker)?;
         let result = self
             .ctx
             .renderer()
@@ -255,17 +256,17 @@ impl Sensors {
             .ok_or_else(|| EnvError::Render("the renderer returned no image".to_owned()))
     }
 
-    /// Calls `f` with the scene synchronised with `world`, the goal marker shown at
-    /// `goal_world` (m) when given (hidden again afterwards), and the cameras at their poses.
+    /// Calls `f` with the scene synchronised with `world`, `goal_marker` shown
+    /// when given (hidden again afterwards), and the cameras at their poses.
     pub fn with_view<R>(
         &mut self,
         world: &dyn RigidWorld,
-        goal_world: Option<Vector3<f32>>,
+        goal_marker: Option<GoalMarker>,
         f: impl FnOnce(&SceneView<'_>) -> R,
     ) -> Result<R, EnvError> {
         let cams = self.prepare(world)?;
         let render_camera = self.render_camera.camera_at(world, self.robot)?;
-        self.show_goal_marker(goal_world)?;
+        self.show_goal_marker(goal_marker)?;
         let view = SceneView {
             renderer: self.ctx.renderer(),
             scene: self.scene.scene(),

@@ -33,7 +33,7 @@
 //! - `extra` (state modes): `articulations` (13 + 2·25), `fingers_pos` (12), `fingers_vel`
 //!   (12): `state` is 131 floats in the default mode; visual modes: `left_tcp_pose`,
 //!   `right_tcp_pose`. Cameras 2 m above the base (ManiSkill2's `camera_h`), `render()` from
-//!   4 m straight above the goal.
+//!   4 m straight above the goal, which it marks with a red 15 cm sphere.
 
 use std::f32::consts::PI;
 
@@ -54,7 +54,7 @@ use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
-use crate::sensors::{CameraConfig, CameraMount};
+use crate::sensors::{CameraConfig, CameraMount, GoalMarker};
 use crate::task::{Task, TaskScene};
 
 /// Environment variable choosing the chair models: `train` (default), `test` or `partnet`.
@@ -75,6 +75,10 @@ pub const WHEEL_FRICTION: f32 = 1.0;
 pub const LINK_SAMPLES: usize = 512;
 /// Goal of the chair's root (m, world xy).
 pub const TARGET_XY: [f32; 2] = [0.0, 0.0];
+
+/// Radius (m) of the goal marker of human renders (ManiSkill2's target indicator; the success
+/// threshold is 0.15 m too).
+pub const GOAL_MARKER_RADIUS_M: f32 = 0.15;
 /// Success distance (m, xy).
 pub const SUCCESS_DISTANCE: f32 = 0.15;
 /// Largest tilt (rad) of a standing chair.
@@ -518,6 +522,16 @@ impl Task for PushChair {
             ),
         };
         camera
+    }
+
+    /// ManiSkill2's target indicator: a red sphere of radius [`GOAL_MARKER_RADIUS_M`] centred
+    /// on the goal at ground height.
+    fn goal_marker(&self, _scene: &TaskScene) -> Option<GoalMarker> {
+        Some(GoalMarker {
+            position_world: Vector3::new(self.target_xy[0], self.target_xy[1], 0.0),
+            radius_m: GOAL_MARKER_RADIUS_M,
+            rgb: [1.0, 0.0, 0.0],
+        })
     }
 }
 
