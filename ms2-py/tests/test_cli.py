@@ -82,3 +82,21 @@ def test_bench_visual_smoke():
         assert float(fields[-8]) > 0 and float(fields[-4]) > 10 and int(fields[-2]) > 100
     # MB per extra env: only for the vector env (the single env is the baseline).
     assert rows[0].split()[-3] == "-" and float(rows[1].split()[-3]) > -1000, out
+
+
+def test_bench_of_a_mobile_task_uses_its_base_control_mode():
+    # The Panda modes (pd_ee_delta_pose, pd_joint_delta_pos) do not exist on the mobile robots:
+    # without --control-modes the task's default mode is benchmarked, with no ManiSkill2 ratio.
+    out = subprocess.run(
+        [sys.executable, "-m", "ms2", "bench", "--steps", "10", "--num-envs", ""]
+        + ["--env-id", "OpenCabinetDrawer-v1"],
+        check=True,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    ).stdout
+    rows = [line for line in out.splitlines() if line.startswith("base_pd_joint_vel_arm")]
+    assert len(rows) == 1 and "gym.make (1 env)" in rows[0], out
+    # ... steps/s, x our single, x MS2 single, peak RSS MB, load
+    fields = rows[0].split()
+    assert float(fields[-5]) > 0 and fields[-3] == "-", out

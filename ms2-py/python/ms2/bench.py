@@ -226,6 +226,24 @@ def _soak(args: argparse.Namespace) -> int:
     return 0 if total["non_finite"] == 0 and total["errors"] == 0 else 1
 
 
+def _task_spec(env_id: str) -> dict:
+    """The registered spec of ``env_id`` (a ``ValueError`` naming the valid ids otherwise)."""
+    from . import _native
+
+    specs = {s["env_id"]: s for s in _native.task_specs()}
+    if env_id not in specs:
+        raise ValueError(f"unknown env id {env_id!r}; valid: {sorted(specs)}")
+    return specs[env_id]
+
+
+def _default_control_modes(env_id: str) -> str:
+    """The control modes benchmarked when none are given: ``pd_ee_delta_pose`` and
+    ``pd_joint_delta_pos`` (the visual rows take ``pd_joint_delta_pos``), or the task's default
+    mode for the mobile robots, which have neither (``base_pd_joint_vel_arm_pd_joint_vel``)."""
+    default = _task_spec(env_id)["default_control_mode"]
+    return default if default.startswith("base_") else "pd_ee_delta_pose,pd_joint_delta_pos"
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     if args.worker:
         return _worker(args)
@@ -235,7 +253,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     if args.visual:
         return _bench_visual(args, num_envs_list)
     steps = args.steps or 4000
-    given = args.control_modes or "pd_ee_delta_pose,pd_joint_delta_pos"
+    given = args.control_modes or _default_control_modes(args.env_id)
     control_modes = [m for m in given.split(",") if m]
     from . import _native
 
@@ -244,8 +262,9 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         f"control, {os.cpu_count()} cores, vector pool {_native.num_threads()} threads, "
         f"{steps} env steps per row"
     )
+    mode_width = max([20, *(len(m) for m in control_modes)])
     header = (
-        f"{'control_mode':<20} {'runner':<18} {'steps/s':>9} {'x our single':>12} "
+        f"{'control_mode':<{mode_width}} {'runner':<18} {'steps/s':>9} {'x our single':>12} "
         f"{'x MS2 single':>12} {'peak RSS MB':>11} {'load':>5}"
     )
     print(header)
@@ -255,7 +274,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         peer = MANISKILL2_SINGLE_STEPS_PER_S.get(spec["control_mode"])
         vs_peer = f"{result['steps_per_s'] / peer:.2f}" if peer else "-"
         return (
-            f"{spec['control_mode']:<20} {_runner_name(spec['kind'], spec['num_envs']):<18} "
+            f"{spec['control_mode']:<{mode_width}} "
+            f"{_runner_name(spec['kind'], spec['num_envs']):<18} "
             f"{result['steps_per_s']:>9.0f} {result['steps_per_s'] / single:>12.2f} "
             f"{vs_peer:>12} {result['peak_rss_mb']:>11.0f}"
         )
@@ -286,11 +306,18 @@ def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
     soft = any(s["env_id"] == args.env_id and s["soft_bodies"] for s in _native.task_specs())
     steps = args.steps or (200 if soft else 1000)
     obs_modes = [m for m in args.obs_modes.split(",") if m]
-    control_mode = (args.control_modes or "pd_joint_delta_pos").split(",")[0]
+    mobile = _task_spec(args.env_id)["default_control_mode"].startswith("base_")
+    # The first mode given, else the last default (pd_joint_delta_pos, or the mobile default).
+    given = args.control_modes or _default_control_modes(args.env_id).split(",")[-1]
+    control_mode = given.split(",")[0]
     if args.policy == "scripted" and num_envs_list:
         print("(--policy scripted drives single envs only: make_vec rows skipped)")
         num_envs_list = []
+    # ManiSkill2's visual figure is PickCube's (two cameras); the mobile tasks have three
+    # cameras and no recorded ManiSkill2 figure.
     peer = MANISKILL2_SOFT_RENDER_STEPS_PER_S if soft else MANISKILL2_VISUAL_STEPS_PER_S
+    if mobile and not soft:
+        peer = None
     print(
         f"ms2 bench --visual: {args.env_id}, {control_mode}, {args.policy} actions, 500 Hz "
         f"physics / 20 Hz control, cameras base_camera + hand_camera 128x128, "
@@ -307,13 +334,14 @@ def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
     def visual_row(spec: dict, result: dict, single: float) -> str:
         # Measured in this run when --peer-python is given, else the recorded figure.
         reference = result.get("peer_steps_per_s", peer)
+        vs_peer = "-" if reference is None else f"{result['steps_per_s'] / reference:.2f}"
         extra = result.get("mb_per_extra_env")
         triangles = result["triangles_per_camera"]
         return (
             f"{spec['obs_mode']:<11} {_runner_name(spec['kind'], spec['num_envs']):<18} "
             f"{result['steps_per_s']:>9.1f} {result['cpu_ms_per_step']:>11.1f} "
             f"{result['steps_per_s'] / single:>12.2f} "
-            f"{result['steps_per_s'] / reference:>12.2f} "
+            f"{vs_peer:>12} "
             f"{result['peak_rss_mb']:>11.0f} {'-' if extra is None else f'{extra:.0f}':>12} "
             f"{'-' if triangles is None else triangles:>13}"
         )
@@ -330,6 +358,8 @@ def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
             f"ManiSkill2 paper: soft-body envs with rendering ~{peer:.1f} steps/s single env on "
             f"an RTX Titan GPU (MPM on the GPU); ms2 runs MPM and rendering on the CPU cores above"
         )
+    elif mobile and not peer_python:
+        print("ManiSkill2 0.5.3: no figure recorded for the mobile tasks (three cameras)")
     elif not peer_python:
         print(
             f"ManiSkill2 0.5.3 on this machine (single env, lavapipe, same cameras), recorded "
@@ -390,8 +420,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--control-modes",
         default=None,
-        help="comma-separated (None: pd_ee_delta_pose,pd_joint_delta_pos; --visual: the first "
-        "one given, else pd_joint_delta_pos)",
+        help="comma-separated (None: pd_ee_delta_pose,pd_joint_delta_pos, or the task's default "
+        "mode on the mobile robots; --visual: the first one given, else pd_joint_delta_pos or the "
+        "mobile default)",
     )
     p.add_argument(
         "--policy",
