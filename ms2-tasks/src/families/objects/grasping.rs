@@ -245,8 +245,9 @@ pub struct PoseOptions {
     pub ground_clearance: f64,
     /// The gripper's fingertips.
     pub fingertips: Fingertips,
-    /// Weight (1/m) of the contact line's horizontal distance from the centre of mass in the
-    /// score (rad-equivalent per metre).
+    /// Weight (1/m) in the score (rad-equivalent per metre) of the centre of mass's offset
+    /// from the contact line: its horizontal distance from the line (gravity's lever arm about
+    /// the line, about which two pads hold least) plus a quarter of its distance along it.
     pub com_weight: f64,
 }
 
@@ -303,7 +304,7 @@ impl PoseOptions {
 }
 
 /// TCP poses (base frame) realising `grasps` on the object at `site`, best first: the approach
-/// closest to straight down, the line closest to the centre of mass, the hand turned least
+/// closest to straight down, the line passing closest to the centre of mass, the hand turned least
 /// from `tcp_now`, the tightest cone. The
 /// fingertips are kept off the ground ([`PoseOptions::min_pad_depth`]).
 pub fn grasp_poses(
@@ -328,7 +329,12 @@ pub fn grasp_poses(
             }
         }
         let base_approach = base_approach.normalize();
-        let off_com = (centre.coords - site.com).xy().norm();
+        // The centre of mass's horizontal offset from the closing line: gravity's lever arm
+        // about the line, about which two pads hold least (a quarter of the offset along the
+        // line counts too).
+        let to_com = site.com - centre.coords;
+        let along = to_com.dot(&line);
+        let off_com = (to_com - line * along).xy().norm() + 0.25 * along.abs();
         for &turn in options.approach_turns {
             let approach =
                 UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_normalize(line), turn)
@@ -546,5 +552,33 @@ mod tests {
         assert!((best.translation.vector - Vector3::new(0.5, 0.1, 0.02)).norm() < 1e-9);
         assert_eq!(poses[0].kind, GraspKind::TopDown);
         assert_eq!(poses.last().unwrap().kind, GraspKind::Side);
+    }
+
+    #[test]
+    fn a_line_through_the_centre_of_mass_ranks_above_one_beside_it() {
+        // Two contact lines centred 4 cm from the centre of mass, horizontal: one pointing
+        // at it (gravity has no lever arm about it), one across (a 4 cm lever arm).
+        let line = |closing: Vector3<f64>| AntipodalGrasp {
+            centre: Vector3::new(0.04, 0.0, 0.05),
+            closing,
+            width: 0.03,
+            cone_angle: 0.1,
+        };
+        let grasps = [line(Vector3::y()), line(Vector3::x())];
+        let site = GraspSite {
+            pose_base_from_object: Isometry3::translation(0.5, 0.0, 0.0),
+            com: Vector3::new(0.5, 0.0, 0.05),
+            ground_z: 0.0,
+        };
+        let tcp_now = Isometry3::translation(0.5, 0.0, 0.3);
+        let options = PoseOptions {
+            approach_turns: &[0.0],
+            ..DEFAULT_POSE_OPTIONS
+        };
+        let poses = grasp_poses(&grasps, &site, &tcp_now, &options);
+        assert_eq!(poses.len(), 4, "two lines, two hand orientations each");
+        // The best pose closes along x (its y axis, the closing axis, is ±x).
+        let closing = poses[0].pose_base_from_tcp.rotation * Vector3::y();
+        assert!(closing.x.abs() > 0.99, "{closing:?}");
     }
 }
