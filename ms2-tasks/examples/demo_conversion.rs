@@ -17,9 +17,10 @@
 //! Episodes run in parallel on rayon's pool (`RAYON_NUM_THREADS`); times are CPU-seconds per
 //! episode summed over threads divided by the episode count.
 
+use std::collections::BTreeMap;
 use std::time::Instant;
 
-use ms2_tasks::demos::solutions::{gripper_closings, solution_env_ids, solve_episode};
+use ms2_tasks::demos::solutions::{gripper_closings, solution_env_ids, Cleanliness, DemoSolver};
 use ms2_tasks::demos::{replay_episode, scripted_episode, DemoEpisode, DemoError, ReplayOptions};
 use ms2_tasks::{EnvConfig, InfoValue};
 use rayon::prelude::*;
@@ -72,22 +73,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let n = seeds.len() as u64;
     let start = Instant::now();
-    let sources: Vec<Result<DemoEpisode, DemoError>> = seeds
+    let sources: Vec<Result<(DemoEpisode, Option<Cleanliness>), DemoError>> = seeds
         .into_par_iter()
         .map(|seed| {
             if use_solution {
-                solve_episode(&cfg, seed)
+                let solved = DemoSolver::new(&cfg)?.solve_ranked(seed)?;
+                Ok((solved.episode, solved.cleanliness))
             } else {
-                scripted_episode(&cfg, seed)
+                scripted_episode(&cfg, seed).map(|ep| (ep, None))
             }
         })
         .collect();
     let source_secs = start.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
-    let sources: Vec<DemoEpisode> = sources
+    let (sources, ranks): (Vec<DemoEpisode>, Vec<Option<Cleanliness>>) = sources
         .into_iter()
         .filter_map(Result::ok)
-        .filter(DemoEpisode::succeeded)
-        .collect();
+        .filter(|(ep, _)| ep.succeeded())
+        .unzip();
     println!(
         "{env_id}: {} of {n} source episodes ({}) succeeded; {:.3} s per source episode \
          ({} threads)",
@@ -121,7 +123,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut over_limit = 0;
         let mut steps = 0usize;
         let mut failed_seeds = Vec::new();
-        for (ep, r) in sources.iter().zip(&results) {
+        // Conversions (succeeded, tried) per source rank.
+        let mut by_rank: BTreeMap<Cleanliness, (usize, usize)> = BTreeMap::new();
+        for ((ep, r), rank) in sources.iter().zip(&results).zip(&ranks) {
+            let converted = matches!(r, Ok(r) if r.episode.succeeded());
+            if let Some(rank) = rank {
+                let entry = by_rank.entry(*rank).or_default();
+                entry.0 += usize::from(converted);
+                entry.1 += 1;
+            }
             match r {
                 Ok(r) if r.episode.succeeded() => {
                     ok += 1;
@@ -159,6 +169,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             steps as f64 / src_steps.max(1) as f64,
             failed_seeds
         );
+        if !by_rank.is_empty() {
+            let table: Vec<String> = by_rank
+                .iter()
+                .rev()
+                .map(|(rank, (ok, n))| format!("{rank:?} {ok}/{n}"))
+                .collect();
+            println!("     by source rank (Cleanliness): {}", table.join(", "));
+        }
     }
     Ok(())
 }

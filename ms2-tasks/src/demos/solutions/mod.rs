@@ -66,6 +66,18 @@ pub trait Solution: Sync {
     }
 }
 
+/// One episode solved by [`DemoSolver::solve_ranked`].
+#[derive(Debug, Clone)]
+pub struct SolvedEpisode {
+    /// The kept plan's episode (successful or not).
+    pub episode: DemoEpisode,
+    /// Time spent on every plan made for it.
+    pub timings: SolveTimings,
+    /// The kept plan's rank, for successful episodes of solutions that
+    /// [prefer clean grasps](Solution::prefers_single_grasp); `None` otherwise.
+    pub cleanliness: Option<Cleanliness>,
+}
+
 /// Plans per episode when a solution [prefers clean grasps](Solution::prefers_single_grasp).
 pub const SINGLE_GRASP_PLANS: u64 = 3;
 
@@ -206,12 +218,25 @@ impl DemoSolver {
     /// # Errors
     /// [`DemoError::Planning`] if a planning query fails, [`DemoError::Env`] if the env fails.
     pub fn solve(&mut self, seed: u64) -> Result<(DemoEpisode, SolveTimings), DemoError> {
-        let first = self.solve_with(seed, seed)?;
-        if !self.solution.prefers_single_grasp() || !first.0.succeeded() {
-            return Ok(first);
+        self.solve_ranked(seed).map(|s| (s.episode, s.timings))
+    }
+
+    /// [`DemoSolver::solve`], also returning the kept plan's [`Cleanliness`] (for solutions
+    /// that [prefer clean grasps](Solution::prefers_single_grasp) and succeeded).
+    ///
+    /// # Errors
+    /// As [`DemoSolver::solve`].
+    pub fn solve_ranked(&mut self, seed: u64) -> Result<SolvedEpisode, DemoError> {
+        let (first, first_timings) = self.solve_with(seed, seed)?;
+        if !self.solution.prefers_single_grasp() || !first.succeeded() {
+            return Ok(SolvedEpisode {
+                episode: first,
+                timings: first_timings,
+                cleanliness: None,
+            });
         }
-        let mut rank = Cleanliness::of(&mut self.env, &first.0)?;
-        let (mut best, mut timings) = first;
+        let mut rank = Cleanliness::of(&mut self.env, &first)?;
+        let (mut best, mut timings) = (first, first_timings);
         for k in 1..SINGLE_GRASP_PLANS {
             if rank == Cleanliness::Clean {
                 break;
@@ -230,7 +255,11 @@ impl DemoSolver {
                 (best, rank) = (episode, r);
             }
         }
-        Ok((best, timings))
+        Ok(SolvedEpisode {
+            episode: best,
+            timings,
+            cleanliness: Some(rank),
+        })
     }
 
     /// One plan of episode `seed` with the planners seeded by `planning_seed`.
