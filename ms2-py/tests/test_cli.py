@@ -34,27 +34,22 @@ def test_run_random_and_bad_env(capsys):
     assert MAIN_ID in capsys.readouterr().err
 
 
-def test_python_dash_m_and_bench_smoke():
-    out = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "ms2",
-            "bench",
-            "--steps",
-            "40",
-            "--num-envs",
-            "2",
-            "--env-id",
-            MAIN_ID,
-            "--control-modes",
-            "pd_joint_delta_pos",
-        ],
+def _bench_stdout(*args: str) -> str:
+    """The stdout of ``python -m ms2 bench *args`` (which must exit 0)."""
+    return subprocess.run(
+        [sys.executable, "-m", "ms2", "bench", *args],
         check=True,
         capture_output=True,
         text=True,
         timeout=300,
     ).stdout
+
+
+def test_python_dash_m_and_bench_smoke():
+    out = _bench_stdout(
+        "--steps", "40", "--num-envs", "2", "--env-id", MAIN_ID,
+        "--control-modes", "pd_joint_delta_pos",
+    )  # fmt: skip
     rows = [line for line in out.splitlines() if line.startswith("pd_joint_delta_pos")]
     assert len(rows) == 2, out
     assert "make_vec(2)" in rows[1]
@@ -65,14 +60,10 @@ def test_python_dash_m_and_bench_smoke():
 
 
 def test_bench_visual_smoke():
-    out = subprocess.run(
-        [sys.executable, "-m", "ms2", "bench", "--visual", "--steps", "10", "--num-envs", "2"]
-        + ["--obs-modes", "rgbd", "--env-id", "PickCube-v0"],
-        check=True,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    ).stdout
+    out = _bench_stdout(
+        "--visual", "--steps", "10", "--num-envs", "2", "--obs-modes", "rgbd",
+        "--env-id", "PickCube-v0",
+    )  # fmt: skip
     rows = [line for line in out.splitlines() if line.startswith("rgbd")]
     assert len(rows) == 2 and "make_vec(2)" in rows[1], out
     for row in rows:
@@ -87,14 +78,7 @@ def test_bench_visual_smoke():
 def test_bench_of_a_mobile_task_uses_its_base_control_mode():
     # The Panda modes (pd_ee_delta_pose, pd_joint_delta_pos) do not exist on the mobile robots:
     # without --control-modes the task's default mode is benchmarked, with no ManiSkill2 ratio.
-    out = subprocess.run(
-        [sys.executable, "-m", "ms2", "bench", "--steps", "10", "--num-envs", ""]
-        + ["--env-id", "OpenCabinetDrawer-v1"],
-        check=True,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    ).stdout
+    out = _bench_stdout("--steps", "10", "--num-envs", "", "--env-id", "OpenCabinetDrawer-v1")
     rows = [line for line in out.splitlines() if line.startswith("base_pd_joint_vel_arm")]
     assert len(rows) == 1 and "gym.make (1 env)" in rows[0], out
     # ... steps/s, x our single, x MS2 single, peak RSS MB, load
