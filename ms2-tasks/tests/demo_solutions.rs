@@ -389,3 +389,42 @@ fn conversion_approaches_the_object_where_the_source_hand_was_relative_to_it() {
         );
     }
 }
+
+#[test]
+fn conversion_carries_the_centre_of_mass_where_the_source_held_a_turned_object() {
+    // A source whose recorded cube, once the grasp settled, sits turned by 0.5 rad in the hand
+    // and 1 cm further along x (as a bowl that swung about its rim grasp): beyond the
+    // orientation the in-hand correction takes over (0.2 rad), the converted hand still
+    // carries its cube's centre of mass to the source's, 1 cm along x from where the hand
+    // path alone leaves it.
+    let cfg = EnvConfig::new("PickCube-v0");
+    let source = solve_episode(&cfg, 3).unwrap();
+    let settled = first_close(&source) + ms2_tasks::demos::solutions::quality::GRASP_SETTLE_STEPS;
+    let turn = nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), 0.5);
+    let mut turned = with_cube_moved(&source, settled..source.env_states.len(), 0.01);
+    for state in &mut turned.env_states[settled..] {
+        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            state[3], state[4], state[5], state[6],
+        ));
+        let q = turn * q;
+        state[3..7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+    }
+    let mut final_cube_x = Vec::new();
+    for track_hand_only in [false, true] {
+        let opts = ReplayOptions {
+            target_control_mode: Some("pd_ee_delta_pose".to_owned()),
+            track_hand_only,
+            ..ReplayOptions::default()
+        };
+        let converted = replay_episode(&cfg, &turned, &opts).unwrap().episode;
+        assert!(converted.succeeded(), "track_hand_only {track_hand_only}");
+        final_cube_x.push(converted.env_states.last().unwrap()[0]);
+    }
+    let source_x = source.env_states.last().unwrap()[0];
+    let (corrected, hand_path) = (final_cube_x[0] - source_x, final_cube_x[1] - source_x);
+    assert!(
+        (corrected - 0.01).abs() < 0.003 && hand_path.abs() < 0.003,
+        "the converted cube ended {corrected} m (corrected) and {hand_path} m (hand path) \
+         along x from the source's"
+    );
+}

@@ -21,7 +21,10 @@
 //!   fingers, the source's fingers still squeezing): the two in-hand transforms
 //!   `H = X_tcp⁻¹ · X_object` are compared and the TCP shifted by `C = H_source · H_target⁻¹`
 //!   (TCP frame): the target hand goes where it must for *its* object to take the source's
-//!   object's pose.
+//!   object's pose. When the two objects sit in the hands turned by more than
+//!   [`MAX_CORRECTION_RAD`] from each other (a bowl that swung about its rim grasp), the
+//!   source's orientation is out of reach and the hand is shifted so that the object's centre
+//!   of mass takes the source's position (what the pick tasks' success measures).
 //!
 //! Differences larger than these corrections are for ([`MAX_APPROACH_M`], [`MAX_CORRECTION_M`],
 //! [`MAX_CORRECTION_RAD`]) are left alone: the runs are then not doing the same thing, and
@@ -45,7 +48,8 @@ use crate::task::TaskScene;
 /// 2026-11-25: PickSingleYCB 174/185 conversions, 175/185 with 3.5 cm).
 pub const MAX_CORRECTION_M: f64 = 0.035;
 
-/// Largest in-hand rotation (rad) that is corrected.
+/// Largest in-hand rotation (rad) that is corrected; beyond it only the centre of mass's
+/// position is.
 pub const MAX_CORRECTION_RAD: f64 = 0.2;
 
 /// Largest distance (m) from the source's TCP to an object's centre of mass for the approach
@@ -156,10 +160,20 @@ impl ObjectFollowing {
                 ) else {
                     return Ok(Correction::None);
                 };
-                let c = h_source * h_target.inverse();
-                if c.translation.vector.norm() > MAX_CORRECTION_M
-                    || c.rotation.angle() > MAX_CORRECTION_RAD
-                {
+                let mut c = h_source * h_target.inverse();
+                if c.rotation.angle() > MAX_CORRECTION_RAD {
+                    // Held otherwise than the source's (a bowl swung about its rim grasp): the
+                    // orientation cannot be taken over, but the centre of mass's position,
+                    // which the pick tasks' success measures, can.
+                    let (Some(com_target), Some(com_source)) = (
+                        com_in_hand(scene, object),
+                        com_in_hand(source_scene, object),
+                    ) else {
+                        return Ok(Correction::None);
+                    };
+                    c = Translation3::from(com_source - com_target).into();
+                }
+                if c.translation.vector.norm() > MAX_CORRECTION_M {
                     return Ok(Correction::None);
                 }
                 Ok(if self.move_tcp(desired, |tcp| tcp * c) {
@@ -292,6 +306,14 @@ fn held_object(scene: &TaskScene) -> Option<BodyId> {
         matches!(world.body_kind(b), Ok(BodyKind::Dynamic))
             && scene.agent.is_grasping(world, b, GRASP_MAX_ANGLE_DEG)
     })
+}
+
+/// The centre of mass of `object` in the TCP frame of `scene`'s robot (m).
+fn com_in_hand(scene: &TaskScene, object: BodyId) -> Option<nalgebra::Vector3<f64>> {
+    let world = scene.world.as_ref();
+    let tcp: Isometry3<f64> = scene.agent.tcp_pose(world).cast();
+    let com: nalgebra::Point3<f64> = world.body_center_of_mass(object).ok()?.cast();
+    Some((tcp.inverse() * com).coords)
 }
 
 /// `X_tcp⁻¹ · X_object` in `scene` (f64).
