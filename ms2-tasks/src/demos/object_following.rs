@@ -24,7 +24,8 @@
 //!   object's pose. When the two objects sit in the hands turned by more than
 //!   [`MAX_CORRECTION_RAD`] from each other (a bowl that swung about its rim grasp), the
 //!   source's orientation is out of reach and the hand is shifted so that the object's centre
-//!   of mass takes the source's position (what the pick tasks' success measures).
+//!   of mass takes the source's position (what the pick tasks' success measures), unless the
+//!   object touches anything but the robot (a kit piece turned by its slot's walls).
 //!
 //! Differences larger than these corrections are for ([`MAX_APPROACH_M`], [`MAX_CORRECTION_M`],
 //! [`MAX_CORRECTION_RAD`]) are left alone: the runs are then not doing the same thing, and
@@ -164,7 +165,13 @@ impl ObjectFollowing {
                 if c.rotation.angle() > MAX_CORRECTION_RAD {
                     // Held otherwise than the source's (a bowl swung about its rim grasp): the
                     // orientation cannot be taken over, but the centre of mass's position,
-                    // which the pick tasks' success measures, can.
+                    // which the pick tasks' success measures, can, while the object hangs in
+                    // the hand. Not while it touches anything else (a kit piece pressed into
+                    // its slot, turned there by the slot's walls): shifting it would push it
+                    // out.
+                    if touches_other_than_robot(scene, object) {
+                        return Ok(Correction::None);
+                    }
                     let (Some(com_target), Some(com_source)) = (
                         com_in_hand(scene, object),
                         com_in_hand(source_scene, object),
@@ -306,6 +313,18 @@ fn held_object(scene: &TaskScene) -> Option<BodyId> {
         matches!(world.body_kind(b), Ok(BodyKind::Dynamic))
             && scene.agent.is_grasping(world, b, GRASP_MAX_ANGLE_DEG)
     })
+}
+
+/// Whether `object` pushed on any body but the robot's links in the last physics step (the
+/// ground, a fixture, another object).
+fn touches_other_than_robot(scene: &TaskScene, object: BodyId) -> bool {
+    let world = scene.world.as_ref();
+    let robot = scene.robot_link_bodies();
+    world
+        .bodies()
+        .into_iter()
+        .filter(|b| *b != object && !robot.contains(b))
+        .any(|b| world.contact_impulse_between(object, b) != nalgebra::Vector3::zeros())
 }
 
 /// The centre of mass of `object` in the TCP frame of `scene`'s robot (m).
