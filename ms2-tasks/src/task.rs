@@ -45,15 +45,6 @@ impl TaskScene {
             .collect()
     }
 
-    /// Whether any robot link pushed on `body` in the last physics step (a nonzero contact
-    /// impulse between them).
-    pub fn robot_touches(&self, body: ms2_physics::BodyId) -> bool {
-        let world = self.world.as_ref();
-        self.robot_link_bodies()
-            .into_iter()
-            .any(|link| world.contact_impulse_between(link, body) != nalgebra::Vector3::zeros())
-    }
-
     /// Every dynamic body of the world that is not one of the robot's links (the task's free
     /// objects, and the links of other articulations), in creation order.
     pub fn free_dynamic_bodies(&self) -> Vec<ms2_physics::BodyId> {
