@@ -4,8 +4,12 @@
 //!
 //! [`common`] is the family's shared base: the robot's start on a ring around the object, the
 //! privileged `extra` entries, the static check, the spec defaults. [`handles`] reads handle
-//! geometry and visual names from a model's URDF. Each task is its hooks and spec.
+//! geometry and visual names from a model's URDF; [`surface`] samples an object's links for
+//! the rewards' distance terms. Each task is its hooks and spec; MoveBucket's reward is
+//! [`bucket_reward`]. The scripted oracles: [`scripted`] (cabinets), [`chair_oracle`],
+//! [`bucket_oracle`].
 
+pub mod bucket_oracle;
 pub mod bucket_reward;
 pub mod chair_oracle;
 pub mod common;
@@ -93,7 +97,8 @@ pub fn register(r: &mut Registrar) {
         TaskRegistration::new(PUSH_CHAIR, |_| Ok(Box::new(PushChair::new()?)))
             .scripted(chair_oracle::policy),
     );
-    r.add(TaskRegistration::new(MOVE_BUCKET, |_| {
-        Ok(Box::new(MoveBucket::new()?))
-    }));
+    r.add(
+        TaskRegistration::new(MOVE_BUCKET, |_| Ok(Box::new(MoveBucket::new()?)))
+            .scripted(bucket_oracle::policy),
+    );
 }

@@ -6,8 +6,8 @@
 //!   info's `scale` (1 without one), links of 1000 kg/m³, friction 0.5, no self-collision; one
 //!   model drawn per episode (the scene is rebuilt at every reset). The root is free
 //!   ([`crate::families::articulated::floating`]). The first movable joint (the handle) has its
-//!   range narrowed by 10 % at each end and starts at the narrowed lower limit; its parent link
-//!   is the bucket's body ([`MoveBucket::body_link`]).
+//!   range narrowed by 10 % of its span at each end and starts at the narrowed lower limit;
+//!   its parent link is the bucket's body ([`MoveBucket::body_link`]).
 //! - Platform: a static 0.6 × 0.6 × 0.2 m box centred on the origin (top at z = 0.1 m),
 //!   friction 0.5. Goal: (0, 0) m, fixed.
 //! - Ball: one dynamic sphere of radius 0.05 m, 1000 kg/m³, friction 0.5.
@@ -23,6 +23,7 @@
 //!   ≤ 0.1 m/s, angular speed ≤ 0.2 rad/s, from its velocities; ManiSkill2 differences its pose
 //!   over the control step).
 //! - Dense reward: ManiSkill2's ([`super::bucket_reward`]); `normalized_dense` = dense / 20.
+//! - Scripted oracle: [`super::bucket_oracle`].
 //! - `extra` (state modes): `actors` (the ball, 13), `articulations` (13 + 2·2), `fingers_pos`
 //!   (12), `fingers_vel` (12): `state` is 98 floats in the default mode; visual modes:
 //!   `left_tcp_pose`, `right_tcp_pose`. `render()` from 4 m above the goal, looking down.
