@@ -14,7 +14,8 @@
 //! 3. `Descend`: the hands down onto the rim (IK over the arms, the base held).
 //! 4. `Close`: the grippers close.
 //! 5. `Lift`: the arms keep their joints; the lift rises by [`LIFT_RAISE`].
-//! 6. `Carry`: the base drives (same yaw) so that the bucket's root goes over the goal.
+//! 6. `Carry`: the base drives (same yaw, speeding up gently) so that the bucket's root stops
+//!    [`CARRY_SHORT`] before the goal.
 //! 7. `Lower`: the lift goes down until the bucket stands on the platform; then `Hold`.
 //!
 //! A grasp that slips while lifting or carrying (the bucket lags the lift by over
@@ -55,7 +56,7 @@ const LEFT_AZIMUTHS: [f32; 4] = [75.0 * DEG, 105.0 * DEG, -75.0 * DEG, -105.0 * 
 const DEG: f32 = std::f32::consts::PI / 180.0;
 /// How far (m) the hands press inwards once the fingers are closed: the arms squeeze the
 /// bucket between the outer fingers, adding to the grippers' pinch.
-pub const SQUEEZE: f32 = 0.015;
+pub const SQUEEZE: f32 = 0.025;
 /// Largest base speed (m/s) while carrying.
 const CARRY_SPEED: f32 = 0.3;
 /// Environment variable that makes the oracle print its phase changes to stderr.
@@ -68,12 +69,22 @@ pub const DROP_MARGIN: f32 = 0.05;
 const MAX_TILT_COS: f32 = 0.94;
 /// Steps of letting go (gripper open, hands up) after a slipping grasp.
 const RELEASE_STEPS: u32 = 8;
-/// Distance (m) of the bucket's root to the goal at which the carry ends.
+/// Distance (m) short of the goal at which the carry stops the bucket's root (the bucket,
+/// radius ≤ 0.17 m, still stands wholly on the platform, half size 0.3 m).
+pub const CARRY_SHORT: f32 = 0.1;
+/// Distance (m) of the bucket's root to its carry stop at which the carry ends.
 const LOWER_DISTANCE: f32 = 0.05;
+/// Speed-up (m/s per control step) at the start of the carry.
+const CARRY_ACCELERATION: f32 = 0.02;
 /// Largest base speed (m/s) otherwise.
-const MOVE_SPEED: f32 = 0.3;
+const MOVE_SPEED: f32 = 0.4;
 /// Position gain (1/s) of the base's and the lift's velocity commands.
 const BASE_GAIN: f32 = 3.0;
+/// Largest change (rad) of an arm joint's target per control step: the arms move no faster
+/// than a converted `pd_ee_delta_pose` episode can follow (0.1 m, 0.1 rad per step).
+pub const MAX_JOINT_STEP: f32 = 0.1;
+/// Largest arm joint error (rad) of settled arms.
+const SETTLED_JOINTS: f32 = 0.05;
 /// Gain (1/s) of the arms' joint velocity commands in `pd_joint_vel`.
 const ARM_VEL_GAIN: f32 = 10.0;
 /// Largest lift speed command (m/s).
@@ -113,8 +124,10 @@ pub struct MoveBucketPolicy {
     steps: u32,
     /// Base yaw (rad, world) of the grasp.
     yaw: Option<f32>,
-    /// Arm joint targets (action order: left, right).
+    /// Arm joint targets commanded (action order: left, right).
     arm_targets: [Option<[f32; 7]>; 2],
+    /// The last IK solutions (the next solve's seeds).
+    ik_solutions: [Option<[f32; 7]>; 2],
     /// The lift at the grasp (m).
     grasp_lift: f32,
     /// The base's position (m, world xy) at the grasp, held while lifting.
@@ -137,6 +150,7 @@ pub fn policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
         steps: 0,
         yaw: None,
         arm_targets: [None, None],
+        ik_solutions: [None, None],
         grasp_lift: GRASP_LIFT,
         hold_base: None,
         attempts: 0,
@@ -149,6 +163,7 @@ impl ScriptedPolicy for MoveBucketPolicy {
         self.steps = 0;
         self.yaw = None;
         self.arm_targets = [None, None];
+        self.ik_solutions = [None, None];
         self.grasp_lift = GRASP_LIFT;
         self.hold_base = None;
         self.attempts = 0;
@@ -231,7 +246,7 @@ impl MoveBucketPolicy {
                 if (b - staging).norm() < 0.01
                     && wrap_angle(view.q[2] - yaw).abs() < 0.02
                     && (lift - GRASP_LIFT).abs() < 0.02
-                    && self.steps > 8
+                    && self.arms_settled(&view)
                 {
                     self.next(Phase::Descend);
                 }
@@ -267,13 +282,17 @@ impl MoveBucketPolicy {
                 (self.hold_base.unwrap_or(staging), target, None, -1.0)
             }
             Phase::Carry => {
+                // The bucket's root goes to [`CARRY_SHORT`] m before the goal, on the line
+                // from its start.
                 let goal = Vector2::from(task.target_xy);
                 let to_goal = goal - view.center;
-                if to_goal.norm() < LOWER_DISTANCE || self.steps > 120 {
+                let d = to_goal.norm();
+                let to_stop = to_goal * ((d - CARRY_SHORT).max(0.0) / d.max(1e-6));
+                if to_stop.norm() < LOWER_DISTANCE || self.steps > 120 {
                     self.next(Phase::Lower);
                 }
                 let b = Vector2::new(view.q[0], view.q[1]);
-                (b + to_goal, self.grasp_lift + LIFT_RAISE, None, -1.0)
+                (b + to_stop, self.grasp_lift + LIFT_RAISE, None, -1.0)
             }
             Phase::Release => {
                 if self.steps >= RELEASE_STEPS {
@@ -300,7 +319,8 @@ impl MoveBucketPolicy {
             }
         };
         let speed = if self.phase == Phase::Carry {
-            CARRY_SPEED
+            // Speeding up gently: a sudden start swings the bucket in the hands.
+            CARRY_SPEED.min(CARRY_ACCELERATION * self.steps as f32)
         } else {
             MOVE_SPEED
         };
@@ -313,7 +333,14 @@ impl MoveBucketPolicy {
             for arm in 0..2 {
                 let target = self.solve_arm(config, &view, arm, yaw, (h, inward), from_staging);
                 if let Some(t) = target {
-                    self.arm_targets[arm] = Some(t);
+                    // The command follows the solution at a bounded joint speed.
+                    let chain = &view.chains[arm];
+                    let prev = self.arm_targets[arm]
+                        .unwrap_or_else(|| std::array::from_fn(|k| view.q[chain[4 + k]]));
+                    self.arm_targets[arm] = Some(std::array::from_fn(|k| {
+                        prev[k] + (t[k] - prev[k]).clamp(-MAX_JOINT_STEP, MAX_JOINT_STEP)
+                    }));
+                    self.ik_solutions[arm] = Some(t);
                 }
             }
         }
@@ -332,6 +359,20 @@ impl MoveBucketPolicy {
             action[start + 7] = gripper;
         }
         Some(action)
+    }
+
+    /// Whether the arm commands have caught up with the IK solutions and the arms with the
+    /// commands (within [`SETTLED_JOINTS`]).
+    fn arms_settled(&self, view: &View) -> bool {
+        (0..2).all(
+            |arm| match (self.arm_targets[arm], self.ik_solutions[arm]) {
+                (Some(t), Some(sol)) => (0..7).all(|k| {
+                    let q = view.q[view.chains[arm][4 + k]];
+                    (t[k] - sol[k]).abs() < 1e-3 && (q - t[k]).abs() < SETTLED_JOINTS
+                }),
+                _ => false,
+            },
+        )
     }
 
     fn next(&mut self, phase: Phase) {
@@ -371,7 +412,7 @@ impl MoveBucketPolicy {
             let s = view.center - u * STAGING_DISTANCE;
             seed[..4].copy_from_slice(&[s.x, s.y, yaw, GRASP_LIFT].map(f64::from));
         }
-        if let Some(t) = self.arm_targets[arm] {
+        if let Some(t) = self.ik_solutions[arm] {
             for (k, v) in t.iter().enumerate() {
                 seed[4 + k] = f64::from(*v);
             }
