@@ -80,9 +80,10 @@ const CARRY_ACCELERATION: f32 = 0.02;
 const MOVE_SPEED: f32 = 0.4;
 /// Position gain (1/s) of the base's and the lift's velocity commands.
 const BASE_GAIN: f32 = 3.0;
-/// Largest change (rad) of an arm joint's target per control step: the arms move no faster
-/// than a converted `pd_ee_delta_pose` episode can follow (0.1 m, 0.1 rad per step).
-pub const MAX_JOINT_STEP: f32 = 0.1;
+/// Largest change (rad) of an arm joint's target per control step: slow enough for a
+/// `pd_ee_delta_pose` conversion (at most 0.1 m and 0.1 rad per target step, 4 target steps
+/// per source step) to keep up; at 0.1 rad it could not.
+pub const MAX_JOINT_STEP: f32 = 0.05;
 /// Largest arm joint error (rad) of settled arms.
 const SETTLED_JOINTS: f32 = 0.05;
 /// Gain (1/s) of the arms' joint velocity commands in `pd_joint_vel`.
