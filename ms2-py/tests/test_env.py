@@ -114,6 +114,7 @@ PENALISED_REWARDS = {
     "OpenCabinetDrawer-v1",
     "OpenCabinetDoor-v1",
     "PushChair-v1",
+    "MoveBucket-v1",
 }
 
 

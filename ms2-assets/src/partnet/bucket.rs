@@ -8,10 +8,10 @@
 //! ball inside the body link's bounding box.
 //!
 //! Handle joint (documented in docs/assets.md): about the body's y axis through two pivots
-//! just below the rim, range [−π/2, π/2] (0 = upright; ManiSkill2 narrows it by 10 % on each
-//! side and starts the handle at the lower end, lying beside the body), `<dynamics
-//! damping="0.1" friction="0.02">` (N·m·s/rad, N·m: a handle that falls when let go). The arc
-//! clears the wall in every position. Density 1000 kg/m³ (ManiSkill2's bucket density).
+//! just below the rim, range [−π/2, π/2] (0 = upright; ManiSkill2 narrows it by 10 % of the
+//! span on each side, to ±0.4π, and starts the handle at the lower end, lying beside the
+//! body), `<dynamics damping="0.1" friction="0.02">` (N·m·s/rad, N·m: a handle that falls
+//! when let go). The arc clears the wall in every position. Density 1000 kg/m³ (ManiSkill2's bucket density).
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::path::{Path, PathBuf};

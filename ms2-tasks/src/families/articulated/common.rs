@@ -142,3 +142,61 @@ pub fn min_distance(a: &[Point3<f32>], b: &[Point3<f32>]) -> f32 {
     }
     best.sqrt()
 }
+
+/// Axis-aligned bounds (min, max; m) of `visuals` seen from a frame in which their body sits at
+/// `pose` (mesh and hull vertices, box corners, the bounding boxes of round primitives);
+/// `None` without visuals. ManiSkill2 bounds links and articulations by their visual meshes.
+pub fn visual_bounds(visuals: &[VisualShape], pose: &Pose3) -> Option<(Point3<f32>, Point3<f32>)> {
+    fn corners(h: Vector3<f32>) -> Vec<Point3<f32>> {
+        (0..8)
+            .map(|i| {
+                Point3::new(
+                    if i & 1 == 0 { -h.x } else { h.x },
+                    if i & 2 == 0 { -h.y } else { h.y },
+                    if i & 4 == 0 { -h.z } else { h.z },
+                )
+            })
+            .collect()
+    }
+    fn points(shape: &ShapeDesc) -> Vec<Point3<f32>> {
+        match shape {
+            ShapeDesc::TriMesh { vertices, .. } => vertices.clone(),
+            ShapeDesc::ConvexHull { points } => points.clone(),
+            ShapeDesc::Box { half_extents } => corners(*half_extents),
+            ShapeDesc::Sphere { radius } => corners(Vector3::repeat(*radius)),
+            ShapeDesc::Capsule {
+                radius,
+                half_length,
+            } => corners(Vector3::new(*radius, *radius, radius + half_length)),
+            ShapeDesc::Cylinder {
+                radius,
+                half_length,
+            } => corners(Vector3::new(*radius, *radius, *half_length)),
+            ShapeDesc::Compound { parts } => parts
+                .iter()
+                .flat_map(|(p, s)| points(s).into_iter().map(move |x| p * x))
+                .collect(),
+        }
+    }
+    visuals
+        .iter()
+        .flat_map(|v| {
+            let to = pose * v.pose_body_from_shape;
+            points(&v.shape).into_iter().map(move |p| to * p)
+        })
+        .fold(None, |acc, p| match acc {
+            None => Some((p, p)),
+            Some((lo, hi)) => Some((lo.inf(&p), hi.sup(&p))),
+        })
+}
+
+/// The union of two optional bounds.
+pub fn union_bounds(
+    a: Option<(Point3<f32>, Point3<f32>)>,
+    b: Option<(Point3<f32>, Point3<f32>)>,
+) -> Option<(Point3<f32>, Point3<f32>)> {
+    match (a, b) {
+        (Some((l1, h1)), Some((l2, h2))) => Some((l1.inf(&l2), h1.sup(&h2))),
+        (x, None) | (None, x) => x,
+    }
+}

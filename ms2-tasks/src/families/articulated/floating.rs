@@ -84,3 +84,34 @@ pub fn with_floating_root(desc: &ArticulationDesc) -> ArticulationDesc {
         joints,
     }
 }
+
+/// Puts the floating root of `art` (built with [`with_floating_root`]) at `pose` (world), the
+/// object's own joints at `own_qpos`, everything at rest, the drive targets on that state.
+pub fn set_floating_state(
+    world: &mut dyn crate::rigid_world::RigidWorld,
+    art: ms2_physics::ArticulationId,
+    pose: &Pose3,
+    own_qpos: &[f32],
+) -> Result<(), crate::error::EnvError> {
+    let (roll, pitch, yaw) = pose.rotation.euler_angles();
+    let t = pose.translation.vector;
+    let mut q = vec![t.x, t.y, t.z, yaw, pitch, roll];
+    q.extend_from_slice(own_qpos);
+    let zeros = vec![0.0; q.len()];
+    world.set_qpos(art, &q)?;
+    world.set_qvel(art, &zeros)?;
+    world.set_drive_targets(art, &q)?;
+    world.set_drive_velocity_targets(art, &zeros)?;
+    Ok(())
+}
+
+/// The object's own joint positions (after the floating root's six; empty on an error).
+pub fn own_qpos(
+    world: &dyn crate::rigid_world::RigidWorld,
+    art: ms2_physics::ArticulationId,
+) -> Vec<f32> {
+    let q = world.qpos(art).unwrap_or_default();
+    q.get(FLOATING_JOINTS.len()..)
+        .map(<[f32]>::to_vec)
+        .unwrap_or_default()
+}

@@ -21,6 +21,7 @@ use crate::geometry::{pose_xyz_yaw, vectorize_pose, Pose3};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
+use crate::sensors::{CameraConfig, CameraMount};
 use crate::spec::{RobotChoice, RIGID_OBS_MODES};
 use crate::task::TaskScene;
 use crate::ObsMode;
@@ -198,6 +199,36 @@ pub fn push_privileged_extra(
     extra.push_vector("fingers_pos", &flat(agent.finger_tips(world)));
     extra.push_vector("fingers_vel", &flat(agent.finger_velocities(world)));
     Ok(())
+}
+
+/// Appends the visual modes' `extra` of the two-arm MS1 tasks: `left_tcp_pose`,
+/// `right_tcp_pose` (world poses of the TCPs; nothing for another robot).
+pub fn push_tcp_poses(scene: &TaskScene, extra: &mut DictBuilder) {
+    let Ok(agent) = mobile_agent(scene) else {
+        return;
+    };
+    let world = scene.world.as_ref();
+    // Dof order: the right arm is arm 0, the left arm 1.
+    extra.push_vector(
+        "left_tcp_pose",
+        &vectorize_pose(&agent.arm_tcp_pose(world, 1)),
+    );
+    extra.push_vector(
+        "right_tcp_pose",
+        &vectorize_pose(&agent.arm_tcp_pose(world, 0)),
+    );
+}
+
+/// `camera` moved 4 m straight above the world origin, looking down (the `render()` view of
+/// PushChair and MoveBucket, whose goals are at the origin).
+pub fn overhead_render_camera(mut camera: CameraConfig) -> CameraConfig {
+    camera.mount = CameraMount::World {
+        pose_world_from_camera: Pose3::from_parts(
+            Vector3::new(0.0, 0.0, 4.0).into(),
+            nalgebra::UnitQuaternion::from_axis_angle(&Vector3::y_axis(), PI / 2.0),
+        ),
+    };
+    camera
 }
 
 /// Linear (m/s) and angular (rad/s) speed of `body`.

@@ -1,18 +1,26 @@
 //! Mobile manipulation (ManiSkill2's MS1 tasks) on the mobile Pandas
 //! ([`crate::agents::mobile_panda`]): `OpenCabinetDrawer-v1`, `OpenCabinetDoor-v1`
-//! ([`open_cabinet`]), `PushChair-v1` ([`push_chair`]).
+//! ([`open_cabinet`]), `PushChair-v1` ([`push_chair`]), `MoveBucket-v1` ([`move_bucket`]).
 //!
 //! [`common`] is the family's shared base: the robot's start on a ring around the object, the
 //! privileged `extra` entries, the static check, the spec defaults. [`handles`] reads handle
-//! geometry and visual names from a model's URDF. Each task is its hooks and spec.
+//! geometry and visual names from a model's URDF; [`surface`] samples an object's links for
+//! the rewards' distance terms. Each task is its hooks and spec; MoveBucket's reward is
+//! [`bucket_reward`]. The scripted oracles: [`scripted`] (cabinets), [`chair_oracle`],
+//! [`bucket_oracle`].
 
+pub mod bucket_oracle;
+pub mod bucket_reward;
 pub mod chair_oracle;
 pub mod common;
 pub mod handles;
+pub mod move_bucket;
 pub mod open_cabinet;
 pub mod push_chair;
 pub mod scripted;
+pub mod surface;
 
+pub use move_bucket::MoveBucket;
 pub use open_cabinet::{CabinetTarget, OpenCabinet};
 pub use push_chair::PushChair;
 
@@ -63,6 +71,14 @@ pub const PUSH_CHAIR: TaskSpec = TaskSpec {
     ..OPEN_CABINET_DRAWER
 };
 
+/// `MoveBucket-v1`'s spec.
+pub const MOVE_BUCKET: TaskSpec = TaskSpec {
+    env_id: "MoveBucket-v1",
+    summary: "lift a bucket with a ball inside onto the platform at the origin, upright, with a \
+              two-arm mobile Panda",
+    ..PUSH_CHAIR
+};
+
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
     r.add(
@@ -80,5 +96,9 @@ pub fn register(r: &mut Registrar) {
     r.add(
         TaskRegistration::new(PUSH_CHAIR, |_| Ok(Box::new(PushChair::new()?)))
             .scripted(chair_oracle::policy),
+    );
+    r.add(
+        TaskRegistration::new(MOVE_BUCKET, |_| Ok(Box::new(MoveBucket::new()?)))
+            .scripted(bucket_oracle::policy),
     );
 }

@@ -38,18 +38,21 @@
 use std::f32::consts::PI;
 
 use ms2_physics::{ArticulationId, ArticulationOptions, DriveParams, Material, SelfCollision};
-use nalgebra::{Point3, UnitQuaternion, Vector2, Vector3};
+use nalgebra::{UnitQuaternion, Vector2, Vector3};
 use rand::Rng;
 
 use super::common::{
-    body_speeds, mobile_agent, place_robot, push_privileged_extra, BaseRing, ObservedArticulation,
+    body_speeds, mobile_agent, overhead_render_camera, place_robot, push_privileged_extra,
+    push_tcp_poses, BaseRing, ObservedArticulation,
 };
 use super::handles::link_visual_names;
+use super::surface::LinkSurface;
 use crate::error::EnvError;
-use crate::families::articulated::common::surface_samples;
-use crate::families::articulated::floating::{with_floating_root, FLOATING_JOINTS};
+use crate::families::articulated::floating::{
+    own_qpos, set_floating_state, with_floating_root, FLOATING_JOINTS,
+};
 use crate::families::articulated::model::{load_model, ModelSet, ModelSource};
-use crate::geometry::{vectorize_pose, Pose3};
+use crate::geometry::Pose3;
 use crate::info::{Evaluation, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
@@ -109,7 +112,7 @@ pub struct PushChair {
     pub chair_init_ori: f32,
     /// Goal (m, world xy).
     pub target_xy: [f32; 2],
-    links_samples: Vec<(usize, Vec<Point3<f32>>)>,
+    surface: LinkSurface,
 }
 
 impl PushChair {
@@ -135,7 +138,7 @@ impl PushChair {
             swivel_dof: None,
             chair_init_ori: 0.0,
             target_xy: TARGET_XY,
-            links_samples: Vec::new(),
+            surface: LinkSurface::default(),
         }
     }
 
@@ -158,56 +161,21 @@ impl PushChair {
         pose: &Pose3,
         qpos: &[f32],
     ) -> Result<(), EnvError> {
-        let art = self.chair();
-        let (roll, pitch, yaw) = pose.rotation.euler_angles();
-        let t = pose.translation.vector;
-        let mut q = vec![t.x, t.y, t.z, yaw, pitch, roll];
-        q.extend_from_slice(qpos);
-        let zeros = vec![0.0; q.len()];
-        world.set_qpos(art, &q)?;
-        world.set_qvel(art, &zeros)?;
-        world.set_drive_targets(art, &q)?;
-        world.set_drive_velocity_targets(art, &zeros)?;
-        Ok(())
+        set_floating_state(world, self.chair(), pose, qpos)
     }
 
     /// The chair's own joint positions (after the floating root's six).
     pub fn chair_qpos(&self, world: &dyn RigidWorld) -> Vec<f32> {
-        let q = world.qpos(self.chair()).unwrap_or_default();
-        q.get(FLOATING_JOINTS.len()..)
-            .map(<[f32]>::to_vec)
-            .unwrap_or_default()
-    }
-
-    /// The chair's surface samples in the world (m).
-    fn chair_points(&self, world: &dyn RigidWorld) -> Vec<Point3<f32>> {
-        self.links_samples
-            .iter()
-            .flat_map(|(link, pts)| {
-                let pose = world
-                    .link_pose(self.chair(), *link)
-                    .unwrap_or_else(|_| Pose3::identity());
-                pts.iter().map(move |p| pose * p)
-            })
-            .collect()
+        own_qpos(world, self.chair())
     }
 
     /// ManiSkill2's dense reward and its stage term.
     fn reward(&self, scene: &TaskScene, eval: &Evaluation) -> Result<(f64, f64), EnvError> {
         let world = scene.world.as_ref();
         let agent = mobile_agent(scene)?;
-        let chair = self.chair_points(world);
-        let tips = agent.finger_tips(world);
-        let dist_ee = tips
-            .iter()
-            .map(|t| {
-                chair
-                    .iter()
-                    .map(|p| (p.coords - t).norm())
-                    .fold(f32::INFINITY, f32::min)
-            })
-            .sum::<f32>()
-            / tips.len().max(1) as f32;
+        let dist_ee = self
+            .surface
+            .mean_distance(world, self.chair(), &agent.finger_tips(world));
         let mut reward = -dist_ee - (dist_ee + 1e-5).ln().clamp(-10.0, 0.0);
         let tilt = eval.number("chair_tilt").unwrap_or(PI as f64) as f32;
         reward -= tilt * 0.2;
@@ -409,16 +377,7 @@ impl Task for PushChair {
 
     fn initialize_task(&mut self, scene: &TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         self.target_xy = TARGET_XY;
-        let world = scene.world.as_ref();
-        let art = self.chair();
-        let mut samples = Vec::new();
-        for link in 0..world.link_names(art)?.len() {
-            let visuals = world.link_visuals(art, link)?;
-            if !visuals.is_empty() {
-                samples.push((link, surface_samples(visuals, LINK_SAMPLES, rng)));
-            }
-        }
-        self.links_samples = samples;
+        self.surface = LinkSurface::sample(scene.world.as_ref(), self.chair(), LINK_SAMPLES, rng)?;
         Ok(())
     }
 
@@ -437,19 +396,7 @@ impl Task for PushChair {
     }
 
     fn visual_extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
-        let Ok(agent) = mobile_agent(scene) else {
-            return;
-        };
-        let world = scene.world.as_ref();
-        // Dof order: the right arm is arm 0, the left arm 1.
-        extra.push_vector(
-            "left_tcp_pose",
-            &vectorize_pose(&agent.arm_tcp_pose(world, 1)),
-        );
-        extra.push_vector(
-            "right_tcp_pose",
-            &vectorize_pose(&agent.arm_tcp_pose(world, 0)),
-        );
+        push_tcp_poses(scene, extra);
     }
 
     fn evaluate(&self, scene: &TaskScene) -> Evaluation {
@@ -514,14 +461,8 @@ impl Task for PushChair {
     }
 
     /// 4 m straight above the goal, looking down.
-    fn render_camera(&self, mut camera: CameraConfig) -> CameraConfig {
-        camera.mount = CameraMount::World {
-            pose_world_from_camera: Pose3::from_parts(
-                Vector3::new(0.0, 0.0, 4.0).into(),
-                UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f32::consts::FRAC_PI_2),
-            ),
-        };
-        camera
+    fn render_camera(&self, camera: CameraConfig) -> CameraConfig {
+        overhead_render_camera(camera)
     }
 
     /// ManiSkill2's target indicator: a red sphere of radius [`GOAL_MARKER_RADIUS_M`] centred
