@@ -313,6 +313,11 @@ def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
     if args.policy == "scripted" and num_envs_list:
         print("(--policy scripted drives single envs only: make_vec rows skipped)")
         num_envs_list = []
+    cameras = (
+        "overhead_camera_0-2 400x160 (fused in the base frame)"
+        if mobile
+        else "base_camera + hand_camera 128x128"
+    )
     # ManiSkill2's visual figure is PickCube's (two cameras); the mobile tasks have three
     # cameras and no recorded ManiSkill2 figure.
     peer = MANISKILL2_SOFT_RENDER_STEPS_PER_S if soft else MANISKILL2_VISUAL_STEPS_PER_S
@@ -320,7 +325,7 @@ def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
         peer = None
     print(
         f"ms2 bench --visual: {args.env_id}, {control_mode}, {args.policy} actions, 500 Hz "
-        f"physics / 20 Hz control, cameras base_camera + hand_camera 128x128, "
+        f"physics / 20 Hz control, cameras {cameras}, "
         f"{os.cpu_count()} cores, renderer {_native.render_adapter()}, {steps} env steps per row"
     )
     header = (
