@@ -6,27 +6,14 @@
 //! chair_trace <control_mode> <K> <seed>...
 //! ```
 
-use ms2_tasks::{info_get, make_env, make_scripted_policy, EnvConfig, EnvError, Info, InfoValue};
+mod common;
 
-/// A real-valued info term (NaN when absent).
-fn real(info: &Info, key: &str) -> f64 {
-    match info_get(info, key) {
-        Some(InfoValue::F64(x)) => x,
-        _ => f64::NAN,
-    }
-}
+use common::{print_outcome, real, trace_args, trace_episode};
+use ms2_tasks::{make_env, make_scripted_policy, EnvConfig, EnvError};
 
 fn main() -> Result<(), EnvError> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let mode = args
-        .first()
-        .cloned()
-        .unwrap_or("base_pd_joint_vel_arm_pd_joint_vel".into());
-    let every: u32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(10);
-    let seeds: Vec<u64> = args[2.min(args.len())..]
-        .iter()
-        .filter_map(|s| s.parse().ok())
-        .collect();
+    let (mode, every, seeds) = trace_args(&args, "base_pd_joint_vel_arm_pd_joint_vel");
     let mut env = make_env(&EnvConfig {
         obs_mode: "state_dict".to_owned(),
         control_mode: Some(mode),
@@ -34,11 +21,7 @@ fn main() -> Result<(), EnvError> {
     })?;
     let mut policy = make_scripted_policy(&env)?;
     for seed in seeds {
-        env.reset(Some(seed), false)?;
-        policy.reset(&env);
-        let mut outcome = None;
-        for step in 1..=env.max_episode_steps() {
-            let out = env.step(&policy.act(&env))?;
+        let outcome = trace_episode(&mut env, Some(policy.as_mut()), seed, |_, step, _, out| {
             let base = out
                 .obs
                 .get("agent/base_pos")
@@ -62,15 +45,8 @@ fn main() -> Result<(), EnvError> {
                     real(&out.info, "chair_tilt"),
                 );
             }
-            if out.terminated {
-                outcome = Some(step);
-                break;
-            }
-        }
-        println!(
-            "seed {seed}: {}",
-            outcome.map_or("failed".into(), |s| format!("success at step {s}"))
-        );
+        })?;
+        print_outcome(seed, outcome);
     }
     Ok(())
 }

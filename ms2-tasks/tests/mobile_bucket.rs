@@ -4,45 +4,24 @@
 //! check on buckets put on the platform through the state vector, finite rewards, get/set_state
 //! round trips and the scripted oracle.
 
+mod common;
+
 use std::f32::consts::PI;
 
+use common::{leaf, wrap};
 use ms2_tasks::families::articulated::floating::FLOATING_JOINTS;
 use ms2_tasks::families::mobile::MoveBucket;
-use ms2_tasks::{make_env, Env, EnvConfig, ObsValue};
+use ms2_tasks::Env;
 use rand::{Rng, SeedableRng};
 
 const ID: &str = "MoveBucket-v1";
 
 fn env(obs_mode: &str, control_mode: Option<&str>, reward_mode: Option<&str>) -> Env {
-    make_env(&EnvConfig {
-        obs_mode: obs_mode.to_owned(),
-        control_mode: control_mode.map(str::to_owned),
-        reward_mode: reward_mode.map(str::to_owned),
-        ..EnvConfig::new(ID)
-    })
-    .unwrap()
-}
-
-fn leaf(obs: &ObsValue, path: &str) -> Vec<f32> {
-    obs.get(path)
-        .unwrap_or_else(|| panic!("no {path}"))
-        .as_f32()
-        .unwrap()
-        .to_vec()
+    common::env(ID, obs_mode, control_mode, reward_mode)
 }
 
 fn task(e: &Env) -> &MoveBucket {
-    e.task().unwrap().downcast_ref::<MoveBucket>().unwrap()
-}
-
-/// Wraps an angle into (−π, π].
-fn wrap(a: f32) -> f32 {
-    let w = (a + PI).rem_euclid(2.0 * PI) - PI;
-    if w <= -PI {
-        w + 2.0 * PI
-    } else {
-        w
-    }
+    common::task(e)
 }
 
 #[test]
@@ -119,14 +98,7 @@ fn reset_distribution_is_maniskill2_and_seeded() {
         assert!(ms2_tasks::info_get(&info, "dist_bucket_to_target").is_some());
     }
     assert!(models.len() > 3, "models drawn: {models:?}");
-    let mut other = env("state", None, None);
-    let mut again = env("state", None, None);
-    for seed in [3, 7] {
-        let (a, _) = other.reset(Some(seed), false).unwrap();
-        let (b, _) = again.reset(Some(seed), false).unwrap();
-        assert_eq!(a.as_f32().unwrap(), b.as_f32().unwrap(), "seed {seed}");
-        assert_eq!(task(&other).model_id, task(&again).model_id);
-    }
+    common::assert_resets_seeded(ID, &[3, 7], |e| task(e).model_id.clone());
 }
 
 /// The ball starts above the rim (ManiSkill2's reset leaves it falling), drops in and stays
@@ -168,12 +140,9 @@ fn the_ball_falls_into_the_bucket_and_stays_there() {
 }
 
 /// Index in the state vector of the qpos of the bucket's floating joint `k` (x, y, z, yaw,
-/// pitch, roll): the ball (13), the robot (root pose 7, 4 values per joint), then the bucket
-/// (root pose 7, 4 values per joint, the floating ones first).
+/// pitch, roll): the ball (one actor) and the robot precede the bucket.
 fn floating_qpos_index(e: &Env, k: usize) -> usize {
-    let scene = e.task_scene().unwrap();
-    let robot = scene.agent.qpos(scene.world.as_ref());
-    13 + 7 + 4 * robot.len() + 7 + 4 * k
+    common::floating_qpos_index(e, 1, k)
 }
 
 #[test]
@@ -216,28 +185,24 @@ fn success_needs_the_bucket_on_the_platform_upright_with_the_ball_inside() {
     assert!(out.terminated, "{:?}", out.info);
     assert!(out.reward.is_finite());
     // 0.35 m off centre: not above the platform.
-    e.set_state(&moved(0.35 - root.x, -root.y)).unwrap();
-    let eval = e.evaluate();
-    assert!(!eval.success && eval.flag("bucket_above_platform") == Some(false));
+    common::assert_fails_on(
+        &mut e,
+        &moved(0.35 - root.x, -root.y),
+        "bucket_above_platform",
+    );
     // The ball left behind: not inside.
     let mut no_ball = on_platform.clone();
     no_ball[0] += 0.5;
-    e.set_state(&no_ball).unwrap();
-    let eval = e.evaluate();
-    assert!(!eval.success && eval.flag("balls_in_bucket") == Some(false));
+    common::assert_fails_on(&mut e, &no_ball, "balls_in_bucket");
     // Tilted by 0.4 rad (> 0.1π): not standing.
     let mut tilted = on_platform.clone();
     tilted[ipitch] = 0.4;
-    e.set_state(&tilted).unwrap();
-    let eval = e.evaluate();
-    assert!(!eval.success && eval.flag("bucket_standing") == Some(false));
+    let eval = common::assert_fails_on(&mut e, &tilted, "bucket_standing");
     assert!((eval.number("bucket_tilt").unwrap() - 0.4).abs() < 1e-3);
     // Moving at 0.5 m/s: not static.
     let mut moving = on_platform.clone();
     moving[ix + 1] = 0.5;
-    e.set_state(&moving).unwrap();
-    let eval = e.evaluate();
-    assert!(!eval.success && eval.flag("bucket_static") == Some(false));
+    common::assert_fails_on(&mut e, &moving, "bucket_static");
     assert_eq!(FLOATING_JOINTS.len(), 6);
 }
 
@@ -266,29 +231,9 @@ fn rewards_are_finite_under_random_actions() {
 #[test]
 fn get_and_set_state_round_trip() {
     let mut e = env("state", None, None);
-    e.reset(Some(5), false).unwrap();
     let mut a = vec![0.3_f32; e.action_space().low.len()];
     a[0] = 1.0;
-    for _ in 0..20 {
-        e.step(&a).unwrap();
-    }
-    let state = e.get_state();
-    let obs = e.observe();
-    let next: Vec<f32> = e.step(&a).unwrap().obs.as_f32().unwrap().to_vec();
-    for _ in 0..5 {
-        e.step(&a).unwrap();
-    }
-    e.set_state(&state).unwrap();
-    let again = e.observe();
-    let (x, y) = (obs.as_f32().unwrap(), again.as_f32().unwrap());
-    let err = x
-        .iter()
-        .zip(y)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f32::max);
-    assert!(err < 1e-4, "observation after set_state differs by {err}");
-    let replay = e.step(&a).unwrap().obs;
-    assert_eq!(replay.as_f32().unwrap(), next.as_slice());
+    common::assert_state_round_trip_replays(&mut e, 5, &a);
 }
 
 /// The scripted oracle (both hands pinching the rim, lift, carry, lower) succeeds on a few
@@ -303,19 +248,13 @@ fn scripted_oracle_moves_the_bucket_onto_the_platform() {
         let mut policy = ms2_tasks::make_scripted_policy(&e).unwrap();
         let mut successes = 0;
         for seed in 0..3 {
-            e.reset(Some(seed), false).unwrap();
-            policy.reset(&e);
-            for _ in 0..e.max_episode_steps() {
-                let out = e.step(&policy.act(&e)).unwrap();
-                if out.terminated {
-                    successes += 1;
-                    // On success the ball is inside and the bucket's root above the platform.
-                    assert_eq!(
-                        ms2_tasks::info_get(&out.info, "balls_in_bucket"),
-                        Some(ms2_tasks::InfoValue::Bool(true))
-                    );
-                    break;
-                }
+            if let Some(out) = common::oracle_success(&mut e, policy.as_mut(), seed) {
+                successes += 1;
+                // On success the ball is inside and the bucket's root above the platform.
+                assert_eq!(
+                    ms2_tasks::info_get(&out.info, "balls_in_bucket"),
+                    Some(ms2_tasks::InfoValue::Bool(true))
+                );
             }
         }
         assert!(
@@ -323,14 +262,9 @@ fn scripted_oracle_moves_the_bucket_onto_the_platform() {
             "{mode}: {successes}/3 buckets on the platform"
         );
     }
-    let other = env(
-        "state",
-        Some("base_pd_joint_vel_arm_pd_ee_delta_pose"),
-        None,
+    common::assert_oracle_refuses(
+        ID,
+        "base_pd_joint_vel_arm_pd_ee_delta_pose",
+        "base_pd_joint_vel_arm_pd_joint_pos",
     );
-    let err = ms2_tasks::make_scripted_policy(&other)
-        .err()
-        .unwrap()
-        .to_string();
-    assert!(err.contains("base_pd_joint_vel_arm_pd_joint_pos"), "{err}");
 }

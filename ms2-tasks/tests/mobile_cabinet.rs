@@ -2,24 +2,14 @@
 //! start around the cabinet, the target drawer opening when it is pulled (simulated),
 //! get/set_state round trips, the scripted oracle and the conversion of its episodes.
 
+mod common;
+
+use common::leaf;
 use ms2_tasks::families::mobile::OpenCabinet;
-use ms2_tasks::{make_env, Env, EnvConfig, ObsValue};
+use ms2_tasks::Env;
 
 fn env(id: &str, obs_mode: &str, control_mode: Option<&str>) -> Env {
-    make_env(&EnvConfig {
-        obs_mode: obs_mode.to_owned(),
-        control_mode: control_mode.map(str::to_owned),
-        ..EnvConfig::new(id)
-    })
-    .unwrap()
-}
-
-fn leaf(obs: &ObsValue, path: &str) -> Vec<f32> {
-    obs.get(path)
-        .unwrap_or_else(|| panic!("no {path}"))
-        .as_f32()
-        .unwrap()
-        .to_vec()
+    common::env(id, obs_mode, control_mode, None)
 }
 
 #[test]
@@ -72,7 +62,7 @@ fn episodes_start_closed_with_the_target_range_set() {
                 !eval.success && eval.flag("open_enough") == Some(false),
                 "{id} {seed}"
             );
-            let task = e.task().unwrap().downcast_ref::<OpenCabinet>().unwrap();
+            let task = common::task::<OpenCabinet>(&e);
             let t = task.target_link();
             let q = task.link_qpos(e.task_scene().unwrap().world.as_ref());
             assert!(
@@ -93,23 +83,7 @@ fn get_and_set_state_round_trip() {
     let mut e = env("OpenCabinetDoor-v1", "state", None);
     e.reset(Some(5), false).unwrap();
     let a = vec![0.3_f32; e.action_space().low.len()];
-    for _ in 0..3 {
-        e.step(&a).unwrap();
-    }
-    let state = e.get_state();
-    let obs = e.observe();
-    for _ in 0..3 {
-        e.step(&a).unwrap();
-    }
-    e.set_state(&state).unwrap();
-    let again = e.observe();
-    let (x, y) = (obs.as_f32().unwrap(), again.as_f32().unwrap());
-    let err = x
-        .iter()
-        .zip(y)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f32::max);
-    assert!(err < 1e-4, "observation after set_state differs by {err}");
+    common::assert_state_round_trip(&mut e, &a, 3, 3);
 }
 
 /// The scripted oracle (base and arm together) opens the target drawer / door: success over a
@@ -152,6 +126,7 @@ fn scripted_oracle_opens_cabinets() {
 #[test]
 fn oracle_episodes_convert_to_ee_delta_pose() {
     use ms2_tasks::demos::{replay_episode, scripted_episode, ReplayOptions};
+    use ms2_tasks::EnvConfig;
     for id in ["OpenCabinetDrawer-v1", "OpenCabinetDoor-v1"] {
         let cfg = EnvConfig {
             obs_mode: "state".to_owned(),

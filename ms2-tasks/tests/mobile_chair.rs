@@ -3,43 +3,23 @@
 //! drives into it (simulated), the success check on chairs put at the goal through the state
 //! vector (upright: success; tilted: none), and get/set_state round trips.
 
+mod common;
+
 use std::f32::consts::PI;
 
+use common::{leaf, wrap};
 use ms2_tasks::families::articulated::floating::FLOATING_JOINTS;
 use ms2_tasks::families::mobile::PushChair;
-use ms2_tasks::{make_env, Env, EnvConfig, ObsValue};
+use ms2_tasks::Env;
 
 const ID: &str = "PushChair-v1";
 
 fn env(obs_mode: &str, control_mode: Option<&str>) -> Env {
-    make_env(&EnvConfig {
-        obs_mode: obs_mode.to_owned(),
-        control_mode: control_mode.map(str::to_owned),
-        ..EnvConfig::new(ID)
-    })
-    .unwrap()
-}
-
-fn leaf(obs: &ObsValue, path: &str) -> Vec<f32> {
-    obs.get(path)
-        .unwrap_or_else(|| panic!("no {path}"))
-        .as_f32()
-        .unwrap()
-        .to_vec()
+    common::env(ID, obs_mode, control_mode, None)
 }
 
 fn task(e: &Env) -> &PushChair {
-    e.task().unwrap().downcast_ref::<PushChair>().unwrap()
-}
-
-/// Wraps an angle into (−π, π].
-fn wrap(a: f32) -> f32 {
-    let w = (a + PI).rem_euclid(2.0 * PI) - PI;
-    if w <= -PI {
-        w + 2.0 * PI
-    } else {
-        w
-    }
+    common::task(e)
 }
 
 #[test]
@@ -124,14 +104,7 @@ fn reset_distribution_is_maniskill2_and_seeded() {
     }
     assert!(models.len() > 3, "models drawn: {models:?}");
     // Seeded: the same seed gives the same episode, in another env too.
-    let mut other = env("state", None);
-    let mut again = env("state", None);
-    for seed in [3, 7] {
-        let (a, _) = other.reset(Some(seed), false).unwrap();
-        let (b, _) = again.reset(Some(seed), false).unwrap();
-        assert_eq!(a.as_f32().unwrap(), b.as_f32().unwrap(), "seed {seed}");
-        assert_eq!(task(&other).model_id, task(&again).model_id);
-    }
+    common::assert_resets_seeded(ID, &[3, 7], |e| task(e).model_id.clone());
 }
 
 /// Lowers the lift (the torso, the robot's colliding body, then spans the chair's back), then
@@ -181,15 +154,9 @@ fn the_chair_moves_when_the_base_drives_into_it() {
 }
 
 /// Index in the state vector of the qpos of the chair's floating joint `k` (x, y, z, yaw,
-/// pitch, roll): the robot's articulation (root pose 7, 4 values per joint) precedes the
-/// chair's (root pose 7, then 4 values per joint, the floating ones first).
+/// pitch, roll): no actor, the robot precedes the chair.
 fn floating_qpos_index(e: &Env, k: usize) -> usize {
-    let robot = e
-        .task_scene()
-        .unwrap()
-        .agent
-        .qpos(e.task_scene().unwrap().world.as_ref());
-    7 + 4 * robot.len() + 7 + 4 * k
+    common::floating_qpos_index(e, 0, k)
 }
 
 #[test]
@@ -224,53 +191,27 @@ fn success_needs_the_chair_at_the_goal_upright_and_static() {
     let mut far = state.clone();
     far[ix] = 0.2;
     far[iy] = 0.0;
-    e.set_state(&far).unwrap();
-    let eval = e.evaluate();
-    assert!(!eval.success && eval.flag("chair_close_to_target") == Some(false));
+    common::assert_fails_on(&mut e, &far, "chair_close_to_target");
     // At the goal but tilted by 0.2 rad (> 0.05π): not standing, no success.
     let mut tilted = at_goal.clone();
     tilted[ipitch] = 0.2;
-    e.set_state(&tilted).unwrap();
-    let eval = e.evaluate();
-    assert!(!eval.success && eval.flag("chair_standing") == Some(false));
+    let eval = common::assert_fails_on(&mut e, &tilted, "chair_standing");
     assert!((eval.number("chair_tilt").unwrap() - 0.2).abs() < 1e-3);
     // At the goal, upright, but moving at 0.5 m/s: not static.
     let ivx = floating_qpos_index(&e, 0) + 1;
     let mut moving = at_goal.clone();
     moving[ivx] = 0.5;
-    e.set_state(&moving).unwrap();
-    let eval = e.evaluate();
-    assert!(!eval.success && eval.flag("chair_static") == Some(false));
+    common::assert_fails_on(&mut e, &moving, "chair_static");
     assert_eq!(FLOATING_JOINTS.len(), 6);
 }
 
 #[test]
 fn get_and_set_state_round_trip() {
     let mut e = env("state", None);
-    e.reset(Some(5), false).unwrap();
     let mut a = vec![0.3_f32; e.action_space().low.len()];
     a[0] = 1.0;
-    for _ in 0..20 {
-        e.step(&a).unwrap();
-    }
-    let state = e.get_state();
-    let obs = e.observe();
-    let next: Vec<f32> = e.step(&a).unwrap().obs.as_f32().unwrap().to_vec();
-    for _ in 0..5 {
-        e.step(&a).unwrap();
-    }
-    e.set_state(&state).unwrap();
-    let again = e.observe();
-    let (x, y) = (obs.as_f32().unwrap(), again.as_f32().unwrap());
-    let err = x
-        .iter()
-        .zip(y)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f32::max);
-    assert!(err < 1e-4, "observation after set_state differs by {err}");
-    // Stepping on reproduces the run.
-    let replay = e.step(&a).unwrap().obs;
-    assert_eq!(replay.as_f32().unwrap(), next.as_slice());
+    // Stepping on from the restored state reproduces the run.
+    common::assert_state_round_trip_replays(&mut e, 5, &a);
 }
 
 /// The scripted oracle (lift lowered, the torso pushing the chair's back along the line to the
@@ -279,26 +220,16 @@ fn get_and_set_state_round_trip() {
 fn scripted_oracle_pushes_the_chair_to_the_goal() {
     let mut e = env("state", None);
     let mut policy = ms2_tasks::make_scripted_policy(&e).unwrap();
-    let mut successes = 0;
-    for seed in 0..4 {
-        e.reset(Some(seed), false).unwrap();
-        policy.reset(&e);
-        for _ in 0..e.max_episode_steps() {
-            let out = e.step(&policy.act(&e)).unwrap();
-            if out.terminated {
-                successes += 1;
-                break;
-            }
-        }
-    }
+    let successes = (0..4)
+        .filter(|&seed| common::oracle_success(&mut e, policy.as_mut(), seed).is_some())
+        .count();
     assert!(successes >= 3, "{successes}/4 chairs at the goal");
     // Another control mode than the oracle's is refused with a message naming its modes.
-    let other = env("state", Some("base_pd_joint_vel_arm_pd_ee_delta_pose"));
-    let err = ms2_tasks::make_scripted_policy(&other)
-        .err()
-        .unwrap()
-        .to_string();
-    assert!(err.contains("base_pd_joint_vel_arm_pd_joint_pos"), "{err}");
+    common::assert_oracle_refuses(
+        ID,
+        "base_pd_joint_vel_arm_pd_ee_delta_pose",
+        "base_pd_joint_vel_arm_pd_joint_pos",
+    );
 }
 
 /// `render()` looks down on the goal from 4 m and marks it with ManiSkill2's red 15 cm sphere,
@@ -307,7 +238,7 @@ fn scripted_oracle_pushes_the_chair_to_the_goal() {
 #[cfg(feature = "render")]
 #[test]
 fn render_marks_the_goal_with_a_red_sphere_at_the_centre() {
-    use ms2_tasks::ArrayData;
+    use ms2_tasks::{make_env, ArrayData, EnvConfig, ObsValue};
     let mut e = make_env(&EnvConfig {
         obs_mode: "rgbd".to_owned(),
         render_mode: Some("rgb_array".to_owned()),

@@ -39,6 +39,19 @@ pub fn no_policy(env: &Env, reason: &str) -> EnvError {
     }
 }
 
+/// `Ok` when `env`'s control mode is one of `modes`; else the [`no_policy`] error saying that
+/// `oracle` (e.g. "the chair oracle") drives control_mode in `modes`.
+pub fn require_control_mode(env: &Env, modes: &[&str], oracle: &str) -> Result<(), EnvError> {
+    if modes.contains(&env.control_mode()) {
+        Ok(())
+    } else {
+        Err(no_policy(
+            env,
+            &format!("{oracle} drives control_mode in {modes:?}"),
+        ))
+    }
+}
+
 /// The [`oracle::TcpOracle`] of `env`, for policies that plan TCP poses; an error when the
 /// env's control mode is not one the oracle drives ([`oracle::SUPPORTED_MODES`]).
 pub fn tcp_oracle(env: &Env) -> Result<oracle::TcpOracle, EnvError> {

@@ -12,8 +12,10 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use ms2_assets::partnet::{self, ModelDb, ModelInfo};
 use ms2_physics::{parse_urdf_file, ArticulationDesc, MeshCollision, UrdfLoadOptions};
+use rand::Rng;
 
 use crate::error::EnvError;
+use crate::seeding::EpisodeRng;
 
 /// ManiSkill2's default density of articulated-object links (kg/m³).
 pub const DEFAULT_DENSITY: f32 = 8e3;
@@ -101,6 +103,18 @@ impl ModelSet {
         self.db.keys().map(String::as_str).collect()
     }
 
+    /// One id drawn uniformly with `rng` (one `random_range` draw over the sorted ids): the
+    /// episode's model.
+    pub fn draw(&self, rng: &mut EpisodeRng) -> String {
+        let ids = self.ids();
+        ids[rng.random_range(0..ids.len())].to_owned()
+    }
+
+    /// The URDF file of model `id` in the dataset root, or an error naming what is missing.
+    pub fn urdf(&self, id: &str) -> Result<PathBuf, EnvError> {
+        partnet::find_urdf(&self.root, id).map_err(|e| EnvError::Asset(e.to_string()))
+    }
+
     /// The info of `id`, or an error naming the info file.
     pub fn info(&self, id: &str) -> Result<&ModelInfo, EnvError> {
         self.db.get(id).ok_or_else(|| {
@@ -115,8 +129,7 @@ impl ModelSet {
     /// The parsed description of model `id` (cached per process).
     pub fn load(&self, id: &str) -> Result<Arc<ArticulationDesc>, EnvError> {
         let info = self.info(id)?;
-        let urdf =
-            partnet::find_urdf(&self.root, id).map_err(|e| EnvError::Asset(e.to_string()))?;
+        let urdf = self.urdf(id)?;
         load_model(
             &urdf,
             info.effective_scale(),

@@ -198,8 +198,7 @@ impl Task for TurnFaucet {
     ) -> Result<(), EnvError> {
         // The episode's model, drawn first (the parsed description is cached, so a rebuild
         // costs the world's construction only).
-        let ids = self.models.ids();
-        self.model_id = ids[rng.random_range(0..ids.len())].to_owned();
+        self.model_id = self.models.draw(rng);
         let info = self.models.info(&self.model_id)?.clone();
         let desc = self.models.load(&self.model_id)?;
         let switch_links = info.links_labelled("switch");

@@ -30,7 +30,7 @@ use crate::env::Env;
 use crate::error::EnvError;
 use crate::geometry::wrap_angle;
 use crate::scripted::oracle::{GRIPPER_CLOSED, GRIPPER_OPEN};
-use crate::scripted::{no_policy, ScriptedPolicy};
+use crate::scripted::{require_control_mode, ScriptedPolicy};
 
 /// The control modes the oracle drives.
 pub const ORACLE_MODES: [&str; 2] = [
@@ -139,12 +139,7 @@ pub struct MoveBucketPolicy {
 
 /// The bucket oracle for `env` (an error in another control mode).
 pub fn policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
-    if !ORACLE_MODES.contains(&env.control_mode()) {
-        return Err(no_policy(
-            env,
-            &format!("the bucket oracle drives control_mode in {ORACLE_MODES:?}"),
-        ));
-    }
+    require_control_mode(env, &ORACLE_MODES, "the bucket oracle")?;
     Ok(Box::new(MoveBucketPolicy {
         joint_velocity: env.control_mode() == ORACLE_MODES[0],
         phase: Phase::Prepare,

@@ -16,7 +16,7 @@ use super::push_chair::PushChair;
 use crate::env::Env;
 use crate::error::EnvError;
 use crate::geometry::wrap_angle;
-use crate::scripted::{no_policy, ScriptedPolicy};
+use crate::scripted::{require_control_mode, ScriptedPolicy};
 
 /// The control modes the oracle drives.
 pub const ORACLE_MODES: [&str; 2] = [
@@ -66,12 +66,7 @@ pub struct PushChairPolicy {
 
 /// The chair oracle for `env` (an error in another control mode).
 pub fn policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
-    if !ORACLE_MODES.contains(&env.control_mode()) {
-        return Err(no_policy(
-            env,
-            &format!("the chair oracle drives control_mode in {ORACLE_MODES:?}"),
-        ));
-    }
+    require_control_mode(env, &ORACLE_MODES, "the chair oracle")?;
     Ok(Box::new(PushChairPolicy {
         joint_position: env.control_mode() == ORACLE_MODES[1],
         push: None,

@@ -1,7 +1,8 @@
 //! The shared base of ManiSkill2's mobile-manipulation (MS1) tasks: the robot placed on a ring
 //! around the object, facing it; the privileged `extra` entries every MS1 task observes
 //! (padded articulation states, actor states, finger tips and velocities); the link static
-//! check of their success metrics; the spec defaults.
+//! check of their success metrics and the goal metrics of a free object's root ([`RootMetrics`],
+//! PushChair and MoveBucket); the spec defaults.
 //!
 //! ManiSkill2's MS1 observation: in the state modes `extra` is privileged state only
 //! (`actors` if any, `articulations`, `fingers_pos`, `fingers_vel`, then the task's own
@@ -17,7 +18,9 @@ use rand::Rng;
 
 use crate::agents::mobile_panda::{MobilePandaAgent, MOBILE_LIFT_START, PLANAR_BASE_DOF};
 use crate::error::EnvError;
+use crate::families::articulated::floating::FLOATING_JOINTS;
 use crate::geometry::{pose_xyz_yaw, vectorize_pose, Pose3};
+use crate::info::{Info, InfoValue};
 use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
@@ -38,6 +41,15 @@ pub const SINGLE_ARM_ROBOTS: &[RobotChoice] = &[RobotChoice::same("mobile_panda_
 pub const DUAL_ARM_ROBOTS: &[RobotChoice] = &[RobotChoice::same("mobile_panda_dual_arm")];
 /// Largest yaw noise (rad) of the robot's start orientation (ManiSkill2: ±0.05π).
 pub const BASE_YAW_NOISE: f32 = 0.05 * PI;
+/// Goal (m, world xy) of the object's root in PushChair and MoveBucket (ManiSkill2's
+/// `target_xy`): the origin.
+pub const TARGET_XY: [f32; 2] = [0.0, 0.0];
+/// Largest root speed (m/s) and angular speed (rad/s) of a static object in PushChair and
+/// MoveBucket's success checks.
+pub const STATIC_SPEEDS: (f32, f32) = (0.1, 0.2);
+/// Surface samples per object link of the PushChair and MoveBucket rewards' distance term
+/// (ManiSkill2: 512).
+pub const LINK_SAMPLES: usize = 512;
 
 /// The mobile robot of a scene (an error if the task runs another robot).
 pub fn mobile_agent(scene: &TaskScene) -> Result<&MobilePandaAgent, EnvError> {
@@ -134,6 +146,17 @@ impl ObservedArticulation {
             art,
             root_link: 0,
             first_dof: 0,
+            max_dof,
+        }
+    }
+
+    /// An articulation whose root is free ([`crate::families::articulated::floating`]): its
+    /// own root is link `root_link`, its own dofs follow the six dummy joints.
+    pub fn floating(art: ArticulationId, root_link: usize, max_dof: usize) -> Self {
+        Self {
+            art,
+            root_link,
+            first_dof: FLOATING_JOINTS.len(),
             max_dof,
         }
     }
@@ -247,6 +270,74 @@ pub fn body_speeds(world: &dyn RigidWorld, body: BodyId) -> (f32, f32) {
 pub fn body_is_static(world: &dyn RigidWorld, body: BodyId, max_v: f32, max_ang_v: f32) -> bool {
     let (v, w) = body_speeds(world, body);
     v <= max_v && w <= max_ang_v
+}
+
+/// Where an object's root link stands relative to the goal, as the success checks of the
+/// floating-object MS1 tasks (PushChair, MoveBucket) read it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RootMetrics {
+    /// Distance (m, world xy) of the root to the goal.
+    pub dist: f32,
+    /// Angle (rad) between the root's z axis and the world's.
+    pub tilt: f32,
+    /// Linear speed (m/s) of the root's body (∞ when it has none).
+    pub speed: f32,
+    /// Angular speed (rad/s) of the root's body (∞ when it has none).
+    pub ang_speed: f32,
+}
+
+impl RootMetrics {
+    /// The metrics of link `root_link` of `art` (at the identity pose when it has none)
+    /// against the goal `target_xy` (m, world xy).
+    pub fn of(
+        world: &dyn RigidWorld,
+        art: ArticulationId,
+        root_link: usize,
+        target_xy: [f32; 2],
+    ) -> Self {
+        let pose = world
+            .link_pose(art, root_link)
+            .unwrap_or_else(|_| Pose3::identity());
+        let p = pose.translation.vector;
+        let dist = (p.x - target_xy[0]).hypot(p.y - target_xy[1]);
+        let up = pose.rotation * Vector3::z();
+        let tilt = up.z.clamp(-1.0, 1.0).acos();
+        let (speed, ang_speed) = world
+            .link_body(art, root_link)
+            .map_or((f32::INFINITY, f32::INFINITY), |b| body_speeds(world, b));
+        Self {
+            dist,
+            tilt,
+            speed,
+            ang_speed,
+        }
+    }
+
+    /// Whether the root moves and turns at most [`STATIC_SPEEDS`].
+    pub fn is_static(&self) -> bool {
+        self.speed <= STATIC_SPEEDS.0 && self.ang_speed <= STATIC_SPEEDS.1
+    }
+
+    /// ManiSkill2's info terms of the metrics, for the object called `name`:
+    /// `dist_{name}_to_target` (m), `{name}_tilt` (rad), `{name}_vel_norm` (m/s) and
+    /// `{name}_ang_vel_norm` (rad/s).
+    pub fn terms(&self, name: &str) -> Info {
+        vec![
+            (
+                format!("dist_{name}_to_target"),
+                InfoValue::F64(f64::from(self.dist)),
+            ),
+            (format!("{name}_tilt"), InfoValue::F64(f64::from(self.tilt))),
+            (
+                format!("{name}_vel_norm"),
+                InfoValue::F64(f64::from(self.speed)),
+            ),
+            (
+                format!("{name}_ang_vel_norm"),
+                InfoValue::F64(f64::from(self.ang_speed)),
+            ),
+        ]
+    }
 }
 
 #[cfg(test)]

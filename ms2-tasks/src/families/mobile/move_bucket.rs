@@ -38,9 +38,10 @@ use nalgebra::{Point3, Vector3};
 use rand::Rng;
 
 use super::common::{
-    body_speeds, overhead_render_camera, place_robot, push_privileged_extra, push_tcp_poses,
-    BaseRing, ObservedArticulation,
+    overhead_render_camera, place_robot, push_privileged_extra, push_tcp_poses, BaseRing,
+    ObservedArticulation, RootMetrics,
 };
+pub use super::common::{LINK_SAMPLES, STATIC_SPEEDS, TARGET_XY};
 use super::surface::LinkSurface;
 use crate::error::EnvError;
 use crate::families::articulated::common::{union_bounds, visual_bounds};
@@ -70,22 +71,16 @@ pub const FRICTION: f32 = 0.5;
 pub const PLATFORM_HALF_SIZE: [f32; 3] = [0.3, 0.3, 0.1];
 /// Radius (m) of the ball.
 pub const BALL_RADIUS: f32 = 0.05;
-/// Goal of the bucket's root (m, world xy).
-pub const TARGET_XY: [f32; 2] = [0.0, 0.0];
 /// Success distance (m, xy) of the root to the goal.
 pub const SUCCESS_DISTANCE: f32 = 0.3;
 /// Largest tilt (rad) of a standing bucket.
 pub const MAX_TILT: f32 = 0.1 * PI;
-/// Largest root speed (m/s) and angular speed (rad/s) of a static bucket.
-pub const STATIC_SPEEDS: (f32, f32) = (0.1, 0.2);
 /// Lift height (m) of the robot's start.
 pub const START_LIFT: f32 = 0.5;
 /// Fraction of the handle's range cut off at each end.
 pub const HANDLE_RANGE_MARGIN: f32 = 0.1;
 /// Physics steps run at the end of the reset (the ball falls in).
 pub const SETTLE_STEPS: usize = 25;
-/// Surface samples per bucket link of the reward's distance term (ManiSkill2: 512).
-pub const LINK_SAMPLES: usize = 512;
 
 /// `MoveBucket-v1` (see the module docs).
 #[derive(Debug)]
@@ -269,12 +264,10 @@ impl Task for MoveBucket {
         world: &mut dyn RigidWorld,
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
-        let ids = self.models.ids();
-        self.model_id = ids[rng.random_range(0..ids.len())].to_owned();
+        self.model_id = self.models.draw(rng);
         let info = self.models.info(&self.model_id)?;
         let scale = info.scale.unwrap_or(1.0);
-        let urdf = ms2_assets::partnet::find_urdf(&self.models.root, &self.model_id)
-            .map_err(|e| EnvError::Asset(e.to_string()))?;
+        let urdf = self.models.urdf(&self.model_id)?;
         self.ball = Some(add_platform_and_ball(world)?);
         let mut desc = with_floating_root(&*load_model(&urdf, scale, BUCKET_DENSITY)?);
         // The handle: the first movable joint after the floating root's, its range narrowed.
@@ -397,12 +390,7 @@ impl Task for MoveBucket {
         let (Some(art), Some(ball)) = (self.bucket, self.ball) else {
             return;
         };
-        let bucket = ObservedArticulation {
-            art,
-            root_link: self.root_link,
-            first_dof: FLOATING_JOINTS.len(),
-            max_dof: BUCKET_MAX_DOF,
-        };
+        let bucket = ObservedArticulation::floating(art, self.root_link, BUCKET_MAX_DOF);
         // An error here means a robot other than the mobile Panda: the spec refuses it.
         let _ = push_privileged_extra(scene, &[ball], &[bucket], extra);
     }
@@ -413,33 +401,21 @@ impl Task for MoveBucket {
 
     fn evaluate(&self, scene: &TaskScene) -> Evaluation {
         let world = scene.world.as_ref();
-        let pose = self.bucket_pose(world);
-        let p = pose.translation.vector;
-        let dist = (p.x - self.target_xy[0]).hypot(p.y - self.target_xy[1]);
-        let up = pose.rotation * Vector3::z();
-        let tilt = up.z.clamp(-1.0, 1.0).acos();
-        let (v, w) = world
-            .link_body(self.bucket(), self.root_link)
-            .map_or((f32::INFINITY, f32::INFINITY), |b| body_speeds(world, b));
+        let m = RootMetrics::of(world, self.bucket(), self.root_link, self.target_xy);
         let inside = self.ball_in_bucket(world);
-        let above = dist < SUCCESS_DISTANCE;
-        let standing = tilt < MAX_TILT;
-        let is_static = v <= STATIC_SPEEDS.0 && w <= STATIC_SPEEDS.1;
+        let above = m.dist < SUCCESS_DISTANCE;
+        let standing = m.tilt < MAX_TILT;
+        let is_static = m.is_static();
+        let mut terms = vec![
+            ("balls_in_bucket".into(), InfoValue::Bool(inside)),
+            ("bucket_above_platform".into(), InfoValue::Bool(above)),
+            ("bucket_standing".into(), InfoValue::Bool(standing)),
+            ("bucket_static".into(), InfoValue::Bool(is_static)),
+        ];
+        terms.extend(m.terms("bucket"));
         Evaluation {
             success: inside && above && standing && is_static,
-            terms: vec![
-                ("balls_in_bucket".into(), InfoValue::Bool(inside)),
-                ("bucket_above_platform".into(), InfoValue::Bool(above)),
-                ("bucket_standing".into(), InfoValue::Bool(standing)),
-                ("bucket_static".into(), InfoValue::Bool(is_static)),
-                (
-                    "dist_bucket_to_target".into(),
-                    InfoValue::F64(f64::from(dist)),
-                ),
-                ("bucket_tilt".into(), InfoValue::F64(f64::from(tilt))),
-                ("bucket_vel_norm".into(), InfoValue::F64(f64::from(v))),
-                ("bucket_ang_vel_norm".into(), InfoValue::F64(f64::from(w))),
-            ],
+            terms,
         }
     }
 

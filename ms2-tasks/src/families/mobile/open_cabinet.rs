@@ -337,12 +337,10 @@ impl Task for OpenCabinet {
         world: &mut dyn RigidWorld,
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
-        let ids = self.models.ids();
-        self.model_id = ids[rng.random_range(0..ids.len())].to_owned();
+        self.model_id = self.models.draw(rng);
         let info = self.models.info(&self.model_id)?.clone();
         let desc = self.models.load(&self.model_id)?;
-        let urdf = ms2_assets::partnet::find_urdf(&self.models.root, &self.model_id)
-            .map_err(|e| EnvError::Asset(e.to_string()))?;
+        let urdf = self.models.urdf(&self.model_id)?;
         let handles = read_handles(&urdf, info.effective_scale())?;
         let art = add_articulated_object(world, &desc, |_| JointDynamics {
             friction: 0.1,

@@ -43,8 +43,9 @@ use rand::Rng;
 
 use super::common::{
     body_speeds, mobile_agent, overhead_render_camera, place_robot, push_privileged_extra,
-    push_tcp_poses, BaseRing, ObservedArticulation,
+    push_tcp_poses, BaseRing, ObservedArticulation, RootMetrics,
 };
+pub use super::common::{LINK_SAMPLES, TARGET_XY};
 use super::handles::link_visual_names;
 use super::surface::LinkSurface;
 use crate::error::EnvError;
@@ -74,10 +75,6 @@ pub const CHAIR_DENSITY: f32 = 200.0;
 pub const CHAIR_FRICTION: f32 = 0.1;
 /// Friction of the wheels.
 pub const WHEEL_FRICTION: f32 = 1.0;
-/// Surface samples per chair link of the reward's distance term (ManiSkill2: 512).
-pub const LINK_SAMPLES: usize = 512;
-/// Goal of the chair's root (m, world xy).
-pub const TARGET_XY: [f32; 2] = [0.0, 0.0];
 
 /// Radius (m) of the goal marker of human renders (ManiSkill2's target indicator; the success
 /// threshold is 0.15 m too).
@@ -242,10 +239,8 @@ impl Task for PushChair {
         world: &mut dyn RigidWorld,
         rng: &mut EpisodeRng,
     ) -> Result<(), EnvError> {
-        let ids = self.models.ids();
-        self.model_id = ids[rng.random_range(0..ids.len())].to_owned();
-        let urdf = ms2_assets::partnet::find_urdf(&self.models.root, &self.model_id)
-            .map_err(|e| EnvError::Asset(e.to_string()))?;
+        self.model_id = self.models.draw(rng);
+        let urdf = self.models.urdf(&self.model_id)?;
         let desc = if self.partnet {
             load_model(&urdf, PARTNET_CHAIR_SCALE, CHAIR_DENSITY)?
         } else {
@@ -385,12 +380,7 @@ impl Task for PushChair {
         let Some(art) = self.chair else {
             return;
         };
-        let chair = ObservedArticulation {
-            art,
-            root_link: self.root_link,
-            first_dof: FLOATING_JOINTS.len(),
-            max_dof: CHAIR_MAX_DOF,
-        };
+        let chair = ObservedArticulation::floating(art, self.root_link, CHAIR_MAX_DOF);
         // An error here means a robot other than the mobile Panda: the spec refuses it.
         let _ = push_privileged_extra(scene, &[], &[chair], extra);
     }
@@ -401,31 +391,19 @@ impl Task for PushChair {
 
     fn evaluate(&self, scene: &TaskScene) -> Evaluation {
         let world = scene.world.as_ref();
-        let pose = self.chair_pose(world);
-        let p = pose.translation.vector;
-        let dist = (p.x - self.target_xy[0]).hypot(p.y - self.target_xy[1]);
-        let up = pose.rotation * Vector3::z();
-        let tilt = up.z.clamp(-1.0, 1.0).acos();
-        let (v, w) = world
-            .link_body(self.chair(), self.root_link)
-            .map_or((f32::INFINITY, f32::INFINITY), |b| body_speeds(world, b));
-        let close = dist < SUCCESS_DISTANCE;
-        let standing = tilt < MAX_TILT;
-        let is_static = v <= 0.1 && w <= 0.2;
+        let m = RootMetrics::of(world, self.chair(), self.root_link, self.target_xy);
+        let close = m.dist < SUCCESS_DISTANCE;
+        let standing = m.tilt < MAX_TILT;
+        let is_static = m.is_static();
+        let mut terms = vec![
+            ("chair_close_to_target".into(), InfoValue::Bool(close)),
+            ("chair_standing".into(), InfoValue::Bool(standing)),
+            ("chair_static".into(), InfoValue::Bool(is_static)),
+        ];
+        terms.extend(m.terms("chair"));
         Evaluation {
             success: close && standing && is_static,
-            terms: vec![
-                ("chair_close_to_target".into(), InfoValue::Bool(close)),
-                ("chair_standing".into(), InfoValue::Bool(standing)),
-                ("chair_static".into(), InfoValue::Bool(is_static)),
-                (
-                    "dist_chair_to_target".into(),
-                    InfoValue::F64(f64::from(dist)),
-                ),
-                ("chair_tilt".into(), InfoValue::F64(f64::from(tilt))),
-                ("chair_vel_norm".into(), InfoValue::F64(f64::from(v))),
-                ("chair_ang_vel_norm".into(), InfoValue::F64(f64::from(w))),
-            ],
+            terms,
         }
     }
 

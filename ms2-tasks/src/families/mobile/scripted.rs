@@ -18,7 +18,7 @@ use crate::env::Env;
 use crate::error::EnvError;
 use crate::geometry::{wrap_angle, Pose3};
 use crate::scripted::oracle::{GRIPPER_CLOSED, GRIPPER_OPEN};
-use crate::scripted::{no_policy, ScriptedPolicy};
+use crate::scripted::{require_control_mode, ScriptedPolicy};
 
 /// The control modes the oracle drives: absolute arm joint targets, or (the tasks' default)
 /// arm joint velocities toward them.
@@ -70,12 +70,7 @@ pub struct OpenCabinetPolicy {
 
 /// The cabinet oracle for `env` (an error in another control mode).
 pub fn policy(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
-    if !ORACLE_MODES.contains(&env.control_mode()) {
-        return Err(no_policy(
-            env,
-            &format!("the cabinet oracle drives control_mode in {ORACLE_MODES:?}"),
-        ));
-    }
+    require_control_mode(env, &ORACLE_MODES, "the cabinet oracle")?;
     Ok(Box::new(OpenCabinetPolicy {
         joint_velocity: env.control_mode() == ORACLE_MODES[1],
         phase: Phase::Standoff,
