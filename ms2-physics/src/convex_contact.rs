@@ -24,11 +24,9 @@
 
 use parry3d::math::{Pose, Vector};
 use parry3d::query::{
-    ClosestPoints, Contact, ContactManifold, ContactManifoldsWorkspace, NonlinearRigidMotion,
-    PersistentQueryDispatcher, QueryDispatcher, ShapeCastHit, ShapeCastOptions, TrackedContact,
+    ContactManifold, ContactManifoldsWorkspace, PersistentQueryDispatcher, TrackedContact,
     Unsupported,
 };
-use parry3d::query::{ShapeDistance, ShapeIntersection};
 use parry3d::shape::{ConvexPolyhedron, PackedFeatureId, PolygonalFeature, Shape};
 
 /// cos(1°): a manifold is reused without a new SAT when the relative rotation changed less.
@@ -245,69 +243,78 @@ fn polyhedra<'a>(
     ))
 }
 
-impl QueryDispatcher for SatConvexDispatcher {
-    fn intersection_test(
-        &self,
-        _: &Pose,
-        _: &dyn Shape,
-        _: &dyn Shape,
-    ) -> Result<ShapeIntersection, Unsupported> {
-        Err(Unsupported)
-    }
+/// Implements parry's `QueryDispatcher` for a dispatcher that only computes contact manifolds:
+/// every other query answers `Unsupported`, so that the next dispatcher in the chain takes it.
+macro_rules! manifolds_only_dispatcher {
+    ($t:ty) => {
+        impl parry3d::query::QueryDispatcher for $t {
+            fn intersection_test(
+                &self,
+                _: &parry3d::math::Pose,
+                _: &dyn parry3d::shape::Shape,
+                _: &dyn parry3d::shape::Shape,
+            ) -> Result<parry3d::query::ShapeIntersection, parry3d::query::Unsupported> {
+                Err(parry3d::query::Unsupported)
+            }
 
-    fn distance(
-        &self,
-        _: &Pose,
-        _: &dyn Shape,
-        _: &dyn Shape,
-    ) -> Result<ShapeDistance, Unsupported> {
-        Err(Unsupported)
-    }
+            fn distance(
+                &self,
+                _: &parry3d::math::Pose,
+                _: &dyn parry3d::shape::Shape,
+                _: &dyn parry3d::shape::Shape,
+            ) -> Result<parry3d::query::ShapeDistance, parry3d::query::Unsupported> {
+                Err(parry3d::query::Unsupported)
+            }
 
-    fn contact(
-        &self,
-        _: &Pose,
-        _: &dyn Shape,
-        _: &dyn Shape,
-        _: f32,
-    ) -> Result<Option<Contact>, Unsupported> {
-        Err(Unsupported)
-    }
+            fn contact(
+                &self,
+                _: &parry3d::math::Pose,
+                _: &dyn parry3d::shape::Shape,
+                _: &dyn parry3d::shape::Shape,
+                _: f32,
+            ) -> Result<Option<parry3d::query::Contact>, parry3d::query::Unsupported> {
+                Err(parry3d::query::Unsupported)
+            }
 
-    fn closest_points(
-        &self,
-        _: &Pose,
-        _: &dyn Shape,
-        _: &dyn Shape,
-        _: f32,
-    ) -> Result<ClosestPoints, Unsupported> {
-        Err(Unsupported)
-    }
+            fn closest_points(
+                &self,
+                _: &parry3d::math::Pose,
+                _: &dyn parry3d::shape::Shape,
+                _: &dyn parry3d::shape::Shape,
+                _: f32,
+            ) -> Result<parry3d::query::ClosestPoints, parry3d::query::Unsupported> {
+                Err(parry3d::query::Unsupported)
+            }
 
-    fn cast_shapes(
-        &self,
-        _: &Pose,
-        _: Vector,
-        _: &dyn Shape,
-        _: &dyn Shape,
-        _: ShapeCastOptions,
-    ) -> Result<Option<ShapeCastHit>, Unsupported> {
-        Err(Unsupported)
-    }
+            fn cast_shapes(
+                &self,
+                _: &parry3d::math::Pose,
+                _: parry3d::math::Vector,
+                _: &dyn parry3d::shape::Shape,
+                _: &dyn parry3d::shape::Shape,
+                _: parry3d::query::ShapeCastOptions,
+            ) -> Result<Option<parry3d::query::ShapeCastHit>, parry3d::query::Unsupported> {
+                Err(parry3d::query::Unsupported)
+            }
 
-    fn cast_shapes_nonlinear(
-        &self,
-        _: &NonlinearRigidMotion,
-        _: &dyn Shape,
-        _: &NonlinearRigidMotion,
-        _: &dyn Shape,
-        _: f32,
-        _: f32,
-        _: bool,
-    ) -> Result<Option<ShapeCastHit>, Unsupported> {
-        Err(Unsupported)
-    }
+            fn cast_shapes_nonlinear(
+                &self,
+                _: &parry3d::query::NonlinearRigidMotion,
+                _: &dyn parry3d::shape::Shape,
+                _: &parry3d::query::NonlinearRigidMotion,
+                _: &dyn parry3d::shape::Shape,
+                _: f32,
+                _: f32,
+                _: bool,
+            ) -> Result<Option<parry3d::query::ShapeCastHit>, parry3d::query::Unsupported> {
+                Err(parry3d::query::Unsupported)
+            }
+        }
+    };
 }
+pub(crate) use manifolds_only_dispatcher;
+
+manifolds_only_dispatcher!(SatConvexDispatcher);
 
 impl<ManifoldData, ContactData> PersistentQueryDispatcher<ManifoldData, ContactData>
     for SatConvexDispatcher

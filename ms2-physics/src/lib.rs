@@ -57,6 +57,9 @@ pub mod contact;
 pub mod convex_contact;
 pub mod description;
 pub mod error;
+pub mod graph_hull;
+#[cfg(feature = "rapier")]
+pub mod halfspace_cull;
 mod ids;
 #[cfg(feature = "rapier")]
 mod joints;

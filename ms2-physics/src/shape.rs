@@ -187,12 +187,22 @@ fn convex_hull(points: &[Point3<f32>]) -> Result<SharedShape> {
         )));
     }
     let pts: Vec<_> = points.iter().map(|p| vec_from_na(&p.coords)).collect();
-    SharedShape::convex_hull(&pts).ok_or_else(|| {
+    let poly = parry3d::shape::ConvexPolyhedron::from_convex_hull(&pts).ok_or_else(|| {
         PhysicsError::InvalidShape(format!(
             "convex hull of {} points failed: expected at least 4 points not all coplanar",
             points.len()
         ))
-    })
+    })?;
+    // Hulls too large for the SAT contact path (a robot link's 100-150 vertices) answer their
+    // support and AABB queries by a graph walk; small ones stay parry's polyhedron, which the
+    // SAT path recognises.
+    Ok(
+        if poly.points().len() > crate::convex_contact::MAX_SAT_VERTICES {
+            SharedShape::new(crate::graph_hull::GraphHull::new(poly))
+        } else {
+            SharedShape::new(poly)
+        },
+    )
 }
 
 /// A physical material: friction and restitution of a shape's surface.

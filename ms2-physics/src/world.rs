@@ -1,7 +1,8 @@
 //! The rigid world: rapier's sets, the body table, actors, stepping and body queries.
 
-use std::collections::HashSet;
 use std::sync::Mutex;
+
+use rustc_hash::FxHashSet;
 
 use nalgebra::Vector3;
 use rapier3d::prelude::{
@@ -15,6 +16,7 @@ pub use crate::actor::{ActorDesc, ActorKind};
 use crate::articulation::Articulation;
 use crate::config::WorldConfig;
 use crate::error::{check_finite, check_non_negative, check_pose_finite, PhysicsError, Result};
+use crate::halfspace_cull::HalfSpaceCullDispatcher;
 pub use crate::ids::{BodyId, BodyKind};
 use crate::math::{pose_from_na, vec_from_na};
 use crate::shape::{ShapeSpec, VisualShape};
@@ -35,7 +37,7 @@ pub(crate) struct BodyEntry {
 /// Body pairs whose contacts are ignored (robot links that touch at rest), as a rapier hook.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ExcludedPairs {
-    pub(crate) pairs: HashSet<(u32, u32)>,
+    pub(crate) pairs: FxHashSet<(u32, u32)>,
 }
 
 impl ExcludedPairs {
@@ -126,10 +128,14 @@ impl World {
                 broad_phase: BroadPhaseBvh::new(),
                 narrow_phase: if s.sat_convex_contacts {
                     NarrowPhase::with_query_dispatcher(
-                        crate::convex_contact::SatConvexDispatcher.chain(DefaultQueryDispatcher),
+                        HalfSpaceCullDispatcher
+                            .chain(crate::convex_contact::SatConvexDispatcher)
+                            .chain(DefaultQueryDispatcher),
                     )
                 } else {
-                    NarrowPhase::new()
+                    NarrowPhase::with_query_dispatcher(
+                        HalfSpaceCullDispatcher.chain(DefaultQueryDispatcher),
+                    )
                 },
                 bodies: RigidBodySet::new(),
                 colliders: ColliderSet::new(),
