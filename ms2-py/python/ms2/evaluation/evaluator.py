@@ -46,6 +46,19 @@ def check_env_id(env_id: str) -> str:
     return env_id
 
 
+def _episode_identity(env: Any) -> tuple[int | None, str | None]:
+    """The current episode's seed and asset model id (``None`` where there is none)."""
+    try:
+        seed: int | None = int(env.episode_seed)
+    except (AttributeError, ValueError, TypeError, RuntimeError):
+        seed = None
+    try:
+        model_id: str | None = str(env.model_id)
+    except (AttributeError, ValueError, RuntimeError):
+        model_id = None
+    return seed, model_id
+
+
 class Evaluator:
     """Evaluates ``policy_cls`` (a ``UserPolicy`` class) on episodes of ``env_id``.
 
@@ -179,10 +192,11 @@ class Evaluator:
             path = env.flush_video()
             env.flush_trajectory()
             video = str(path) if path is not None else None
-        seed = getattr(env.unwrapped, "episode_seed", None)
+        seed, model_id = _episode_identity(env.unwrapped)
         return EpisodeResult(
             episode_id=episode.episode_id,
-            seed=None if seed is None else int(seed),
+            seed=seed,
+            model_id=model_id,
             metrics=metrics,
             seconds=time.perf_counter() - started,
             failure_kind=None if failure is None else failure.kind,

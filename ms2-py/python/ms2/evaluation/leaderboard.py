@@ -27,8 +27,8 @@ h1 {{ font-size: 22px; margin: 0 0 12px 0; }}
 p.note {{ color: #444; font-size: 13px; margin: 0 0 16px 0; }}
 table.leaderboard {{ border-collapse: collapse; font-size: 15px; }}
 table.leaderboard th {{ background: {HEADER_BACKGROUND}; color: #fff; text-align: left;
-  padding: 8px 14px; }}
-table.leaderboard td {{ padding: 8px 14px; border-bottom: 1px solid #c8d3e6; }}
+  padding: 8px 14px; white-space: nowrap; }}
+table.leaderboard td {{ padding: 8px 14px; border-bottom: 1px solid #c8d3e6; white-space: nowrap; }}
 table.leaderboard tr.band0 td {{ background: {ROW_BACKGROUNDS[0]}; }}
 table.leaderboard tr.band1 td {{ background: {ROW_BACKGROUNDS[1]}; }}
 td.num {{ text-align: right; font-variant-numeric: tabular-nums; }}

@@ -9,8 +9,9 @@ name and renamed (a reader never sees half a file):
   Every episode has the same keys.
 * ``average_metrics.json`` — ManiSkill2's: ``{metric: mean over the episodes}``.
 * ``results.json`` — ms2's summary: the task, solution, modes, split, counts, success rate,
-  mean episode length, the averages, and one entry per episode (seed, success, steps, seconds,
-  failure kind and reason, video). ``ms2 leaderboard`` reads it.
+  mean episode length, the averages, and one entry per episode (seed, asset model where the
+  task draws one, success, steps, seconds, failure kind and reason, video). ``ms2 leaderboard``
+  reads it.
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ class EpisodeResult:
     failure_reason: str | None = None
     failure_step: int | None = None
     video: str | None = None
+    model_id: str | None = None
 
     @property
     def failed(self) -> bool:
@@ -70,6 +72,7 @@ class EpisodeResult:
         return {
             "episode_id": self.episode_id,
             "seed": self.seed,
+            "model_id": self.model_id,
             "success": self.success,
             "elapsed_steps": int(self.metrics.get("elapsed_steps", 0)),
             "seconds": round(self.seconds, 4),
