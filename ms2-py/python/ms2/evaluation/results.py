@@ -204,7 +204,7 @@ def read_results(path: str | os.PathLike[str]) -> dict[str, Any]:
     """Reads an evaluation's ``results.json`` (``path`` is the file or its directory);
     ``ValueError`` naming the file if it is missing, not JSON or not ms2's layout."""
     path = Path(path)
-    if path.is_dir():
+    if path.is_dir() or path.suffix != ".json":
         path = path / RESULTS_FILE
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
