@@ -47,7 +47,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
             name=args.name,
             progress=not args.quiet,
         )
-    except (ValueError, TypeError, OSError) as err:
+    except (ValueError, TypeError, RuntimeError, OSError) as err:
         # As ManiSkill2's evaluation: the reason also goes to <output>/error.log.
         try:
             write_text_atomic(Path(args.output_dir) / ERROR_LOG_FILE, f"{err}\n")

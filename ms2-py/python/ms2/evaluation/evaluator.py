@@ -46,6 +46,19 @@ def check_env_id(env_id: str) -> str:
     return env_id
 
 
+def _check_video_support() -> None:
+    """``RuntimeError`` naming the ``video`` extra if imageio / imageio-ffmpeg are missing (checked
+    before any episode runs, rather than failing at the first video)."""
+    try:
+        import imageio.v2  # noqa: F401
+        import imageio_ffmpeg  # noqa: F401
+    except ImportError as err:
+        raise RuntimeError(
+            f"recording videos (record_dir / --record-dir) needs imageio and imageio-ffmpeg "
+            f"({err}): pip install 'ms2[video]'"
+        ) from err
+
+
 def _episode_identity(env: Any) -> tuple[int | None, str | None]:
     """The current episode's seed and asset model id (``None`` where there is none)."""
     try:
@@ -93,6 +106,8 @@ class Evaluator:
         self.caller = PolicyCaller(step_time_limit)
         self.obs_mode = self._ask_mode("get_obs_mode")
         self.control_mode = self._ask_mode("get_control_mode")
+        if record_dir is not None:
+            _check_video_support()
         render_mode = "rgb_array" if record_dir is not None else None
         make_kwargs = dict(env_kwargs or {})
         try:
