@@ -318,6 +318,7 @@ def test_bad_reset_option_fails_only_that_episode(tmp_path):
     summary = run_evaluation("PickCube-v0", RandomPolicy, tmp_path, config=config)
     bad, good = summary["episodes"]
     assert bad["failure"]["kind"] == "env_error" and "no_such_option" in bad["failure"]["reason"]
+    assert (bad["seed"], bad["elapsed_steps"]) == (0, 0)
     assert good["failure"] is None and good["elapsed_steps"] == 2
     per_episode = read_json(tmp_path / "episode_results.json")
     assert set(per_episode["bad"]) == set(per_episode["good"])  # keys filled in
@@ -438,3 +439,44 @@ def test_step_time_limit_option_is_checked(capsys):
         )
     assert info.value.code == 2
     assert "expected a positive number of seconds, got '-1'" in capsys.readouterr().err
+
+
+class _HangsThenCannotRebuild(BasePolicy):
+    """Hangs in its first act(); every policy object after the first fails to build."""
+
+    built = 0
+
+    def __init__(self, *args):
+        type(self).built += 1
+        if type(self).built > 1:
+            raise MemoryError("out of GPU memory")
+        super().__init__(*args)
+
+    def act(self, observations):
+        time.sleep(1.0)
+        return np.zeros(self.action_space.shape)
+
+    @classmethod
+    def get_obs_mode(cls, env_id):
+        return "state"
+
+    @classmethod
+    def get_control_mode(cls, env_id):
+        return None
+
+
+def test_policy_rebuilt_after_a_timeout_and_its_failure_recorded(tmp_path):
+    episodes = [EpisodeConfig(i, {"seed": 10 + i}) for i in range(3)]
+    config = EvaluationConfig("PickCube-v0", {"max_episode_steps": 2}, episodes)
+    summary = run_evaluation(
+        "PickCube-v0", _HangsThenCannotRebuild, tmp_path, config=config, step_time_limit=0.2
+    )
+    kinds = [e["failure"]["kind"] for e in summary["episodes"]]
+    assert kinds == ["timeout", "exception", "exception"]
+    for episode in summary["episodes"][1:]:
+        assert (
+            "_HangsThenCannotRebuild('PickCube-v0', observation_space, action_space) raised "
+            "MemoryError: out of GPU memory" in episode["failure"]["reason"]
+        )
+    assert [e["seed"] for e in summary["episodes"]] == [10, 11, 12]
+    assert _HangsThenCannotRebuild.built == 3  # one try per episode after the timeout

@@ -167,15 +167,17 @@ class Evaluator:
         steps = 0
         failure: PolicyFailure | None = None
         abandoned_before = self.caller.abandoned
+        was_reset = False
         try:
-            if self.policy is None:  # the previous one was abandoned mid-call
-                self.policy = self._new_policy()
             try:
                 obs, info = env.reset(**episode.reset_kwargs)
             except (ValueError, TypeError, RuntimeError) as err:
                 raise PolicyFailure(
                     "env_error", f"env.reset(**{episode.reset_kwargs}) failed: {err}"
                 ) from err
+            was_reset = True
+            if self.policy is None:  # the previous one was abandoned mid-call
+                self.policy = self._new_policy()
             self.caller.call("reset(obs)", self.policy.reset, obs)
             while True:
                 action = self.caller.call("act(obs)", self.policy.act, obs)
@@ -203,11 +205,14 @@ class Evaluator:
             metrics["success"] = 0.0
         metrics["failed"] = float(failure is not None)
         video = None
-        if hasattr(env, "flush_video"):
+        if was_reset and hasattr(env, "flush_video"):
             path = env.flush_video()
             env.flush_trajectory()
             video = str(path) if path is not None else None
-        seed, model_id = _episode_identity(env.unwrapped)
+        if was_reset:
+            seed, model_id = _episode_identity(env.unwrapped)
+        else:  # the env still holds the previous episode
+            seed, model_id = episode.reset_kwargs.get("seed"), None
         return EpisodeResult(
             episode_id=episode.episode_id,
             seed=seed,
