@@ -5,6 +5,7 @@ stable-baselines3 base class only where the package is installed)."""
 from __future__ import annotations
 
 import importlib.util
+import sys
 
 import gymnasium as gym
 import ms2
@@ -153,6 +154,80 @@ def test_sb3_wrapper_without_sb3_names_the_package():
 
     with pytest.raises(ImportError, match="stable-baselines3"):
         _ = ms2.wrappers.SB3VecEnvWrapper
+
+
+#: A stand-in for stable-baselines3's ``VecEnv`` base class (its constructor and abstract
+#: methods), to test how SB3VecEnvWrapper is built where the real package is not installed.
+FAKE_SB3_BASE = """
+from abc import ABC, abstractmethod
+
+
+class VecEnv(ABC):
+    def __init__(self, num_envs, observation_space, action_space):
+        self.num_envs = num_envs
+        self.observation_space = observation_space
+        self.action_space = action_space
+        self.reset_infos = [{} for _ in range(num_envs)]
+        self.render_mode = self.get_attr("render_mode")[0]
+
+    def step(self, actions):
+        self.step_async(actions)
+        return self.step_wait()
+
+    @abstractmethod
+    def reset(self, *args, **kwargs): ...
+
+    @abstractmethod
+    def step_async(self, *args, **kwargs): ...
+
+    @abstractmethod
+    def step_wait(self, *args, **kwargs): ...
+
+    @abstractmethod
+    def close(self, *args, **kwargs): ...
+
+    @abstractmethod
+    def get_attr(self, *args, **kwargs): ...
+
+    @abstractmethod
+    def set_attr(self, *args, **kwargs): ...
+
+    @abstractmethod
+    def env_method(self, *args, **kwargs): ...
+
+    @abstractmethod
+    def env_is_wrapped(self, *args, **kwargs): ...
+"""
+
+
+@pytest.mark.skipif(HAVE_SB3, reason="stable-baselines3 is installed (tested for real below)")
+def test_sb3_vec_env_wrapper_class_over_a_stand_in_base(tmp_path, monkeypatch):
+    package = tmp_path / "stable_baselines3" / "common" / "vec_env"
+    package.mkdir(parents=True)
+    for folder in (package, package.parent, package.parent.parent):
+        (folder / "__init__.py").write_text("")
+    (package / "base_vec_env.py").write_text(FAKE_SB3_BASE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    from ms2.wrappers import sb3_vec_env
+
+    sb3_vec_env._sb3_vec_env_class.cache_clear()
+    try:
+        from ms2.wrappers import SB3VecEnvWrapper
+        from stable_baselines3.common.vec_env.base_vec_env import VecEnv
+
+        venv = SB3VecEnvWrapper(ms2.make_vec(MAIN_ID, num_envs=2, max_episode_steps=2))
+        assert isinstance(venv, VecEnv) and isinstance(venv, SB3VecEnvAdapter)
+        assert SB3VecEnvWrapper.__module__ == "ms2.wrappers.sb3_vec_env"
+        assert venv.render_mode is None and venv.num_envs == 2
+        venv.reset()
+        venv.step(np.zeros((2, *venv.action_space.shape)))
+        _, _, dones, infos = venv.step(np.zeros((2, *venv.action_space.shape)))
+        assert dones.all() and "terminal_observation" in infos[1]
+        venv.close()
+    finally:
+        sb3_vec_env._sb3_vec_env_class.cache_clear()
+        for name in [m for m in sys.modules if m.startswith("stable_baselines3")]:
+            del sys.modules[name]
 
 
 def test_sb3_vec_env_wrapper():
