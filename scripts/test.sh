@@ -12,14 +12,15 @@ bash scripts/check_repo.sh
 bash scripts/test_check_repo.sh
 bash scripts/setup.sh
 # The viewer's tests (ms2-py/tests/test_viewer.py, test_teleop.py) open windows on a virtual X
-# server and drive them with synthetic key and mouse events.
-TEST_APT_PACKAGES=(xvfb xdotool)
+# server and drive them with synthetic key and mouse events; the leaderboard's test
+# (test_leaderboard.py) screenshots its HTML page in headless Chromium.
+TEST_APT_PACKAGES=(xvfb xdotool chromium)
 missing=()
 for p in "${TEST_APT_PACKAGES[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
 done
 if [ "${#missing[@]}" -gt 0 ]; then
-  echo "[test] installing Debian packages for the viewer tests: ${missing[*]}"
+  echo "[test] installing Debian packages for the viewer and leaderboard tests: ${missing[*]}"
   SUDO=""; if [ "$(id -u)" != "0" ]; then SUDO="sudo"; fi
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

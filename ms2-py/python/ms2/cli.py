@@ -16,9 +16,13 @@ Subcommands:
   ``X.<obs_mode>.<control_mode>.h5``.
 
 * ``ms2 gallery`` — one picture per task into ``docs/images/tasks/`` (``docs/tasks.md``).
+* ``ms2 evaluate --env-id PickCube-v0 --solution user_solution.py -o results/`` — evaluate a
+  solution's ``UserPolicy`` (ManiSkill2's submission interface, ``docs/evaluation.md``);
+  ``ms2 leaderboard results_a/ results_b/ -o board.html`` — several results as one HTML table.
 
 Short flags mean the same in every subcommand: ``-n`` how many episodes, ``-o`` obs mode, ``-c``
-control mode, ``-w`` worker threads, ``-v`` verbose, ``-q`` no progress bar.
+control mode, ``-w`` worker threads, ``-v`` verbose, ``-q`` no progress bar; except in
+``evaluate`` and ``leaderboard``, where ``-o`` is the output, as in ManiSkill2's evaluation.
 """
 
 from __future__ import annotations
@@ -416,6 +420,7 @@ def _add_gallery_parser(sub: argparse._SubParsersAction) -> None:
 def build_parser() -> argparse.ArgumentParser:
     """The ``ms2`` argument parser with every subcommand."""
     from . import __version__, assets, bench, teleop
+    from .evaluation import cli as evaluation_cli
 
     parser = argparse.ArgumentParser(prog="ms2", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"ms2 {__version__}")
@@ -429,6 +434,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_replay_parser(sub)
     _add_gallery_parser(sub)
     teleop.add_parser(sub)
+    evaluation_cli.add_parser(sub)
     _show_defaults_everywhere(parser)
     return parser
 

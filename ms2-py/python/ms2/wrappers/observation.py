@@ -1,8 +1,6 @@
-"""Gymnasium wrappers with ManiSkill2's names: :class:`RecordEpisode` (from
-:mod:`ms2.recording`) and :class:`FlattenObservationWrapper`, plus :func:`flatten_dict_keys`.
-
-Code written for ManiSkill2 imports them from ``mani_skill2.utils.wrappers`` (and its
-``observation`` submodule) and ``mani_skill2.utils.common``; with ms2 all three come from here.
+"""ManiSkill2's observation wrapper: :class:`FlattenObservationWrapper`, with
+:func:`flatten_dict_keys` (``mani_skill2.utils.wrappers.observation`` and
+``mani_skill2.utils.common`` in ManiSkill2).
 """
 
 from __future__ import annotations
@@ -12,8 +10,6 @@ from typing import Any
 
 import gymnasium as gym
 from gymnasium import spaces
-
-from .recording import RecordEpisode
 
 
 def flatten_dict_keys(tree: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -57,4 +53,4 @@ class FlattenObservationWrapper(gym.ObservationWrapper):
         return observation
 
 
-__all__ = ["FlattenObservationWrapper", "RecordEpisode", "flatten_dict_keys"]
+__all__ = ["FlattenObservationWrapper", "flatten_dict_keys", "flatten_dict_space_keys"]
