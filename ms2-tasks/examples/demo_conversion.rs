@@ -10,10 +10,12 @@
 //! cargo run -p ms2-tasks --release --example demo_conversion -- StackCube-v0 100 \
 //!     pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos --max-retry 1 --source scripted
 //! cargo run -p ms2-tasks --release --example demo_conversion -- PickSingleYCB-v0 0 \
-//!     pd_ee_delta_pose --seeds 6,23,58
+//!     pd_ee_delta_pose --seeds 6,23,58 --track-hand-only
 //! cargo run -p ms2-tasks --release --example demo_conversion -- OpenCabinetDrawer-v1 200 \
 //!     base_pd_joint_vel_arm_pd_ee_delta_pose --source scripted
 //! ```
+//! `--track-hand-only` converts by the source's hand path alone (`ReplayOptions::track_hand_only`,
+//! ManiSkill2's way), without the in-hand correction.
 //! Episodes run in parallel on rayon's pool (`RAYON_NUM_THREADS`); times are CPU-seconds per
 //! episode summed over threads divided by the episode count.
 
@@ -44,6 +46,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(str::to_owned)
         .collect();
     let max_retry: u32 = flag("--max-retry").map_or(Ok(0), |s| s.parse())?;
+    // `--track-hand-only`: convert by the source's hand path alone (no in-hand correction).
+    let track_hand_only = args.iter().any(|a| a == "--track-hand-only");
     let use_solution = match flag("--source").map(String::as_str) {
         Some("scripted") => false,
         Some("solution") => true,
@@ -110,6 +114,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let opts = ReplayOptions {
             target_control_mode: Some(target.clone()),
             max_retry,
+            track_hand_only,
             ..ReplayOptions::default()
         };
         let start = Instant::now();
