@@ -236,6 +236,14 @@ def test_ray_flag_without_ray_installed_says_how_to_install_it(tmp_path, monkeyp
     assert "pip install 'ms2[ray]'" in capsys.readouterr().err
 
 
+def test_an_address_where_no_head_listens_is_named_at_once():
+    from ms2.distributed import check_reachable
+
+    with pytest.raises(RuntimeError, match=r"no Ray head answers at '127\.0\.0\.1:1'"):
+        check_reachable("127.0.0.1:1")
+    check_reachable("auto")  # left to Ray
+
+
 # --- a real cluster (opt-in) -------------------------------------------------------------------
 
 

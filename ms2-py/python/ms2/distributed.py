@@ -20,6 +20,7 @@ dependency (``pip install 'ms2[ray]'``), imported only when a run asks for it.
 from __future__ import annotations
 
 import os
+import socket
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
@@ -248,6 +249,27 @@ def import_ray() -> Any:
     return ray
 
 
+#: Seconds :func:`check_reachable` waits for a head's port.
+CONNECT_TIMEOUT = 5.0
+
+
+def check_reachable(address: str) -> None:
+    """``RuntimeError`` naming ``address`` when it is ``host:port`` and nothing accepts a TCP
+    connection there within :data:`CONNECT_TIMEOUT` (Ray itself would retry for minutes);
+    other forms (``auto``, ``ray://...``) are left to Ray."""
+    host, sep, port = address.rpartition(":")
+    if not sep or not host or not port.isdigit() or "/" in address:
+        return
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=CONNECT_TIMEOUT):
+            pass
+    except OSError as err:
+        raise RuntimeError(
+            f"no Ray head answers at {address!r} ({err}); start one there with `ray start "
+            f"--head --port {port}` or pass the address it printed (see docs/ray.md)"
+        ) from err
+
+
 def init_ray(address: str | None) -> Any:
     """Connects to the Ray cluster at ``address`` (``None``: starts or joins a local one) unless
     this process is connected already; returns the ``ray`` module. ``RuntimeError`` names the
@@ -255,6 +277,8 @@ def init_ray(address: str | None) -> Any:
     ray = import_ray()
     if ray.is_initialized():
         return ray
+    if address is not None:
+        check_reachable(address)
     try:
         ray.init(
             address=address,
@@ -320,6 +344,7 @@ __all__ = [
     "RAY_EXTRA_HINT",
     "RayOptions",
     "add_ray_arguments",
+    "check_reachable",
     "import_ray",
     "init_ray",
     "ray_chunks",
