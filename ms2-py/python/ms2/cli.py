@@ -33,6 +33,8 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
+from .distributed import add_ray_arguments
+
 
 class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
     """Shows every option's default: appended as ``(default: X)`` unless the help text
@@ -158,7 +160,9 @@ def _add_run_parser(sub: argparse._SubParsersAction) -> None:
 
 def _cmd_demos_generate(args: argparse.Namespace) -> int:
     from . import demos
+    from .distributed import ray_options_from_args
 
+    ray = ray_options_from_args(args, num_cpus=args.workers)
     result = demos.generate(
         args.env_id,
         args.num_episodes,
@@ -167,14 +171,17 @@ def _cmd_demos_generate(args: argparse.Namespace) -> int:
         seed=args.seed,
         max_seeds=args.max_seeds,
         policy=args.policy,
+        chunk_size=args.chunk_size,
         progress=not args.quiet,
         control_mode=args.control_mode,
+        ray=ray,
     )
+    where = f"{args.workers} workers" if ray is None else f"Ray tasks of {args.workers} thread(s)"
     print(
         f"wrote {result.num_episodes} {args.env_id} episodes to {result.path} "
         f"({result.seeds_tried} seeds tried, {result.planner_errors} planner errors) in "
-        f"{result.seconds:.1f} s = {result.seconds_per_episode:.3f} s per demo "
-        f"with {args.workers} workers"
+        f"{result.seconds:.1f} s = {result.seconds_per_episode:.3f} s per demo with {where}"
+        + (f", {result.resubmitted_chunks} lost chunk(s) resubmitted" if ray is not None else "")
     )
     return 0
 
@@ -252,7 +259,13 @@ def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
     g.add_argument("env_id", help="task id, e.g. PickCube-v0")
     g.add_argument("-n", "--num-episodes", type=int, default=100, help="demos to keep")
     g.add_argument("--output", "--out", required=True, help="output .h5 (its .json is written too)")
-    g.add_argument("-w", "--workers", type=int, default=1, help="native worker threads")
+    g.add_argument(
+        "-w",
+        "--workers",
+        type=int,
+        default=1,
+        help="native worker threads (with --ray: threads and CPUs of each Ray task)",
+    )
     g.add_argument("--seed", type=int, default=0, help="first episode seed (then +1 each)")
     g.add_argument(
         "--max-seeds", type=int, default=None, help="give up after this many seeds (None: never)"
@@ -270,7 +283,14 @@ def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
         help="control mode of the demos (None: pd_joint_pos, for soft-body envs "
         "pd_joint_delta_pos; other modes than pd_joint_pos need --policy scripted)",
     )
+    g.add_argument(
+        "--chunk-size",
+        type=int,
+        default=None,
+        help="seeds per chunk; the file is committed after each (None: 4 x workers)",
+    )
     g.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    add_ray_arguments(g, "seeds", "the chunk size")
     g.set_defaults(func=_cmd_demos_generate)
     b = demos_sub.add_parser(
         "bench", help="seconds per generated demo and per converted episode", formatter_class=fmt

@@ -15,11 +15,14 @@ replays restore it after ``reset(seed)`` and step the actions (the simulation is
 deterministic); conversions re-simulate the source alongside.
 
 The simulation runs in Rust (``ms2._native.solve_episodes`` / ``scripted_episodes`` /
-``replay_episodes``) with the GIL released, on a pool of ``num_workers`` threads.
+``replay_episodes``) with the GIL released, on a pool of ``num_workers`` threads. With
+``ray=RayOptions(...)`` :func:`generate` runs its chunks of seeds as Ray tasks instead
+(:mod:`ms2.distributed`, docs/ray.md) and writes the same file.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from collections.abc import Iterator, Sequence
@@ -28,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _native, interrupts
+from .distributed import RayOptions, ray_chunks
 from .trajectory import (
     MAX_SEED,
     TrajectoryFileError,
@@ -72,6 +76,16 @@ def _chunks(items: Sequence[Any], size: int) -> Iterator[Sequence[Any]]:
         yield items[start : start + size]
 
 
+def run_seed_chunk(
+    seeds: Sequence[int], policy: str, env_id: str, env_kwargs: dict[str, Any], num_workers: int
+) -> list[dict[str, Any]]:
+    """The episodes of ``seeds`` (in their order) by demonstration source ``policy`` on
+    ``num_workers`` native threads: what :func:`generate` runs per chunk, locally or as a Ray
+    task (a pure function of its arguments, so a retried task gives the same episodes)."""
+    run = _native.solve_episodes if policy == "solution" else _native.scripted_episodes
+    return run(env_id, list(seeds), env_kwargs, num_workers)
+
+
 def _succeeded(episode: dict[str, Any]) -> bool:
     """Whether an episode dict succeeds at its last step."""
     success = episode["success"]
@@ -109,6 +123,8 @@ class GenerateResult(_PerEpisodeCost):
     failed_seeds: list[int] = field(default_factory=list)
     cpu_seconds: float = 0.0
     control_mode: str = SOURCE_CONTROL_MODE
+    #: Ray runs: chunks the driver submitted again after their task was lost.
+    resubmitted_chunks: int = 0
 
 
 def generate(
@@ -122,6 +138,7 @@ def generate(
     chunk_size: int | None = None,
     progress: bool = True,
     control_mode: str | None = None,
+    ray: RayOptions | None = None,
 ) -> GenerateResult:
     """Writes ``num_episodes`` successful demonstrations of ``env_id`` to ``output`` (``.h5``;
     the ``.json`` is written next to it), in ``pd_joint_pos`` (the motion-planning solutions'
@@ -138,6 +155,12 @@ def generate(
     ``"scripted"`` (the scripted oracle). Raises ``ValueError`` for bad arguments or an env
     without that policy; ``RuntimeError`` when fewer episodes than asked succeeded within
     ``max_seeds`` (the file then holds those that did).
+
+    ``ray``: run the seeds as Ray tasks of ``ray.task_size`` seeds (default ``chunk_size``)
+    with ``ray.num_cpus`` threads each, on the cluster ``ray.address``. The driver takes the
+    episodes back in seed order and commits the file exactly as a local run with the same
+    ``num_workers`` and ``chunk_size`` (seeds beyond those a local run would try are run
+    ahead on idle workers and discarded), so the files are byte-identical to that run's.
     """
     _check_int("num_episodes", num_episodes, 1, MAX_EPISODES)
     _check_int("num_workers", num_workers, 1, None)
@@ -172,7 +195,6 @@ def generate(
     num_workers = min(num_workers, max_seeds, MAX_WORKERS)
     chunk_size = chunk_size or 4 * num_workers
     env_kwargs = {"obs_mode": "state", "control_mode": control_mode}
-    run = _native.solve_episodes if policy == "solution" else _native.scripted_episodes
     recorded = dict(_native.recorded_env_kwargs(env_id, env_kwargs))
     # No observations are stored: the file says so, as ManiSkill2's demonstrations do (replays
     # record the obs mode of env_kwargs unless told another).
@@ -184,9 +206,28 @@ def generate(
     }
     started, cpu_started = time.perf_counter(), time.process_time()
     result = GenerateResult(Path(output), 0, 0, 0, 0.0, control_mode=control_mode)
+    if ray is None:
+
+        def take(seeds: list[int]) -> list[dict[str, Any]]:
+            return run_seed_chunk(seeds, policy, env_id, env_kwargs, num_workers)
+
+        stream = None
+    else:
+        stream = ray_chunks(
+            range(seed, seed + max_seeds),
+            run_seed_chunk,
+            (policy, env_id, env_kwargs, ray.num_cpus),
+            ray,
+            chunk_size,
+        )
+
+        def take(seeds: list[int]) -> list[dict[str, Any]]:
+            return stream.take(len(seeds))  # the stream's next seeds: these (checked below)
+
     with (
         TrajectoryWriter(output, env_info) as writer,
         _progress(num_episodes, f"{env_id} demos", progress) as bar,
+        stream if stream is not None else contextlib.nullcontext(),
     ):
         writer.commit()  # a valid (empty) file from the start
         next_seed = seed
@@ -198,7 +239,11 @@ def generate(
             seeds = list(range(next_seed, next_seed + count))
             next_seed += count
             result.seeds_tried += count
-            for episode in run(env_id, seeds, env_kwargs, num_workers):
+            episodes = take(seeds)
+            got = [int(episode["episode_seed"]) for episode in episodes]
+            if got != seeds:
+                raise RuntimeError(f"episodes of seeds {got} came back for seeds {seeds}")
+            for episode in episodes:
                 if "error" in episode:
                     result.planner_errors += 1
                     result.failed_seeds.append(int(episode["episode_seed"]))
@@ -214,6 +259,7 @@ def generate(
             bar.set_postfix(seeds=result.seeds_tried)
     result.seconds = time.perf_counter() - started
     result.cpu_seconds = time.process_time() - cpu_started
+    result.resubmitted_chunks = stream.resubmitted if stream is not None else 0
     if result.num_episodes < num_episodes:
         raise RuntimeError(
             f"only {result.num_episodes} of {num_episodes} {env_id} episodes succeeded within "

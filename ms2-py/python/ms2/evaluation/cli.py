@@ -11,8 +11,9 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from ..distributed import add_ray_arguments, ray_options_from_args
 from .config import MODEL_SPLITS
-from .evaluator import DEFAULT_STEP_TIME_LIMIT, run_evaluation
+from .evaluator import DEFAULT_RAY_TASK_SIZE, DEFAULT_STEP_TIME_LIMIT, run_evaluation
 from .leaderboard import write_leaderboard
 from .results import ERROR_LOG_FILE, write_text_atomic
 
@@ -46,6 +47,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
             record_dir=args.record_dir,
             name=args.name,
             progress=not args.quiet,
+            ray=ray_options_from_args(args),
         )
     except (ValueError, TypeError, RuntimeError, OSError) as err:
         # As ManiSkill2's evaluation: the reason also goes to <output>/error.log.
@@ -139,6 +141,7 @@ def add_parser(sub: Any) -> None:
     )
     p.add_argument("--name", default=None, help="solution name in the results (default: file stem)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    add_ray_arguments(p, "episodes", str(DEFAULT_RAY_TASK_SIZE))
     p.set_defaults(func=_cmd_evaluate)
 
     lb = sub.add_parser(
