@@ -5,7 +5,8 @@
 # ti.svd, the fair kernel with ms2-mpm's Jacobi left stretch), at equal particle count, grid
 # and thread count. Prints every run, then per particle count and thread count the median
 # particle-substeps per second (per particle each engine really simulated), ms2-mpm's ratio
-# to each Taichi version, the block's top height after the run from each engine (the same
+# to each Taichi version (the median of the per-round ratios, each between runs seconds
+# apart, which shared-machine load shifts less than it shifts the rates), the block's top height after the run from each engine (the same
 # physics gives the same height), and the `uptime` load averages before and after.
 #
 # Taichi is installed on demand into its own venv (default target/taichi-venv; override with
@@ -55,36 +56,42 @@ field() { # field NAME LINE
 
 load() { uptime | sed 's/.*load average: //'; }
 
+median() { # median FORMAT "v1 v2 ..."
+  tr ' ' '\n' <<<"$2" | sed '/^$/d' | sort -g |
+    awk -v f="$1" '{ a[NR] = $1 } END { printf f, (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }'
+}
+
 echo "[bench] $(date -u '+%F %T') UTC, $(nproc) cores, load $(load), substeps $SUBSTEPS"
 summary=()
 for n in $PARTICLES; do
   for t in $THREADS; do
     before=$(load)
-    declare -A rates=() tops=()
+    declare -A rates=() tops=() ratios=() last=()
     for r in $(seq "$ROUNDS"); do
       for e in $ENGINES; do
         line=$(run "$e" "$n" "$t")
         echo "round=$r $line"
-        rates[$e]+="$(field particle_substeps_per_s "$line") "
+        last[$e]=$(field particle_substeps_per_s "$line")
+        rates[$e]+="${last[$e]} "
         tops[$e]=$(field top_z "$line")
       done
+      if [ -n "${last[ms2]:-}" ]; then
+        for e in $ENGINES; do
+          ratios[$e]+="$(awk -v a="${last[ms2]}" -v b="${last[$e]}" 'BEGIN { print a / b }') "
+        done
+      fi
     done
     after=$(load)
     row="particles=$n threads=$t load=[$before]..[$after]"
     for e in $ENGINES; do
-      med=$(tr ' ' '\n' <<<"${rates[$e]}" | sed '/^$/d' | sort -g |
-        awk '{ a[NR] = $1 } END { printf "%.3e", (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2 }')
-      row+=" $e=$med top_z_$e=${tops[$e]}"
-      rates[$e]=$med
+      row+=" $e=$(median "%.3e" "${rates[$e]}") top_z_$e=${tops[$e]}"
     done
-    if [[ " $ENGINES " == *" ms2 "* ]]; then
-      for e in $ENGINES; do
-        [ "$e" = ms2 ] && continue
-        row+=" ms2/$e=$(awk -v a="${rates[ms2]}" -v b="${rates[$e]}" 'BEGIN { printf "%.2f", a / b }')"
-      done
-    fi
+    for e in $ENGINES; do
+      [ "$e" = ms2 ] || [ -z "${ratios[$e]:-}" ] && continue
+      row+=" ms2/$e=$(median "%.2f" "${ratios[$e]}")"
+    done
     summary+=("$row")
-    unset rates tops
+    unset rates tops ratios last
   done
 done
 echo "[bench] medians over $ROUNDS rounds (particle-substeps per second per real particle):"

@@ -2,12 +2,12 @@
 grid, dx, dt, material model, boundary and particle count), written the way a Taichi expert
 would write it for a CPU:
 
-- particle-to-grid scatters without atomics: the particles are split into one contiguous
-  chunk per thread, each chunk scatters with plain loads and stores into that thread's
-  private copy of the grid, and a parallel pass over the nodes adds the copies (and zeroes
-  them for the next substep);
+- particle-to-grid scatters without atomics: each particle adds its contributions with
+  plain loads and stores to the private grid of the thread running it
+  (`ti.global_thread_idx()`, the CPU worker's index), and a parallel pass over the nodes adds
+  the copies (and zeroes them for the next substep);
 - the grid passes (reduction, grid update) visit only the particles' bounding box of nodes
-  (stencil included), tracked per chunk at the end of grid-to-particle;
+  (stencil included), tracked per thread at the end of grid-to-particle;
 - the grids are stored in dense 4x4x4-node blocks (`ti.root.dense(...).dense(...)`), each
   node a vec4 (momentum or velocity xyz, mass w);
 - the stress comes either from `ti.svd` with the original port's von Mises return mapping
@@ -61,7 +61,6 @@ def main() -> None:
     gravity = ti.Vector([0.0, 0.0, -9.81])
     lo_clamp, hi_clamp = bound * dx, (n_grid - bound) * dx
     block = 4
-    chunk = (n_part + n_thr - 1) // n_thr
 
     x = ti.Vector.field(3, ti.f32, n_part)
     v = ti.Vector.field(3, ti.f32, n_part)
@@ -74,9 +73,9 @@ def main() -> None:
     ti.root.dense(ti.i, n_thr).dense(ti.jkl, n_grid // block).dense(
         ti.jkl, block
     ).place(priv)
-    # Per chunk, the range of stencil base nodes of its particles; whole-run box in `box`.
-    chunk_lo = ti.Vector.field(3, ti.i32, n_thr)
-    chunk_hi = ti.Vector.field(3, ti.i32, n_thr)
+    # Per thread, the range of stencil base nodes of the particles it moved; union in `box`.
+    thread_lo = ti.Vector.field(3, ti.i32, n_thr)
+    thread_hi = ti.Vector.field(3, ti.i32, n_thr)
     box = ti.Vector.field(3, ti.i32, 2)
 
     layers = n_part // 1024
@@ -96,12 +95,8 @@ def main() -> None:
             c_aff[p] = ti.Matrix.zero(ti.f32, 3, 3)
             f_def[p] = ti.Matrix.identity(ti.f32, 3)
         for t in range(n_thr):
-            lo = ti.Vector([n_grid, n_grid, n_grid])
-            hi = ti.Vector([-1, -1, -1])
-            for p in range(t * chunk, ti.min((t + 1) * chunk, n_part)):
-                b = base_node(x[p])
-                lo, hi = ti.min(lo, b), ti.max(hi, b)
-            chunk_lo[t], chunk_hi[t] = lo, hi
+            thread_lo[t] = ti.Vector([0, 0, 0])
+            thread_hi[t] = ti.Vector([n_grid - 3, n_grid - 3, n_grid - 3])
 
     @ti.func
     def corotated(u, s):
@@ -210,31 +205,30 @@ def main() -> None:
 
     @ti.kernel
     def p2g():
-        ti.loop_config(block_dim=1)
-        for t in range(n_thr):
-            for p in range(t * chunk, ti.min((t + 1) * chunk, n_part)):
-                base = base_node(x[p])
-                fx = x[p] * inv_dx - base
-                w = weights(fx)
-                f_new = (ti.Matrix.identity(ti.f32, 3) + dt * c_aff[p]) @ f_def[p]
-                f_out, tau = ti.Matrix.zero(ti.f32, 3, 3), ti.Matrix.zero(ti.f32, 3, 3)
-                if ti.static(jacobi):
-                    f_out, tau = stress_jacobi(f_new)
-                else:
-                    f_out, tau = stress_svd(f_new)
-                f_def[p] = f_out
-                affine = (-dt * p_vol * 4.0 * inv_dx * inv_dx) * tau + p_mass * c_aff[p]
-                mv = p_mass * v[p]
-                for i, j, k in ti.static(ti.ndrange(3, 3, 3)):
-                    offset = ti.Vector([i, j, k])
-                    dpos = (offset - fx) * dx
-                    weight = w[i][0] * w[j][1] * w[k][2]
-                    mom = weight * (mv + affine @ dpos)
-                    node = base + offset
-                    # Plain load and store: this grid belongs to this thread alone.
-                    priv[t, node] = priv[t, node] + ti.Vector(
-                        [mom[0], mom[1], mom[2], weight * p_mass]
-                    )
+        for p in range(n_part):
+            t = ti.global_thread_idx()
+            base = base_node(x[p])
+            fx = x[p] * inv_dx - base
+            w = weights(fx)
+            f_new = (ti.Matrix.identity(ti.f32, 3) + dt * c_aff[p]) @ f_def[p]
+            f_out, tau = ti.Matrix.zero(ti.f32, 3, 3), ti.Matrix.zero(ti.f32, 3, 3)
+            if ti.static(jacobi):
+                f_out, tau = stress_jacobi(f_new)
+            else:
+                f_out, tau = stress_svd(f_new)
+            f_def[p] = f_out
+            affine = (-dt * p_vol * 4.0 * inv_dx * inv_dx) * tau + p_mass * c_aff[p]
+            mv = p_mass * v[p]
+            for i, j, k in ti.static(ti.ndrange(3, 3, 3)):
+                offset = ti.Vector([i, j, k])
+                dpos = (offset - fx) * dx
+                weight = w[i][0] * w[j][1] * w[k][2]
+                mom = weight * (mv + affine @ dpos)
+                node = base + offset
+                # Plain load and store: this grid belongs to this thread alone.
+                priv[t, node] = priv[t, node] + ti.Vector(
+                    [mom[0], mom[1], mom[2], weight * p_mass]
+                )
 
     @ti.kernel
     def reduce_and_update():
@@ -242,7 +236,7 @@ def main() -> None:
             lo = ti.Vector([n_grid, n_grid, n_grid])
             hi = ti.Vector([-1, -1, -1])
             for t in range(n_thr):
-                lo, hi = ti.min(lo, chunk_lo[t]), ti.max(hi, chunk_hi[t])
+                lo, hi = ti.min(lo, thread_lo[t]), ti.max(hi, thread_hi[t])
             box[0], box[1] = lo, hi + 3
         for i, j, k in ti.ndrange(
             (box[0][0], box[1][0]), (box[0][1], box[1][1]), (box[0][2], box[1][2])
@@ -272,37 +266,50 @@ def main() -> None:
 
     @ti.kernel
     def g2p():
-        ti.loop_config(block_dim=1)
         for t in range(n_thr):
-            lo = ti.Vector([n_grid, n_grid, n_grid])
-            hi = ti.Vector([-1, -1, -1])
-            for p in range(t * chunk, ti.min((t + 1) * chunk, n_part)):
-                base = base_node(x[p])
-                fx = x[p] * inv_dx - base
-                w = weights(fx)
-                new_v = ti.Vector.zero(ti.f32, 3)
-                new_c = ti.Matrix.zero(ti.f32, 3, 3)
-                for i, j, k in ti.static(ti.ndrange(3, 3, 3)):
-                    offset = ti.Vector([i, j, k])
-                    dpos = (offset - fx) * dx
-                    weight = w[i][0] * w[j][1] * w[k][2]
-                    g4 = grid[base + offset]
-                    g = ti.Vector([g4[0], g4[1], g4[2]])
-                    new_v += weight * g
-                    new_c += 4.0 * inv_dx * inv_dx * weight * g.outer_product(dpos)
-                v[p] = new_v
-                c_aff[p] = new_c
-                xn = ti.math.clamp(x[p] + dt * new_v, lo_clamp, hi_clamp)
-                x[p] = xn
-                b = base_node(xn)
-                lo, hi = ti.min(lo, b), ti.max(hi, b)
-            chunk_lo[t], chunk_hi[t] = lo, hi
+            thread_lo[t] = ti.Vector([n_grid, n_grid, n_grid])
+            thread_hi[t] = ti.Vector([-1, -1, -1])
+        for p in range(n_part):
+            t = ti.global_thread_idx()
+            base = base_node(x[p])
+            fx = x[p] * inv_dx - base
+            w = weights(fx)
+            new_v = ti.Vector.zero(ti.f32, 3)
+            new_c = ti.Matrix.zero(ti.f32, 3, 3)
+            for i, j, k in ti.static(ti.ndrange(3, 3, 3)):
+                offset = ti.Vector([i, j, k])
+                dpos = (offset - fx) * dx
+                weight = w[i][0] * w[j][1] * w[k][2]
+                g4 = grid[base + offset]
+                g = ti.Vector([g4[0], g4[1], g4[2]])
+                new_v += weight * g
+                new_c += 4.0 * inv_dx * inv_dx * weight * g.outer_product(dpos)
+            v[p] = new_v
+            c_aff[p] = new_c
+            xn = ti.math.clamp(x[p] + dt * new_v, lo_clamp, hi_clamp)
+            x[p] = xn
+            b = base_node(xn)
+            # Plain load and store: this box belongs to this thread alone.
+            thread_lo[t] = ti.min(thread_lo[t], b)
+            thread_hi[t] = ti.max(thread_hi[t], b)
 
     def substep():
         p2g()
         reduce_and_update()
         g2p()
 
+    max_tid = ti.field(ti.i32, ())
+
+    @ti.kernel
+    def highest_thread_index():
+        for p in range(n_part):
+            ti.atomic_max(max_tid[None], ti.global_thread_idx())
+
+    highest_thread_index()
+    if max_tid[None] >= n_thr:
+        raise SystemExit(
+            f"ti.global_thread_idx() reached {max_tid[None]}, expected < {n_thr} threads"
+        )
     init()
     for _ in range(50):  # includes JIT compilation
         substep()
