@@ -24,6 +24,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .num_threads(threads)
         .build()?;
     let mut solver = ms2_mpm::scenes::clay_block(particles)?;
+    // Rates are per particle the scene really holds.
+    let particles = solver.particle_count();
     pool.install(|| -> Result<(), ms2_mpm::MpmError> {
         for _ in 0..50 {
             solver.substep()?;

@@ -75,6 +75,14 @@ pub enum MpmError {
         /// Index (in the solver's current order) of the first bad particle found.
         particle: usize,
     },
+    /// A scene's sampler built another number of particles than the scene promises.
+    #[error("the scene asked for {requested} particles but its sampler built {built}")]
+    ParticleCountMismatch {
+        /// Particles requested.
+        requested: usize,
+        /// Particles the sampler produced.
+        built: usize,
+    },
     /// A triangle mesh is malformed.
     #[error("invalid mesh: {reason}")]
     InvalidMesh {

@@ -127,16 +127,29 @@ pub fn jitter(points: &mut [Vec3], amplitude: f32, seed: u64) {
     }
 }
 
+/// Lattice layers (points along one axis) that fit in `[lo, hi]` at `spacing` (m): ⌊(hi −
+/// lo) / spacing⌋, except that an extent short of a whole number of spacings by no more than
+/// the f32 rounding of its corners and of the spacing counts as that whole number. Without
+/// that slack a box built as `lo + n·spacing` may get n − 1 layers: in f32, (0.4 − 0.24) /
+/// 0.005 is 31.999998.
+fn layers(lo: f32, hi: f32, spacing: f32) -> usize {
+    let (lo, hi, s) = (f64::from(lo), f64::from(hi), f64::from(spacing));
+    let ratio = (hi - lo) / s;
+    // A few ulps of each corner (absolute, in layers) and of the spacing (relative).
+    let slack = 8.0 * f64::from(f32::EPSILON) * ((lo.abs() + hi.abs()) / s + ratio.abs());
+    (ratio + slack).floor().max(0.0) as usize
+}
+
 fn lattice(min: Vec3, max: Vec3, spacing: f32, keep: impl Fn(Vec3) -> bool) -> Vec<Vec3> {
     if !(spacing.is_finite() && spacing > 0.0 && min.is_finite() && max.is_finite()) {
         return Vec::new();
     }
-    let n = ((max - min) / spacing).floor();
     let (nx, ny, nz) = (
-        n.x.max(0.0) as usize,
-        n.y.max(0.0) as usize,
-        n.z.max(0.0) as usize,
+        layers(min.x, max.x, spacing),
+        layers(min.y, max.y, spacing),
+        layers(min.z, max.z, spacing),
     );
+    let n = Vec3::new(nx as f32, ny as f32, nz as f32);
     // Centre the lattice in the box.
     let start = min + ((max - min) - n * spacing) * 0.5 + Vec3::splat(spacing * 0.5);
     let mut out = Vec::with_capacity(nx * ny * nz);
@@ -169,6 +182,38 @@ mod tests {
             "{}",
             c.len()
         );
+    }
+
+    #[test]
+    fn a_box_of_n_spacings_gets_n_layers() {
+        let mut checked = 0;
+        for spacing in [
+            0.001f32, 0.003, 0.004, 0.005, 0.007, 0.01, 0.0125, 0.02, 0.05,
+        ] {
+            for lo in [0.0f32, 0.04, 0.24, -0.37, 1.3] {
+                for n in 1..=120usize {
+                    let hi = lo + n as f32 * spacing;
+                    // n layers along one axis, one along the others, for each axis.
+                    for axis in 0..3 {
+                        let mut max = Vec3::splat(lo + spacing);
+                        max[axis] = hi;
+                        let pts = sample_box(Vec3::splat(lo), max, spacing);
+                        assert_eq!(
+                            pts.len(),
+                            n,
+                            "box [{lo}, {hi}] m on axis {axis}, spacing {spacing} m"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 9 * 5 * 120 * 3);
+        // Clearly short of a layer: one layer fewer; clearly over: no extra one.
+        let short = sample_box(Vec3::ZERO, Vec3::new(0.0499, 0.01, 0.01), 0.01);
+        assert_eq!(short.len(), 4);
+        let over = sample_box(Vec3::ZERO, Vec3::new(0.0501, 0.01, 0.01), 0.01);
+        assert_eq!(over.len(), 5);
     }
 
     #[test]
