@@ -125,6 +125,28 @@ def test_bc_state_runs_end_to_end(tmp_path):
     assert pred.shape == actions.shape and np.abs(pred).max() <= 1.0
 
 
+def test_bc_rgbd_runs_end_to_end(tmp_path):
+    bc = load_example("bc_rgbd")
+    out = tmp_path / "bc_rgbd"
+    summary = bc.main(
+        ["--env", "LiftCube-v0", "--num-demos", "2", "--steps", "5", "--batch-size", "8",
+         "--eval-episodes", "1", "--eval-envs", "1", "--max-episode-steps", "10",
+         "--out", str(out)]
+    )  # fmt: skip
+    assert (out / "model.pt").stat().st_size > 0
+    assert json.loads((out / "summary.json").read_text()) == summary
+    assert 0.0 <= summary["success_rate"] <= 1.0
+    assert summary["image_hw"] == [64, 64] and summary["pairs"] > 2
+    images, state, actions = bc.load_demos(out / "demos.rgbd.pd_ee_delta_pose.h5", 2)
+    assert images.shape == (summary["pairs"], 8, 64, 64) and len(state) == len(actions)
+    assert 0.0 <= float(images.min()) and float(images.max()) <= bc.MAX_DEPTH
+    policy = bc.make_policy(state.shape[1], actions.shape[1])
+    policy.load_state_dict(torch.load(out / "model.pt"))
+    with torch.no_grad():
+        pred = policy(torch.from_numpy(images[:4]).float(), torch.from_numpy(state[:4]))
+    assert pred.shape == (4, 7)
+
+
 def test_sb3_vec_env_wrapper_with_sb3_tools():
     """SB3VecEnvWrapper under stable-baselines3's own VecMonitor, PPO.learn and
     evaluate_policy (episode counts and lengths as the time limit sets them)."""
