@@ -60,6 +60,9 @@ def test_ppo_state_runs_end_to_end(tmp_path, backend):
     for r in rows:
         assert 0.0 <= float(r["success_rate"]) <= 1.0
         assert int(r["eval_episodes"]) == 2
+        assert 0.0 <= float(r["train_success_rate"]) <= 1.0
+    # 200 steps over 2 envs with a 20-step limit: 10 training episodes end between evaluations.
+    assert [int(r["train_episodes"]) for r in rows] == [0, 10, 10]
     assert json.loads((out / "summary.json").read_text()) == summary
     assert summary["env_steps"] == 400
     # The saved model loads and acts in the task's action space.

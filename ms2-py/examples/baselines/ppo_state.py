@@ -11,7 +11,8 @@ a terminal state with no future reward (``--backend gym`` uses gymnasium envs wi
 
 Every ``--eval-freq`` env steps the policy (deterministic) is evaluated on ``--eval-episodes``
 seeded episodes that end on success; one CSV row per evaluation: env steps, wall seconds,
-success rate. The model is saved to ``OUT/model.zip``.
+success rate, and the training episodes ended since the previous row with the fraction of them
+whose last step was a success. The model is saved to ``OUT/model.zip``.
 
 Example (the run in docs/baselines.md)::
 
@@ -160,6 +161,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     start = time.perf_counter()
     rows: list[dict[str, Any]] = []
 
+    # Training episodes ended since the last evaluation, and how many of them on a success.
+    train_episodes = [0, 0]
+
     def log_eval(env_steps: int) -> None:
         eval_start = time.perf_counter()
         rate = evaluate(model, args.env, args, args.eval_episodes, seed=10_000 + args.seed)
@@ -169,7 +173,10 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             "success_rate": rate,
             "eval_episodes": args.eval_episodes,
             "eval_s": round(time.perf_counter() - eval_start, 1),
+            "train_episodes": train_episodes[0],
+            "train_success_rate": round(train_episodes[1] / max(1, train_episodes[0]), 4),
         }
+        train_episodes[:] = [0, 0]
         rows.append(row)
         with csv_path.open("a" if len(rows) > 1 else "w", newline="") as f:
             writer = csv.DictWriter(f, fieldnames=list(row))
@@ -184,6 +191,10 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             self.next_eval = args.eval_freq
 
         def _on_step(self) -> bool:
+            for done, info in zip(self.locals["dones"], self.locals["infos"], strict=True):
+                if done:
+                    train_episodes[0] += 1
+                    train_episodes[1] += int(bool(info.get("success", False)))
             if self.num_timesteps >= self.next_eval:
                 self.next_eval += args.eval_freq
                 log_eval(self.num_timesteps)
