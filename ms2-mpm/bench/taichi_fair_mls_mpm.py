@@ -23,9 +23,31 @@ Usage: python taichi_fair_mls_mpm.py PARTICLES THREADS SUBSTEPS [--eigen svd|jac
 """
 
 import argparse
-import time
 
 import taichi as ti
+
+from mls_scene import (
+    BLOCK_ORIGIN,
+    BOUND,
+    DT,
+    DX,
+    ELASTIC_RATIO,
+    FRICTION,
+    GRAVITY,
+    HI_CLAMP,
+    INV_DX,
+    LAM,
+    LO_CLAMP,
+    MU,
+    N_GRID,
+    P_MASS,
+    P_VOL,
+    SPACING,
+    YIELD_STRAIN,
+    check_particles,
+    report,
+    timed_substeps,
+)
 
 
 def main() -> None:
@@ -36,8 +58,7 @@ def main() -> None:
     ap.add_argument("--eigen", choices=["svd", "jacobi"], default="svd")
     args = ap.parse_args()
     n_part, n_thr, substeps = args.particles, args.threads, args.substeps
-    if n_part <= 0 or n_part % 1024:
-        raise SystemExit(f"particles must be a positive multiple of 1024, got {n_part}")
+    layers = check_particles(n_part)
     if n_thr <= 0:
         raise SystemExit(f"threads must be >= 1, got {n_thr}")
     jacobi = args.eigen == "jacobi"
@@ -45,21 +66,15 @@ def main() -> None:
         arch=ti.cpu, cpu_max_num_threads=n_thr, default_fp=ti.f32, log_level=ti.WARN
     )
 
-    n_grid, dx, dt = 64, 0.01, 5e-4
-    inv_dx = 1.0 / dx
-    spacing = 0.005
-    p_vol = spacing**3
-    p_mass = 1000.0 * p_vol
-    e_mod, nu, yield_stress = 1e4, 0.3, 2e3
-    mu, lam = e_mod / (2 * (1 + nu)), e_mod * nu / ((1 + nu) * (1 - 2 * nu))
-    yield_strain = yield_stress / (2 * mu)
-    # Below this ratio of largest to smallest stretch nothing yields (ms2-mpm's shortcut).
-    elastic_ratio = float(__import__("math").exp(yield_strain * 1.5**0.5))
+    n_grid, dx, dt, inv_dx = N_GRID, DX, DT, INV_DX
+    spacing, p_vol, p_mass = SPACING, P_VOL, P_MASS
+    mu, lam, yield_strain = MU, LAM, YIELD_STRAIN
+    elastic_ratio = ELASTIC_RATIO
     min_stretch = 0.05
     jac_tol2, jac_sweeps = 1e-6 * 1e-6, 4
-    bound, friction = 3, 0.5
-    gravity = ti.Vector([0.0, 0.0, -9.81])
-    lo_clamp, hi_clamp = bound * dx, (n_grid - bound) * dx
+    bound, friction = BOUND, FRICTION
+    gravity = ti.Vector(GRAVITY)
+    lo_clamp, hi_clamp = LO_CLAMP, HI_CLAMP
     block = 4
 
     x = ti.Vector.field(3, ti.f32, n_part)
@@ -78,8 +93,6 @@ def main() -> None:
     thread_hi = ti.Vector.field(3, ti.i32, n_thr)
     box = ti.Vector.field(3, ti.i32, 2)
 
-    layers = n_part // 1024
-
     @ti.func
     def base_node(xp):
         return ti.cast(ti.floor(xp * inv_dx - 0.5), ti.i32)
@@ -88,9 +101,7 @@ def main() -> None:
     def init():
         for p in x:
             i, j, k = p // (32 * layers), (p // layers) % 32, p % layers
-            x[p] = (
-                ti.Vector([0.24, 0.24, 0.04]) + (ti.Vector([i, j, k]) + 0.5) * spacing
-            )
+            x[p] = ti.Vector(BLOCK_ORIGIN) + (ti.Vector([i, j, k]) + 0.5) * spacing
             v[p] = ti.Vector.zero(ti.f32, 3)
             c_aff[p] = ti.Matrix.zero(ti.f32, 3, 3)
             f_def[p] = ti.Matrix.identity(ti.f32, 3)
@@ -125,7 +136,9 @@ def main() -> None:
         if excess > 0.0:
             eps -= dev * (excess / dev_norm)
             s = ti.exp(eps)
-        f_out = u @ ti.Matrix([[s[0], 0, 0], [0, s[1], 0], [0, 0, s[2]]]) @ vv.transpose()
+        f_out = (
+            u @ ti.Matrix([[s[0], 0, 0], [0, s[1], 0], [0, 0, s[2]]]) @ vv.transpose()
+        )
         return f_out, corotated(u, s)
 
     @ti.func
@@ -311,22 +324,8 @@ def main() -> None:
             f"ti.global_thread_idx() reached {max_tid[None]}, expected < {n_thr} threads"
         )
     init()
-    for _ in range(50):  # includes JIT compilation
-        substep()
-    ti.sync()
-    start = time.perf_counter()
-    for _ in range(substeps):
-        substep()
-    ti.sync()
-    secs = time.perf_counter() - start
-    xs = x.to_numpy()
-    top = float(xs[:, 2].max())
-    version = ".".join(str(part) for part in ti.__version__)
-    print(
-        f"engine=taichi-{version}-fair-{args.eigen} particles={xs.shape[0]} "
-        f"threads={n_thr} substeps={substeps} seconds={secs:.3f} "
-        f"particle_substeps_per_s={xs.shape[0] * substeps / secs:.4e} top_z={top:.4f}"
-    )
+    secs = timed_substeps(ti, substep, substeps)
+    report(ti, f"-fair-{args.eigen}", x.to_numpy(), n_thr, substeps, secs)
 
 
 if __name__ == "__main__":

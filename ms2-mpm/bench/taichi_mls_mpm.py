@@ -10,30 +10,45 @@ Usage: python taichi_mls_mpm.py PARTICLES THREADS SUBSTEPS
 """
 
 import sys
-import time
 
 import taichi as ti
+
+from mls_scene import (
+    BLOCK_ORIGIN,
+    BOUND,
+    DT,
+    DX,
+    FRICTION,
+    GRAVITY,
+    HI_CLAMP,
+    INV_DX,
+    LAM,
+    LO_CLAMP,
+    MU,
+    N_GRID,
+    P_MASS,
+    P_VOL,
+    SPACING,
+    YIELD_STRAIN,
+    check_particles,
+    report,
+    timed_substeps,
+)
 
 
 def main() -> None:
     particles, threads, substeps = (int(a) for a in sys.argv[1:4])
-    if particles % 1024:
-        raise SystemExit(f"particles must be a multiple of 1024, got {particles}")
+    layers = check_particles(particles)
     ti.init(
         arch=ti.cpu, cpu_max_num_threads=threads, default_fp=ti.f32, log_level=ti.WARN
     )
 
-    n_grid, dx, dt = 64, 0.01, 5e-4
-    inv_dx = 1.0 / dx
-    spacing = 0.005
-    p_vol = spacing**3
-    p_mass = 1000.0 * p_vol
-    e, nu, yield_stress = 1e4, 0.3, 2e3
-    mu, lam = e / (2 * (1 + nu)), e * nu / ((1 + nu) * (1 - 2 * nu))
-    yield_strain = yield_stress / (2 * mu)
-    bound, friction = 3, 0.5
-    gravity = ti.Vector([0.0, 0.0, -9.81])
-    lo_clamp, hi_clamp = bound * dx, (n_grid - bound) * dx
+    n_grid, dx, dt, inv_dx = N_GRID, DX, DT, INV_DX
+    spacing, p_vol, p_mass = SPACING, P_VOL, P_MASS
+    mu, lam, yield_strain = MU, LAM, YIELD_STRAIN
+    bound, friction = BOUND, FRICTION
+    gravity = ti.Vector(GRAVITY)
+    lo_clamp, hi_clamp = LO_CLAMP, HI_CLAMP
 
     x = ti.Vector.field(3, ti.f32, particles)
     v = ti.Vector.field(3, ti.f32, particles)
@@ -42,15 +57,11 @@ def main() -> None:
     grid_v = ti.Vector.field(3, ti.f32, (n_grid, n_grid, n_grid))
     grid_m = ti.field(ti.f32, (n_grid, n_grid, n_grid))
 
-    layers = particles // 1024
-
     @ti.kernel
     def init():
         for p in x:
             i, j, k = p // (32 * layers), (p // layers) % 32, p % layers
-            x[p] = (
-                ti.Vector([0.24, 0.24, 0.04]) + (ti.Vector([i, j, k]) + 0.5) * spacing
-            )
+            x[p] = ti.Vector(BLOCK_ORIGIN) + (ti.Vector([i, j, k]) + 0.5) * spacing
             v[p] = ti.Vector.zero(ti.f32, 3)
             c_aff[p] = ti.Matrix.zero(ti.f32, 3, 3)
             f_def[p] = ti.Matrix.identity(ti.f32, 3)
@@ -137,21 +148,8 @@ def main() -> None:
             x[p] = ti.math.clamp(x[p] + dt * new_v, lo_clamp, hi_clamp)
 
     init()
-    for _ in range(50):  # includes JIT compilation
-        substep()
-    ti.sync()
-    start = time.perf_counter()
-    for _ in range(substeps):
-        substep()
-    ti.sync()
-    secs = time.perf_counter() - start
-    top = float(x.to_numpy()[:, 2].max())
-    version = ".".join(str(part) for part in ti.__version__)
-    print(
-        f"engine=taichi-{version} particles={particles} threads={threads} "
-        f"substeps={substeps} seconds={secs:.3f} "
-        f"particle_substeps_per_s={particles * substeps / secs:.4e} top_z={top:.4f}"
-    )
+    secs = timed_substeps(ti, substep, substeps)
+    report(ti, "", x.to_numpy(), threads, substeps, secs)
 
 
 if __name__ == "__main__":
