@@ -8,18 +8,8 @@
 # not installed. Extra pytest arguments are passed on (e.g. `-k ppo`). See docs/baselines.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh >/dev/null
+bash scripts/install_extra.sh baselines torch,stable_baselines3
 # shellcheck disable=SC1091
 . .venv/bin/activate
-mapfile -t BASELINES_REQS < <(python - <<'PY'
-import tomllib
-with open("ms2-py/pyproject.toml", "rb") as f:
-    print("\n".join(tomllib.load(f)["project"]["optional-dependencies"]["baselines"]))
-PY
-)
-if ! python -c 'import torch, stable_baselines3' >/dev/null 2>&1; then
-  echo "[test_baselines] installing the baselines extra: ${BASELINES_REQS[*]}"
-  python -m pip install -q "${BASELINES_REQS[@]}"
-fi
 echo "[test_baselines] pytest ms2-py/tests/test_baselines.py"
 RAYON_NUM_THREADS=1 python -m pytest -q ms2-py/tests/test_baselines.py "$@"

@@ -7,18 +7,8 @@
 # on (e.g. `-k killed`). See docs/ray.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh >/dev/null
+bash scripts/install_extra.sh ray ray
 # shellcheck disable=SC1091
 . .venv/bin/activate
-mapfile -t RAY_REQS < <(python - <<'PY'
-import tomllib
-with open("ms2-py/pyproject.toml", "rb") as f:
-    print("\n".join(tomllib.load(f)["project"]["optional-dependencies"]["ray"]))
-PY
-)
-if ! python -c 'import ray' >/dev/null 2>&1; then
-  echo "[test_ray] installing the ray extra: ${RAY_REQS[*]}"
-  python -m pip install -q "${RAY_REQS[@]}"
-fi
 echo "[test_ray] pytest ms2-py/tests/test_ray.py (MS2_TEST_RAY=1)"
 MS2_TEST_RAY=1 RAYON_NUM_THREADS=1 python -m pytest -q ms2-py/tests/test_ray.py "$@"

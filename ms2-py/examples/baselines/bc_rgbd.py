@@ -18,9 +18,7 @@ Example (the run in docs/baselines.md)::
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -28,44 +26,28 @@ from typing import Any
 
 import numpy as np
 
-EVAL_SEED = 1_000_000
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bc_common import (  # noqa: E402
+    add_common_args,
+    demo_trajectories,
+    evaluate,
+    make_demos,
+    train,
+    write_summary,
+)
+
 CAMERAS = ("base_camera", "hand_camera")
 MAX_DEPTH = 4.0
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--env", default="LiftCube-v0")
-    p.add_argument("--control-mode", default="pd_ee_delta_pose")
-    p.add_argument("--demos", type=Path, help="a trajectory file with rgbd obs (else generated)")
-    p.add_argument("--num-demos", type=int, default=50)
-    p.add_argument("--steps", type=int, default=1500, help="gradient steps")
-    p.add_argument("--subsample", type=int, default=2, help="keep every k-th pixel")
-    p.add_argument("--batch-size", type=int, default=64)
-    p.add_argument("--lr", type=float, default=3e-4)
-    p.add_argument("--eval-episodes", type=int, default=20)
-    p.add_argument("--eval-envs", type=int, default=4, help="envs of the evaluation make_vec")
-    p.add_argument("--max-episode-steps", type=int, default=200)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--threads", type=int, default=1, help="torch threads")
-    p.add_argument("--out", type=Path, default=Path("runs/bc_rgbd"))
-    return p.parse_args(argv)
-
-
-def make_demos(args: argparse.Namespace) -> Path:
-    """Generates ``--num-demos`` demos and records their RGBD observations; returns the file."""
-    raw = args.out / "demos.h5"
-    ms2_cli = [sys.executable, "-m", "ms2"]
-    subprocess.run(
-        [*ms2_cli, "demos", "generate", args.env, "-n", str(args.num_demos), "--policy",
-         "scripted", "-c", args.control_mode, "--out", str(raw), "-q"],
-        check=True,
+    add_common_args(
+        p, env="LiftCube-v0", num_demos=50, steps=1500, batch_size=64, lr=3e-4,
+        eval_episodes=20, eval_envs=4, out=Path("runs/bc_rgbd"),
     )  # fmt: skip
-    subprocess.run(
-        [*ms2_cli, "replay", "--traj-path", str(raw), "-o", "rgbd", "--save-traj", "-q"],
-        check=True,
-    )
-    return raw.with_name(f"demos.rgbd.{args.control_mode}.h5")
+    p.add_argument("--subsample", type=int, default=2, help="keep every k-th pixel")
+    return p.parse_args(argv)
 
 
 def split_obs(obs: Any, subsample: int = 2) -> tuple[np.ndarray, np.ndarray]:
@@ -92,20 +74,12 @@ def load_demos(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(images, state, actions) of the first ``num_demos`` trajectories (``obs[t]`` with the
     action taken from it)."""
-    import h5py
-
     images, states, actions = [], [], []
-    with h5py.File(path, "r") as f:
-        keys = sorted((k for k in f if k.startswith("traj_")), key=lambda k: int(k[5:]))
-        if len(keys) < num_demos:
-            raise SystemExit(f"{path} holds {len(keys)} trajectories, fewer than {num_demos}")
-        for key in keys[:num_demos]:
-            traj = f[key]
-            a = np.asarray(traj["actions"], dtype=np.float32)
-            im, st = split_obs(traj["obs"], subsample)
-            images.append(im[: len(a)])
-            states.append(st[: len(a)])
-            actions.append(a)
+    for traj_obs, a in demo_trajectories(path, num_demos):
+        im, st = split_obs(traj_obs, subsample)
+        images.append(im[: len(a)])
+        states.append(st[: len(a)])
+        actions.append(a)
     return np.concatenate(images), np.concatenate(states), np.concatenate(actions)
 
 
@@ -136,42 +110,6 @@ def make_policy(state_dim: int, act_dim: int, image_hw: tuple[int, int] = (64, 6
     return RGBDPolicy()
 
 
-def evaluate(policy: Any, args: argparse.Namespace) -> float:
-    """Success rate over ``--eval-episodes`` episodes (seeds ``EVAL_SEED + k``)."""
-    import ms2
-    import torch
-
-    n = min(args.eval_envs, args.eval_episodes)
-    venv = ms2.make_vec(
-        args.env,
-        num_envs=n,
-        obs_mode="rgbd",
-        control_mode=args.control_mode,
-        max_episode_steps=args.max_episode_steps,
-    )
-    successes = done = 0
-    try:
-        while done < args.eval_episodes:
-            k = min(n, args.eval_episodes - done)
-            obs, _ = venv.reset(seed=EVAL_SEED + done)
-            active = np.arange(n) < k
-            succeeded = np.zeros(n, dtype=bool)
-            while active.any():
-                images, state = split_obs(obs, args.subsample)
-                with torch.no_grad():
-                    action = policy(
-                        torch.from_numpy(images.astype(np.float32)), torch.from_numpy(state)
-                    ).numpy()
-                obs, _, terminated, truncated, info = venv.step(action)
-                succeeded |= active & np.asarray(info["success"], dtype=bool)
-                active &= ~(terminated | truncated)
-            successes += int(succeeded[:k].sum())
-            done += k
-    finally:
-        venv.close()
-    return successes / args.eval_episodes
-
-
 def main(argv: list[str] | None = None) -> dict[str, Any]:
     args = parse_args(argv)
     os.environ.setdefault("RAYON_NUM_THREADS", "1")
@@ -182,50 +120,52 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     args.out.mkdir(parents=True, exist_ok=True)
 
     t0 = time.perf_counter()
-    demos = args.demos if args.demos is not None else make_demos(args)
+    demos = args.demos if args.demos is not None else make_demos(args, "rgbd")
     demo_s = time.perf_counter() - t0
     images, state, actions = load_demos(demos, args.num_demos, args.subsample)
     print(f"{args.num_demos} demos, {len(actions)} (obs, action) pairs, images {images.shape[1:]}")
 
     policy = make_policy(state.shape[1], actions.shape[1], images.shape[2:])
-    optim = torch.optim.Adam(policy.parameters(), lr=args.lr)
     images_t, state_t = torch.from_numpy(images), torch.from_numpy(state)
     act_t = torch.from_numpy(actions)
-    rng = np.random.default_rng(args.seed)
-    t1 = time.perf_counter()
-    loss = torch.zeros(())
-    for step in range(1, args.steps + 1):
-        idx = torch.from_numpy(rng.integers(0, len(actions), size=args.batch_size))
-        pred = policy(images_t[idx].float(), state_t[idx])
-        loss = torch.nn.functional.mse_loss(pred, act_t[idx])
-        optim.zero_grad()
-        loss.backward()
-        optim.step()
-        if step % max(1, args.steps // 10) == 0:
-            print(f"step {step}: loss {loss.item():.5f}", flush=True)
-    train_s = time.perf_counter() - t1
+    final_loss, train_s = train(
+        policy,
+        lambda idx: torch.nn.functional.mse_loss(
+            policy(images_t[idx].float(), state_t[idx]), act_t[idx]
+        ),
+        len(actions),
+        args,
+    )
     torch.save(policy.state_dict(), args.out / "model.pt")
 
     policy.eval()
+
+    def act(obs: Any) -> np.ndarray:
+        batch_images, batch_state = split_obs(obs, args.subsample)
+        with torch.no_grad():
+            return policy(
+                torch.from_numpy(batch_images.astype(np.float32)), torch.from_numpy(batch_state)
+            ).numpy()
+
     t2 = time.perf_counter()
-    rate = evaluate(policy, args)
-    summary = {
-        "env": args.env,
-        "obs_mode": "rgbd",
-        "num_demos": args.num_demos,
-        "image_hw": list(images.shape[2:]),
-        "pairs": len(actions),
-        "steps": args.steps,
-        "final_loss": float(loss.item()),
-        "success_rate": rate,
-        "eval_episodes": args.eval_episodes,
-        "demo_s": round(demo_s, 1),
-        "train_s": round(train_s, 1),
-        "eval_s": round(time.perf_counter() - t2, 1),
-    }
-    (args.out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    print(json.dumps(summary), flush=True)
-    return summary
+    rate = evaluate(act, args, "rgbd")
+    return write_summary(
+        args,
+        {
+            "env": args.env,
+            "obs_mode": "rgbd",
+            "num_demos": args.num_demos,
+            "image_hw": list(images.shape[2:]),
+            "pairs": len(actions),
+            "steps": args.steps,
+            "final_loss": final_loss,
+            "success_rate": rate,
+            "eval_episodes": args.eval_episodes,
+            "demo_s": round(demo_s, 1),
+            "train_s": round(train_s, 1),
+            "eval_s": round(time.perf_counter() - t2, 1),
+        },
+    )
 
 
 if __name__ == "__main__":
