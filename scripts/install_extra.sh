@@ -10,7 +10,8 @@ bash scripts/setup.sh >/dev/null
 # shellcheck disable=SC1091
 . .venv/bin/activate
 if ! python -c "import ${modules}" >/dev/null 2>&1; then
-  mapfile -t reqs < <(EXTRA="$extra" python - <<'PY'
+  # A command substitution, not `< <(...)`, so that an unknown extra stops the script (set -e).
+  reqs_text=$(EXTRA="$extra" python - <<'PY'
 import os
 import tomllib
 with open("ms2-py/pyproject.toml", "rb") as f:
@@ -21,6 +22,7 @@ if name not in extras:
 print("\n".join(extras[name]))
 PY
 )
+  mapfile -t reqs <<<"$reqs_text"
   echo "[install_extra] installing the $extra extra: ${reqs[*]}"
   python -m pip install -q "${reqs[@]}"
 fi
