@@ -7,6 +7,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 started=$(date +%s)
+# A build from scratch needs several GB of disk (less without the release profile's line tables,
+# which CI drops: CARGO_PROFILE_RELEASE_DEBUG=0); say so up front rather than failing mid-link.
+free_kb=$(df -Pk . | awk 'NR == 2 {print $4}')
+echo "[test] free disk here: $((free_kb / 1024 / 1024)) GB"
+if [ "$free_kb" -lt $((8 * 1024 * 1024)) ]; then
+  echo "[test] warning: less than 8 GB free; a build from scratch may stop with 'No space left on device'" >&2
+fi
 echo "[test] repository hygiene (no tracked build artefacts; the check's own test)"
 bash scripts/check_repo.sh
 bash scripts/test_check_repo.sh
