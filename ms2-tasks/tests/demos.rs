@@ -256,6 +256,31 @@ fn failed_conversions_of_successful_sources_are_retried() {
     assert!((5 + 10..=20 + 10).contains(&retried.episode.actions.len()));
 }
 
+#[test]
+fn a_conversion_that_succeeds_only_past_the_episode_limit_is_retried_and_kept_if_nothing_better() {
+    let full = oracle_episode("PickCube-v0", "pd_joint_pos", 7);
+    let opts = ReplayOptions {
+        target_control_mode: Some("pd_ee_delta_pose".to_owned()),
+        max_retry: 3,
+        ..ReplayOptions::default()
+    };
+    let first = replay(&full, opts.clone()).unwrap();
+    assert!(first.episode.succeeded());
+    assert_eq!(first.attempts, 1);
+    // With a limit one step shorter than the success takes, every retry of the portfolio runs
+    // (the other tracking, then tighter trailing tests); the successes past the limit beat no
+    // success, so a successful episode comes back.
+    let len = first.episode.actions.len();
+    let cfg = EnvConfig {
+        max_episode_steps: Some(len as u32 - 1),
+        ..EnvConfig::new("PickCube-v0")
+    };
+    let retried = replay_episode(&cfg, &full, &opts).unwrap();
+    assert_eq!(retried.attempts, 4);
+    assert!(retried.episode.succeeded());
+    assert!(retried.episode.actions.len() > len - 1);
+}
+
 #[cfg(feature = "soft")]
 /// The first `steps` steps of the scripted Fill-v0 policy in `control_mode` for `seed`, recorded
 /// as a soft-body episode, with every state it went through (taken separately).

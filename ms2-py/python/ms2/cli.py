@@ -302,7 +302,12 @@ def _add_demos_parser(sub: argparse._SubParsersAction) -> None:
         "--policy", choices=["solution", "scripted"], default="solution", help="demo source"
     )
     b.add_argument("-c", "--control-mode", default=None, help="control mode of the generated demos")
-    b.add_argument("--max-retry", type=int, default=0, help="retries of a failed conversion")
+    b.add_argument(
+        "--max-retry",
+        type=int,
+        default=0,
+        help="retries of a failed (or late) conversion (see docs/trajectory_format.md)",
+    )
     b.add_argument(
         "--target-control-modes",
         default="pd_ee_delta_pose,pd_ee_delta_pos,pd_joint_delta_pos",
@@ -395,7 +400,12 @@ def add_replay_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "-w", "--num-workers", "--num-procs", type=int, default=1, help="native worker threads"
     )
-    p.add_argument("--max-retry", type=int, default=0, help="retries of a failed conversion")
+    p.add_argument(
+        "--max-retry",
+        type=int,
+        default=0,
+        help="retries of a failed (or late) conversion (see docs/trajectory_format.md)",
+    )
     p.add_argument(
         "--track-hand-only",
         action="store_true",

@@ -449,7 +449,10 @@ def replay(
         save_traj: write ``X.<obs_mode>.<control_mode>.h5`` (+ ``.json``).
         save_video: write one MP4 per episode to ``X.<obs_mode>.<control_mode>.videos/``.
         num_workers: native worker threads.
-        max_retry: further attempts for a failed conversion.
+        max_retry: further attempts for a conversion that fails or succeeds only past the
+            env's ``max_episode_steps``: they alternate between object following and the hand
+            path and tighten the trailing test; the best attempt is kept (see
+            docs/trajectory_format.md, "Retry").
         track_hand_only: convert by the source's hand path alone, as ManiSkill2 does. By
             default, while both robots hold the same object, the hand is moved so that the
             converted object follows the source's object (grasps differ by a millimetre).

@@ -20,7 +20,10 @@ pub mod solutions;
 mod source_targets;
 
 pub use episode::{DemoEpisode, EpisodeRecorder, StateRecording};
-pub use replay::{replay_episode, ReplayOptions, ReplayedEpisode, MAX_EXTRA_STEPS_PER_SOURCE_STEP};
+pub use replay::{
+    replay_episode, AttemptPlan, ReplayOptions, ReplayedEpisode, MAX_EXTRA_STEPS_PER_SOURCE_STEP,
+    TRAILING_TOLERANCE_M,
+};
 pub use scripted::scripted_episode;
 
 use crate::error::EnvError;

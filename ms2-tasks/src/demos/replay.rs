@@ -39,10 +39,14 @@ pub struct ReplayOptions {
     pub use_first_env_state: bool,
     /// Collect the observations (in `cfg.obs_mode`) after reset and after every step.
     pub record_obs: bool,
-    /// Further attempts after the conversion of a successful source episode fails. Retry `k`
-    /// also takes extra target steps per source step while the target TCP is more than
-    /// [`TRAILING_TOLERANCE_M`]` / k` away from the recorded one (trading the source's timing
-    /// for its path).
+    /// Further attempts after the conversion of a successful source episode fails, or succeeds
+    /// only after the env's `max_episode_steps`. The retries form a portfolio (see
+    /// [`AttemptPlan::for_attempt`]): they alternate between the two ways of tracking the source
+    /// (with the in-hand object correction and by the hand path alone; only the first for tasks
+    /// without a graspable object) and take extra target steps per source step while the target
+    /// TCP trails the recorded one by more than [`TRAILING_TOLERANCE_M`], then half of it, ...
+    /// (trading the source's timing for its path). The best attempt is returned: a success
+    /// within the episode limit, else a later success, else the last attempt.
     pub max_retry: u32,
     /// Convert by the source's hand path alone: no in-hand correction (see
     /// [`replay_episode`]). ManiSkill2's converter works this way.
@@ -140,17 +144,78 @@ pub fn replay_episode(
             attempts: 1,
         });
     }
-    let mut attempt = 0;
-    loop {
-        let trailing_tolerance = (attempt > 0).then(|| TRAILING_TOLERANCE_M / attempt as f32);
-        let (episode, obs) = convert_once(&env_cfg, &mut env, source, opts, trailing_tolerance)?;
-        attempt += 1;
-        if episode.succeeded() || !source.succeeded() || attempt > opts.max_retry {
-            return Ok(ReplayedEpisode {
-                episode,
-                obs,
-                attempts: attempt,
-            });
+    let step_limit = env.max_episode_steps() as usize;
+    let rank = |e: &DemoEpisode| match (e.succeeded(), e.actions.len() <= step_limit) {
+        (true, true) => 2,
+        (true, false) => 1,
+        (false, _) => 0,
+    };
+    let mut best: Option<(DemoEpisode, Option<Vec<ObsValue>>)> = None;
+    let mut attempts = 0;
+    for attempt in 0..=opts.max_retry {
+        // Robots whose chain the correction does not know have one way of tracking: retries
+        // only tighten it (the env's scene exists from the first attempt's reset on).
+        let can_follow = ObjectFollowing::new(&env).is_some();
+        let plan = AttemptPlan::for_attempt(attempt, opts.track_hand_only, can_follow);
+        let (episode, obs) = convert_once(&env_cfg, &mut env, source, opts, plan)?;
+        attempts = attempt + 1;
+        let better = best.as_ref().is_none_or(|(b, _)| rank(&episode) >= rank(b));
+        if better {
+            best = Some((episode, obs));
+        }
+        let best_rank = best.as_ref().map_or(0, |(b, _)| rank(b));
+        if best_rank == 2 || !source.succeeded() {
+            break;
+        }
+    }
+    let (episode, obs) = best.expect("at least one attempt ran");
+    Ok(ReplayedEpisode {
+        episode,
+        obs,
+        attempts,
+    })
+}
+
+/// How one conversion attempt tracks the source (see [`ReplayOptions::max_retry`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AttemptPlan {
+    /// Convert by the source's hand path alone (no in-hand object correction).
+    pub hand_only: bool,
+    /// Take extra target steps while the target TCP is more than this far (m) from the TCP
+    /// recorded after the source step; `None`: only while the action saturates or IK fails.
+    pub trailing_tolerance: Option<f32>,
+}
+
+impl AttemptPlan {
+    /// The plan of attempt `attempt` (0 = the first, 1 = the first retry, ...). The first
+    /// attempt tracks as asked (`hand_only_first`) with no trailing test. Retry `r` switches to
+    /// the other way of tracking when `r` is odd (if `can_follow`: the task has an object the
+    /// correction can follow) and trails by at most `TRAILING_TOLERANCE_M / ⌈r/2⌉` (without
+    /// `can_follow`: `TRAILING_TOLERANCE_M / r`).
+    ///
+    /// ```
+    /// use ms2_tasks::demos::{AttemptPlan, TRAILING_TOLERANCE_M};
+    /// let p = |a| AttemptPlan::for_attempt(a, false, true);
+    /// assert_eq!(p(0), AttemptPlan { hand_only: false, trailing_tolerance: None });
+    /// assert_eq!(p(1), AttemptPlan { hand_only: true, trailing_tolerance: Some(TRAILING_TOLERANCE_M) });
+    /// assert_eq!(p(2), AttemptPlan { hand_only: false, trailing_tolerance: Some(TRAILING_TOLERANCE_M) });
+    /// assert_eq!(p(3).trailing_tolerance, Some(TRAILING_TOLERANCE_M / 2.0));
+    /// ```
+    pub fn for_attempt(attempt: u32, hand_only_first: bool, can_follow: bool) -> Self {
+        if attempt == 0 {
+            return Self {
+                hand_only: hand_only_first,
+                trailing_tolerance: None,
+            };
+        }
+        let (switch, tightening) = if can_follow {
+            (attempt % 2 == 1, attempt.div_ceil(2))
+        } else {
+            (false, attempt)
+        };
+        Self {
+            hand_only: hand_only_first ^ switch,
+            trailing_tolerance: Some(TRAILING_TOLERANCE_M / tightening as f32),
         }
     }
 }
@@ -227,17 +292,17 @@ pub(crate) fn restore_init_state(env: &mut Env, source: &DemoEpisode) -> Result<
     Ok(())
 }
 
-/// One closed-loop conversion of `source` into `env`'s control mode. With
-/// `trailing_tolerance = Some(d)`, extra target steps are also taken while the TCP is more than
-/// `d` metres from the TCP recorded after the source step.
+/// One closed-loop conversion of `source` into `env`'s control mode, tracking it as `plan`
+/// says.
 fn convert_once(
     cfg: &EnvConfig,
     env: &mut Env,
     source: &DemoEpisode,
     opts: &ReplayOptions,
-    trailing_tolerance: Option<f32>,
+    plan: AttemptPlan,
 ) -> Result<(DemoEpisode, Option<Vec<ObsValue>>), DemoError> {
     let record_obs = opts.record_obs;
+    let trailing_tolerance = plan.trailing_tolerance;
     let (mut recorder, mut first_obs) = EpisodeRecorder::reset(env, source.episode_seed)?;
     if opts.use_first_env_state || source.state_recording == StateRecording::InitialOnly {
         restore_init_state(env, source)?;
@@ -249,7 +314,7 @@ fn convert_once(
     let mut obs = ObsLog::new(record_obs, first_obs);
     let mut targets = SourceJointTargets::new(cfg, env, source)?;
     let dof = targets.dof();
-    let mut following = if opts.track_hand_only {
+    let mut following = if plan.hand_only {
         None
     } else {
         ObjectFollowing::new(env)
