@@ -9,6 +9,7 @@
 //! [`BucketArm`], with no bucket on the hand; ManiSkill2 couples every link, ms2 the ones the
 //! rope can reach and the coupling can read: the real Panda's hand is a convex hull).
 //!
+//! - Rates: MPM at 4 kHz by default ([`HANG_MPM_FREQ_HZ`]), physics 500 Hz, control 20 Hz.
 //! - Episode (seeded): the rod's distance, direction and height; where along the rope the
 //!   fingers hold it ([`GRASP_ARC`]); the particles' jitter.
 //! - Success (ManiSkill2's terms, [`hang_terms`]): the tracked particles near the two ends on
