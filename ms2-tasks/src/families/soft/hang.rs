@@ -2,8 +2,8 @@
 //! Hang.
 //!
 //! The Panda (ManiSkill2's, base at (−0.46, 0, 0) m, arm at ManiSkill2's Hang start
-//! configuration) starts with the rope pinched between its fingers about a fifth of the
-//! rope's length from one end ([`RopeStart`]); a red kinematic rod (60 cm long, 2 cm square)
+//! configuration) starts with the rope on its fingertips (in slots of the rope) about a fifth
+//! of the rope's length from one end ([`RopeStart`]); a red kinematic rod (60 cm long, 2 cm square)
 //! floats at a seeded pose in front of it ([`RodPose::from_unit`]). The rope is coupled
 //! two-way to both fingers and the rod (the coupled solver shared with the bucket tasks,
 //! [`BucketArm`], with no bucket on the hand; ManiSkill2 couples every link, ms2 the ones the
@@ -313,7 +313,7 @@ impl Task for Hang {
         Ok(())
     }
 
-    /// ManiSkill2's Hang start: base at (−0.46, 0, 0), [`ARM_START`], fingers pinching.
+    /// ManiSkill2's Hang start: base at (−0.46, 0, 0), [`ARM_START`], fingertips 8 mm apart.
     fn initialize_agent(
         &mut self,
         scene: &mut TaskScene,
