@@ -11,7 +11,8 @@
 //!   in a fixed order (no atomics), so results are bitwise identical for any thread count. The kernels only read and write flat arrays, which leaves room for
 //!   a GPU compute backend with the same data layout.
 //! - [`Material`]: von Mises clay, weakly compressible water, fixed-corotated elastic solid.
-//! - [`sampling`]: particle sets from boxes, cylinders, mesh volumes and height maps.
+//! - [`sampling`]: particle sets from boxes, cylinders, mesh volumes and height maps;
+//!   [`bent_bar`]: a straight bar bent along a planar curve, with its deformation gradients.
 //! - [`MpmState`]: full state get/set for resets and trajectories.
 //! - [`coupling`]: the [`RigidBackend`] trait a rigid engine implements, collision shapes as
 //!   signed distance functions ([`sdf`]), and [`Coupling`], which applies penalty and friction
@@ -25,6 +26,7 @@
 
 #![warn(missing_docs)]
 
+pub mod bent_bar;
 mod contact;
 pub mod coupling;
 pub mod error;

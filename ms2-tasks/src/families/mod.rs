@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | [`rigid`] | `PickCube-v0`, `LiftCube-v0`, `StackCube-v0` | — |
 //! | [`assembly`] | `PegInsertionSide-v0`, `PlugCharger-v0`, `AssemblingKits-v0` | — |
-//! | [`soft`] | `Excavate-v0`, `Fill-v0` | `soft` |
+//! | [`soft`] | `Excavate-v0`, `Fill-v0`, `Hang-v0` | `soft` |
 //! | [`articulated`] | `TurnFaucet-v0` (PartNet-Mobility-layout models) | — |
 //! | [`misc`] | `PandaAvoidObstacles-v0` | — |
 //! | [`dummy`] | `Dummy-v0` (physics-free test env) | — |

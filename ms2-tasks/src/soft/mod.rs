@@ -115,6 +115,20 @@ impl SoftWorld {
         bodies: Vec<BodyId>,
     ) -> Result<Self, SoftSceneError> {
         let dt = solver.config().substep_dt;
+        let params = CouplingParams::for_substep(dt.max(COUPLING_REFERENCE_SUBSTEP));
+        Self::with_params(solver, world, bodies, params)
+    }
+
+    /// As [`SoftWorld::new`] with the coupling's contact constants `params` (e.g. the stiffer
+    /// ones of [`CouplingParams::for_substep`] at a short substep, for a soft body whose
+    /// weight rests on a few particles).
+    pub fn with_params(
+        solver: MpmSolver,
+        world: &dyn RigidWorld,
+        bodies: Vec<BodyId>,
+        params: CouplingParams,
+    ) -> Result<Self, SoftSceneError> {
+        let dt = solver.config().substep_dt;
         let ratio = world.timestep() / dt;
         let substeps = ratio.round() as usize;
         if substeps == 0 || (ratio - substeps as f32).abs() > 1e-3 {
@@ -125,10 +139,7 @@ impl SoftWorld {
             }));
         }
         let bodies = CoupledBodies::new(world, bodies)?;
-        let coupling = Coupling::new(
-            &MpmRigidWorldView::new(world, &bodies),
-            CouplingParams::for_substep(dt.max(COUPLING_REFERENCE_SUBSTEP)),
-        )?;
+        let coupling = Coupling::new(&MpmRigidWorldView::new(world, &bodies), params)?;
         Ok(Self {
             solver,
             coupling,

@@ -168,9 +168,29 @@ impl BucketArm {
         Ok(())
     }
 
+    /// Couples `solver` (its particles already added) to exactly `bodies` of `world` with the
+    /// contact constants `params` (a task whose hand has shapes the coupling cannot read
+    /// couples its fingers instead).
+    pub fn couple_bodies(
+        &mut self,
+        solver: MpmSolver,
+        world: &dyn RigidWorld,
+        bodies: Vec<BodyId>,
+        params: ms2_mpm::CouplingParams,
+    ) -> Result<(), EnvError> {
+        self.soft = Some(SoftWorld::with_params(solver, world, bodies, params)?);
+        Ok(())
+    }
+
     /// The coupled soft world, once an episode started.
     pub fn soft(&self) -> Option<&SoftWorld> {
         self.soft.as_ref()
+    }
+
+    /// World pose of the hand link (`None` before the hand is located).
+    pub fn hand_pose(&self, world: &dyn RigidWorld) -> Option<Pose3> {
+        let (art, link, _) = self.hand?;
+        world.link_pose(art, link).ok()
     }
 
     /// World pose of the bucket frame (identity before the hand is located).

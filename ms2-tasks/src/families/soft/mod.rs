@@ -1,15 +1,20 @@
 //! Soft-body tasks on the MPM solver two-way coupled with the rigid world: `Excavate-v0` and
 //! `Fill-v0`, both with the Panda carrying a bucket (`panda_bucket`, ManiSkill2's
-//! `robot="panda"` with its bucket configuration).
+//! `robot="panda"` with its bucket configuration), and `Hang-v0` with the plain Panda.
 //!
 //! [`bucket_arm`] is the family's shared base and its one soft component (the clay coupled to
 //! the hand); [`excavate_scene`] the Excavate bed, goal and scoop (and a standalone kinematic
 //! scene); [`excavate`] and [`fill`] the tasks' hooks; [`scripted`] their oracle policies.
+//! [`hang_scene`] is Hang's rope, rod and success terms, [`hang`] its hooks (on the same
+//! base, coupled to the fingers and the rod), [`hang_policy`] its oracle.
 
 pub mod bucket_arm;
 pub mod excavate;
 pub mod excavate_scene;
 pub mod fill;
+pub mod hang;
+pub mod hang_policy;
+pub mod hang_scene;
 pub mod scripted;
 
 use crate::config::ObsMode;
@@ -52,6 +57,28 @@ pub const EXCAVATE: TaskSpec = bucket_spec(
 /// `Fill-v0`'s spec.
 pub const FILL: TaskSpec = bucket_spec("Fill-v0", "pour the clay in the bucket into a beaker");
 
+/// `Hang-v0`'s robot: ManiSkill2's Panda with its gripper.
+const PANDA: &[RobotChoice] = &[RobotChoice {
+    uid: "panda",
+    agent: "panda",
+}];
+
+/// `Hang-v0`'s spec.
+pub const HANG: TaskSpec = TaskSpec {
+    env_id: "Hang-v0",
+    family: "soft",
+    summary: "hang the noodle (an elastic rope) over a rod",
+    max_episode_steps: hang::MAX_EPISODE_STEPS,
+    robots: PANDA,
+    control_modes: &[],
+    default_control_mode: DEFAULT_CONTROL_MODE,
+    obs_modes: SOFT_OBS_MODES,
+    non_privileged_extra_keys: &["tcp_pose", "target"],
+    goal_marker: None,
+    soft_bodies: true,
+    assets: &[],
+};
+
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
     r.add(
@@ -61,5 +88,9 @@ pub fn register(r: &mut Registrar) {
     r.add(
         TaskRegistration::new(FILL, |cfg| Ok(Box::new(fill::Fill::new(cfg)?)))
             .scripted(scripted::FillPolicy::boxed),
+    );
+    r.add(
+        TaskRegistration::new(HANG, |cfg| Ok(Box::new(hang::Hang::new(cfg)?)))
+            .scripted(hang_policy::HangPolicy::boxed),
     );
 }
