@@ -104,6 +104,21 @@ fn hang_env(obs_mode: &str) -> ms2_tasks::Env {
     make_env(&cfg).unwrap()
 }
 
+/// Number of elements of the box at `path` ("a/b") in `space`.
+fn space_size(space: &ms2_tasks::Space, path: &str) -> usize {
+    let mut node = space;
+    for key in path.split('/') {
+        let ms2_tasks::Space::Dict(entries) = node else {
+            panic!("{path}: not a dict at {key}")
+        };
+        node = &entries.iter().find(|(k, _)| k == key).unwrap().1;
+    }
+    match node {
+        ms2_tasks::Space::Box(b) => b.size(),
+        ms2_tasks::Space::Dict(_) => panic!("{path} is a dict"),
+    }
+}
+
 #[test]
 fn episodes_start_with_the_rope_on_the_fingertips_and_a_seeded_rod() {
     let mut env = hang_env("particles");
@@ -113,6 +128,12 @@ fn episodes_start_with_the_rope_on_the_fingertips_and_a_seeded_rod() {
         let (obs, _) = env.reset(Some(seed), false).unwrap();
         let x = obs.get("particles/x").unwrap().as_f32().unwrap();
         assert!(x.len() / 3 > 9000, "seed {seed}: {} particles", x.len() / 3);
+        // The observation space fixes the count: every seed has the same particles.
+        assert_eq!(
+            x.len(),
+            space_size(env.observation_space(), "particles/x"),
+            "seed {seed}"
+        );
         let target = obs.get("extra/target").unwrap().as_f32().unwrap();
         let (r, z) = (target[0].hypot(target[1]), target[2]);
         assert!(
@@ -147,6 +168,13 @@ fn episodes_start_with_the_rope_on_the_fingertips_and_a_seeded_rod() {
     }
     heights.dedup();
     assert_eq!(heights.len(), 4, "the rod height repeats: {heights:?}");
+    // Every grasp point the seeds draw keeps the observation space's particle count.
+    let expected = space_size(env.observation_space(), "particles/x");
+    for seed in 4..40 {
+        let (obs, _) = env.reset(Some(seed), false).unwrap();
+        let x = obs.get("particles/x").unwrap().as_f32().unwrap();
+        assert_eq!(x.len(), expected, "seed {seed}");
+    }
 }
 
 #[test]

@@ -328,7 +328,10 @@ impl Task for Hang {
 
     fn initialize_task(&mut self, scene: &TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let world = scene.world.as_ref();
-        self.grasp_arc = rng.random_range(GRASP_ARC.0..GRASP_ARC.1);
+        // Whole lattice spacings along the rope, so that the fingertips' slots cut the same
+        // particles whatever the draw (the observation space fixes the particle count).
+        let steps = ((GRASP_ARC.1 - GRASP_ARC.0) / ROPE_SPACING).round() as u32;
+        self.grasp_arc = GRASP_ARC.0 + ROPE_SPACING * rng.random_range(0..=steps) as f32;
         let start = RopeStart::new(&self.pinch(world)?, self.grasp_arc);
         let dt = self
             .arm

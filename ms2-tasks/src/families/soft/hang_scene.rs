@@ -33,7 +33,7 @@ pub const ROPE_SPACING: f32 = 0.0025;
 /// Linear RGB colour of the drawn rope (ManiSkill2's pale yellow).
 pub const ROPE_COLOR: [f32; 3] = [1.0, 1.0, 0.5];
 /// Range of the grasp point's arc length from the rope's short end (m): ManiSkill2's
-/// recorded starts hold the rope 20-24 % along it.
+/// recorded starts hold the rope 20-24 % along it. Drawn in whole [`ROPE_SPACING`] steps.
 pub const GRASP_ARC: (f32, f32) = (0.08, 0.095);
 /// Fractions of the rope's length of the five tracked particles (ManiSkill2's
 /// `selected_indices`: two near each end, one in the middle), from the short end.
@@ -248,7 +248,8 @@ impl RopeStart {
         jitter_seed: u64,
     ) -> Result<[ParticleId; 5], SoftSceneError> {
         let mut p = self.bar.sample(ROPE_SPACING);
-        sampling::jitter(&mut p.positions, 0.1 * ROPE_SPACING, jitter_seed);
+        // The slots are cut from the lattice before the jitter, so that every seed keeps the
+        // same particles (the observation space fixes the count).
         let keep: Vec<bool> = p
             .positions
             .iter()
@@ -267,6 +268,7 @@ impl RopeStart {
         p.arc_length.retain(|_| *k.next().unwrap_or(&true));
         let mut k = keep.iter();
         p.on_axis.retain(|_| *k.next().unwrap_or(&true));
+        sampling::jitter(&mut p.positions, 0.1 * ROPE_SPACING, jitter_seed);
         let ids = solver.add_particles(&p.positions, rope, ROPE_SPACING.powi(3), Vec3::ZERO)?;
         let first = ids.first().copied().unwrap_or(0);
         let mut state = solver.state();
