@@ -173,9 +173,11 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     # sum and count of the training step rewards since then.
     train_episodes = [0, 0]
     train_rewards = [0.0, 0]
+    # Wall seconds spent evaluating (unrounded: the CSV's eval_s are rounded).
+    eval_seconds = [0.0]
 
     def train_wall_s() -> float:
-        return time.perf_counter() - start - sum(r["eval_s"] for r in rows)
+        return time.perf_counter() - start - eval_seconds[0]
 
     def log_eval(env_steps: int) -> None:
         wall_s = train_wall_s()
@@ -201,6 +203,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             writer.writerow(row)
         print(json.dumps(row), flush=True)
         model.save(args.out / "model.zip")
+        eval_seconds[0] += time.perf_counter() - eval_start
 
     class EvalCallback(BaseCallback):
         def __init__(self) -> None:
