@@ -73,6 +73,22 @@ def test_ppo_state_runs_end_to_end(tmp_path, backend):
     assert action.shape == (7,)
 
 
+def test_ppo_state_time_limit_stops_training_and_evaluates(tmp_path):
+    """``--time-limit 0`` stops training at its first env step (one step of each env), then the
+    final evaluation runs and the model and summary are written."""
+    ppo = load_example("ppo_state")
+    out = tmp_path / "ppo"
+    summary = ppo.main(
+        ["--env", "LiftCube-v0", "--num-envs", "2", "--max-episode-steps", "20",
+         "--total-steps", "400", "--rollout-steps", "200", "--batch-size", "50",
+         "--n-epochs", "1", "--eval-freq", "200", "--eval-episodes", "2",
+         "--eval-max-episode-steps", "5", "--time-limit", "0", "--out", str(out)]
+    )  # fmt: skip
+    assert summary["env_steps"] == 2
+    assert [int(r["env_steps"]) for r in read_csv(out / "eval.csv")] == [0, 2]
+    assert (out / "model.zip").stat().st_size > 0
+
+
 def test_ppo_continuous_vec_env_reports_success_as_truncation(tmp_path):
     """A demo's actions replayed in the training env: the success that ends the native episode
     is reported as a time-limit truncation (PPO bootstraps), the plain wrapper's as a

@@ -63,3 +63,30 @@ def test_scripted_policy_needs_an_ms2_env():
 
     with pytest.raises(TypeError, match="ms2 env"):
         ms2.ScriptedPolicy(gym.make("CartPole-v1"))
+
+
+def test_liftcube_normalized_dense_reward_along_a_scripted_lift():
+    """LiftCube-v0's ``normalized_dense`` reward (ManiSkill2's terms over 2.25) along the scripted
+    grasp and lift in ``pd_ee_delta_pose``: reach only while the cube is on the table (at most
+    (1 + 0.25) / 2.25 < 0.56), reach + grasp + lift fraction once it is half lifted (> 0.7),
+    within [0, 1] throughout, and exactly 1 at the success that ends the episode."""
+    env = make("LiftCube-v0", obs_mode="state_dict", control_mode="pd_ee_delta_pose",
+               reward_mode="normalized_dense")  # fmt: skip
+    policy = ms2.ScriptedPolicy(env)
+    for seed in range(2):
+        env.reset(seed=seed)
+        policy.reset()
+        on_table, half_lifted = [], []
+        while True:
+            obs, reward, terminated, truncated, info = env.step(policy.act())
+            assert 0.0 <= reward <= 1.0
+            cube_z = obs["extra"]["obj_pose"][2]  # cube centre height (m); half size 0.02
+            if cube_z < 0.021:
+                on_table.append(reward)
+            elif cube_z - 0.02 >= 0.1 and not info["success"]:
+                half_lifted.append(reward)
+            if terminated or truncated:
+                break
+        assert info["success"] and reward == pytest.approx(1.0, abs=1e-6)
+        assert on_table and max(on_table) < 0.56, on_table
+        assert half_lifted and min(half_lifted) > 0.7, half_lifted
