@@ -184,13 +184,15 @@ impl BucketArm {
         hand * hand_from_bucket()
     }
 
-    /// The bucket's plate centre (m) and pitch (rad; positive raises the opening).
+    /// The bucket's plate centre (m), pitch (rad; positive raises the opening) and yaw (rad,
+    /// heading of the open front about world +z).
     pub fn bucket_command_pose(&self, world: &dyn RigidWorld) -> BucketPose {
         let (p, q) = pose_to_glam(&self.bucket_pose(world));
         let x = q * Vec3::X;
         BucketPose {
             position: p,
             pitch: x.z.atan2(Vec2::new(x.x, x.y).length()),
+            yaw: x.y.atan2(x.x),
         }
     }
 
