@@ -474,14 +474,15 @@ mod soft_envs {
     #[test]
     fn mpm_freq_sets_the_soft_substeps_and_bad_values_are_refused() {
         for (env_id, mpm_freq, per_step) in [
-            ("Excavate-v0", None, 50),
-            ("Excavate-v0", Some(2000.0), 100),
+            // ManiSkill2's 2 kHz by default.
+            ("Excavate-v0", None, 100),
+            ("Excavate-v0", Some(1000.0), 50),
             ("Fill-v0", Some(1500.0), 75),
         ] {
             let mut cfg = EnvConfig::new(env_id);
             cfg.mpm_freq = mpm_freq;
             let mut env = make_env(&cfg).unwrap();
-            assert_eq!(env.config().mpm_freq, Some(mpm_freq.unwrap_or(1000.0)));
+            assert_eq!(env.config().mpm_freq, Some(mpm_freq.unwrap_or(2000.0)));
             env.reset(Some(0), false).unwrap();
             let before = mpm_substeps_taken(&env);
             env.step(&vec![0.0; env.action_space().size()]).unwrap();
