@@ -15,7 +15,7 @@ SOFT_IDS = ("Excavate-v0", "Fill-v0")
 @pytest.mark.parametrize("env_id", SOFT_IDS)
 def test_particles_obs_mode_and_default_mpm_freq(env_id):
     env = gym.make(env_id, obs_mode="particles")
-    assert env.unwrapped.mpm_freq == 1000.0
+    assert env.unwrapped.mpm_freq == 2000.0  # ManiSkill2's rate
     space = env.observation_space["particles"]["x"]
     for seed in range(3):
         obs, _ = env.reset(seed=seed)

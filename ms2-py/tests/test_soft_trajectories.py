@@ -48,7 +48,7 @@ def test_recorded_soft_episode_keeps_init_state_and_replays_bit_for_bit(tmp_path
         init = f["traj_0/env_init_state"]
         assert init.dtype == np.float32 and init.shape == final_state.shape
     meta = json.loads(path.with_suffix(".json").read_text())
-    assert meta["env_info"]["env_kwargs"]["mpm_freq"] == 1000.0
+    assert meta["env_info"]["env_kwargs"]["mpm_freq"] == 2000.0
     with open_trajectory(path) as traj:
         assert traj.is_soft(0)
         (episode,) = list(traj)
@@ -60,7 +60,7 @@ def test_recorded_soft_episode_keeps_init_state_and_replays_bit_for_bit(tmp_path
     assert result.num_episodes == 1
     with open_trajectory(result.output) as out:
         replayed = out.read_episode(0, with_obs=True)
-        assert out.env_info["env_kwargs"]["mpm_freq"] == 1000.0
+        assert out.env_info["env_kwargs"]["mpm_freq"] == 2000.0
     np.testing.assert_array_equal(replayed["env_init_state"], episode["env_init_state"])
     np.testing.assert_array_equal(replayed["success"], success)
     np.testing.assert_array_equal(replayed["obs"]["particles"]["x"][-1], final_x)
@@ -94,7 +94,7 @@ def test_generated_soft_demos_replay_convert_and_render(tmp_path, capsys):
     ]
     assert main([*argv, "--workers", "2", "-q"]) == 0
     with open_trajectory(path) as traj:
-        assert traj.env_info["env_kwargs"]["mpm_freq"] == 1000.0
+        assert traj.env_info["env_kwargs"]["mpm_freq"] == 2000.0
         # Soft-body demos default to the soft envs' rate-limited pd_joint_delta_pos.
         assert traj.env_info["env_kwargs"]["control_mode"] == "pd_joint_delta_pos"
         assert all(traj.is_soft(i) for i in range(len(traj)))

@@ -14,6 +14,8 @@
 //! cargo run -p ms2-tasks --release --example demo_conversion -- OpenCabinetDrawer-v1 200 \
 //!     base_pd_joint_vel_arm_pd_ee_delta_pose --source scripted
 //! ```
+//! `--source-mode MODE` records the source episodes in MODE instead of `pd_joint_pos`.
+//! `--mpm-freq HZ` sets the soft-body envs' MPM substep frequency (default: the env's).
 //! `--track-hand-only` converts by the source's hand path alone (`ReplayOptions::track_hand_only`,
 //! ManiSkill2's way), without the in-hand correction.
 //! Episodes run in parallel on rayon's pool (`RAYON_NUM_THREADS`); times are CPU-seconds per
@@ -60,14 +62,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mobile_prefix = "base_pd_joint_vel_arm_";
     let spec = ms2_tasks::task_spec(env_id)?;
     let step_limit = spec.max_episode_steps as usize;
-    let source_mode = if spec.default_control_mode.starts_with(mobile_prefix) {
-        format!("{mobile_prefix}pd_joint_pos")
-    } else {
-        "pd_joint_pos".to_owned()
+    // `--source-mode MODE` records the sources in MODE (default `pd_joint_pos`).
+    let source_mode = match flag("--source-mode") {
+        Some(mode) => mode.clone(),
+        None if spec.default_control_mode.starts_with(mobile_prefix) => {
+            format!("{mobile_prefix}pd_joint_pos")
+        }
+        None => "pd_joint_pos".to_owned(),
     };
+    let mpm_freq: Option<f64> = flag("--mpm-freq").map(|s| s.parse()).transpose()?;
     let cfg = EnvConfig {
         obs_mode: "state".to_owned(),
         control_mode: Some(source_mode),
+        mpm_freq,
         ..EnvConfig::new(env_id)
     };
     // `--seeds 6,23,58` converts those seeds instead of 0..n.

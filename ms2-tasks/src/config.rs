@@ -40,7 +40,7 @@ pub struct EnvConfig {
     /// Episode length limit in env steps; `None` = the task's default (200 for the rigid tasks).
     pub max_episode_steps: Option<u32>,
     /// MPM substep frequency in Hz of the soft-body tasks (`Excavate-v0`, `Fill-v0`); `None` =
-    /// the task's default (1000 Hz; ManiSkill2 uses 2000). Must be a whole multiple of
+    /// the task's default (2000 Hz, as ManiSkill2). Must be a whole multiple of
     /// `sim_freq`; setting it on an env without soft bodies is an error.
     pub mpm_freq: Option<f64>,
     /// Whether the first directional light casts shadows in every image (observation cameras
@@ -183,12 +183,12 @@ impl EnvConfig {
 pub const SIM_FREQ_RANGE: (f64, f64) = (10.0, 10_000.0);
 /// Accepted control (env step) frequencies (Hz); ManiSkill2's default is 20.
 pub const CONTROL_FREQ_RANGE: (f64, f64) = (0.1, 10_000.0);
-/// Accepted MPM substep frequencies (Hz) of the soft-body tasks (default 1000, ManiSkill2 2000).
+/// Accepted MPM substep frequencies (Hz) of the soft-body tasks (default 2000, as ManiSkill2).
 pub const MPM_FREQ_RANGE: (f64, f64) = (10.0, 20_000.0);
 /// Most physics substeps per env step (`sim_freq / control_freq`; 25 by default): bounds the
 /// time one `step` takes (well under a second for the rigid tasks).
 pub const MAX_SUBSTEPS: u32 = 1000;
-/// Most MPM substeps per env step (`mpm_freq / control_freq`; 50 by default, 100 at ManiSkill2's
+/// Most MPM substeps per env step (`mpm_freq / control_freq`; 100 at the default, ManiSkill2's
 /// 2 kHz): bounds the time one soft-body `step` takes (a few seconds at most).
 pub const MAX_MPM_SUBSTEPS: u32 = 2000;
 /// Longest accepted episode limit in env steps (ManiSkill2's tasks use 200-350).

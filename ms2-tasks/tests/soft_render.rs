@@ -315,10 +315,10 @@ fn fill_point_cloud_shows_the_clay_in_the_bucket_then_in_the_beaker() {
             "clay point {p} far from the bucket at {centre}"
         );
     }
-    // Pour until the episode ends in success (about 50 control steps); the arm then moves
+    // Pour until the episode ends in success (about 60 control steps); the arm then moves
     // on and may hide the beaker from the camera.
     let mut obs = obs;
-    for _ in 0..60 {
+    for _ in 0..90 {
         let out = e.step(&policy.act(&e)).unwrap();
         obs = out.obs;
         if out.terminated {

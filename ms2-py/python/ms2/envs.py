@@ -132,7 +132,7 @@ class Ms2Env(gym.Env):
             ``Segmentation`` u32 [H, W, 4] to the ``image`` / ``rgbd`` observations)). Unknown
             keys or bad values raise ``ValueError``.
         mpm_freq: MPM substep frequency in Hz of the soft-body tasks (``Excavate-v0``,
-            ``Fill-v0``); ``None`` = the task's default (1000; ManiSkill2 uses 2000). Must be a
+            ``Fill-v0``); ``None`` = the task's default (2000, as ManiSkill2). Must be a
             whole multiple of ``sim_freq``; ``ValueError`` on envs without soft bodies.
         enable_shadow: whether the first directional light casts shadows in every image
             (ManiSkill2's keyword; off by default).

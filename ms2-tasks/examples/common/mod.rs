@@ -1,6 +1,6 @@
 //! Helpers shared by the examples: process measurements for the cost examples
 //! (`render_cost`, `soft_render_cost`), argument parsing and the episode loop of the oracle
-//! traces (`bucket_trace`, `chair_trace`, `cabinet_trace`).
+//! traces (`bucket_trace`, `chair_trace`, `cabinet_trace`, `fill_trace`).
 #![allow(dead_code)]
 
 use ms2_tasks::{info_get, Env, EnvError, Info, InfoValue, ScriptedPolicy, StepOutput};

@@ -9,10 +9,10 @@
 //! Rates and resolution ([`SoftConfig::default`]), chosen for a 2-core CPU:
 //! grid cell 1 cm (the paper's range is 0.5-1.5 cm), two particles per cell and axis (spacing
 //! 5 mm, particle volume 1.25e-7 m³, the paper's 1.2e-7), soft substeps of 1 ms (1000 Hz, two
-//! per rigid step; ManiSkill2 uses 2000 Hz). Clay: density 1000 kg/m³, E 1e4 Pa, Poisson 0.3,
-//! yield stress 2e3 Pa (the paper's soft clay). Stability: the clay's pressure-wave speed is
-//! `sqrt(E(1−ν)/((1+ν)(1−2ν))/ρ)` ≈ 3.7 m/s, so a substep moves a wave 3.7 mm, 0.37 of a cell
-//! (CFL < 1); tools move below 0.5 m/s (0.05 cell per substep). The coupling's contact
+//! per rigid step; the soft-body tasks run ManiSkill2's 2000 Hz, `families::soft::bucket_arm`).
+//! Clay: density 1000 kg/m³, E 1e4 Pa, Poisson 0.3, yield stress 2e3 Pa (the paper's soft
+//! clay). Stability: the clay's pressure-wave speed is `sqrt(E(1−ν)/((1+ν)(1−2ν))/ρ)`
+//! ≈ 3.7 m/s, so a 1 ms substep moves a wave 3.7 mm, 0.37 of a cell (CFL < 1); tools move below 0.5 m/s (0.05 cell per substep). The coupling's contact
 //! constants are those of a 1 ms substep at every faster rate ([`COUPLING_REFERENCE_SUBSTEP`]).
 //!
 //! The soft-body tasks built on it live in their family folder (`families/soft`).

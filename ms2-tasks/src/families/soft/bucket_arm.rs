@@ -25,8 +25,8 @@ use crate::soft::{SoftConfig, SoftWorld};
 use crate::task::{SoftComponent, TaskScene};
 
 /// MPM substep frequency (Hz) of the soft-body tasks unless `EnvConfig::mpm_freq` says
-/// otherwise: 1 kHz, two substeps per 500 Hz physics step (ManiSkill2 uses 2 kHz).
-pub const DEFAULT_MPM_FREQ_HZ: f64 = 1000.0;
+/// otherwise: ManiSkill2's 2 kHz, four substeps per 500 Hz physics step.
+pub const DEFAULT_MPM_FREQ_HZ: f64 = 2000.0;
 
 /// Floats of task state per particle: position 3, velocity 3, F 9, C 9 (column-major).
 pub const FLOATS_PER_PARTICLE: usize = 24;
@@ -204,13 +204,15 @@ impl BucketArm {
         hand * hand_from_bucket()
     }
 
-    /// The bucket's plate centre (m) and pitch (rad; positive raises the opening).
+    /// The bucket's plate centre (m), pitch (rad; positive raises the opening) and yaw (rad,
+    /// heading of the open front about world +z).
     pub fn bucket_command_pose(&self, world: &dyn RigidWorld) -> BucketPose {
         let (p, q) = pose_to_glam(&self.bucket_pose(world));
         let x = q * Vec3::X;
         BucketPose {
             position: p,
             pitch: x.z.atan2(Vec2::new(x.x, x.y).length()),
+            yaw: x.y.atan2(x.x),
         }
     }
 

@@ -77,14 +77,17 @@ const SPILL_MARGIN: f32 = 0.04;
 /// Range of the episode's target amount (particles).
 const TARGET_RANGE: (usize, usize) = (200, 340);
 
-/// Commanded bucket pose: position of the bottom plate's centre (m, world) and pitch (rad,
-/// about world −y: positive raises the opening).
+/// Commanded bucket pose: position of the bottom plate's centre (m, world), pitch (rad, about
+/// the bucket's horizontal side axis: positive raises the opening) and yaw (rad, about world
+/// +z: 0 points the open front along world +x).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BucketPose {
     /// Plate centre (m, world).
     pub position: Vec3,
     /// Opening raised by this angle (rad).
     pub pitch: f32,
+    /// Heading of the open front (rad, about world +z from world +x).
+    pub yaw: f32,
 }
 
 impl BucketPose {
@@ -92,7 +95,8 @@ impl BucketPose {
     pub fn to_pose(&self) -> Pose3 {
         Pose3::from_parts(
             Translation3::new(self.position.x, self.position.y, self.position.z),
-            UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -self.pitch),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), self.yaw)
+                * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -self.pitch),
         )
     }
 
@@ -100,6 +104,7 @@ impl BucketPose {
         BucketPose {
             position: self.position.lerp(other.position, t),
             pitch: self.pitch + (other.pitch - self.pitch) * t,
+            yaw: self.yaw + (other.yaw - self.yaw) * t,
         }
     }
 }
@@ -366,6 +371,7 @@ impl ExcavateScene {
                 bed.bed_top_z + 0.03,
             ),
             pitch: 0.0,
+            yaw: 0.0,
         };
         let bucket = world.add_actor(
             ActorDesc::new("bucket", ActorKind::Kinematic)
@@ -537,6 +543,7 @@ impl ScriptedScoop {
         let at = |x: f32, z: f32, pitch: f32| BucketPose {
             position: Vec3::new(x, start.position.y, z),
             pitch,
+            yaw: 0.0,
         };
         let lift_z = bed.target_height() + 0.04;
         let curl = 15f32.to_radians();

@@ -22,6 +22,20 @@ const APPROACH_STEPS: u32 = 14;
 /// Pitch (rad) of the pour: the opening 75° down.
 const POUR_PITCH: f32 = -75.0 * std::f32::consts::PI / 180.0;
 
+/// Control steps of the pour's carry: lift, then turn the open front sideways while bringing
+/// the lip over the beaker (the turn takes about 0.04 rad per step in `pd_ee_delta_pose`,
+/// whose rotation is clipped at 0.1 rad per step and tracked about halfway each step).
+const POUR_CARRY_STEPS: u32 = 36;
+
+/// Distance (m) the pour's lip stops short of the pour point, back along the open front.
+const POUR_LIP_BACK: f32 = 0.02;
+
+/// Distance (m) the pour's lip stops below the pour point (2 cm above the beaker's rim).
+const POUR_LIP_DROP: f32 = 0.02;
+
+/// Control steps of the pour's tilt from 30 % to all of [`POUR_PITCH`].
+const POUR_TILT_STEPS: u32 = 24;
+
 /// A bucket trajectory planned once per episode.
 pub trait BucketPlan: Send + Sized + 'static {
     /// Plans from the task at reset, the bucket starting level at `start`; `None` when the
@@ -57,6 +71,7 @@ impl<P: BucketPlan> ScriptedPolicy for BucketPolicy<P> {
                 .or_else(|| arm_task.downcast_ref::<Fill>().map(Fill::arm))?;
             let mut start = arm.bucket_command_pose(scene.world.as_ref());
             start.pitch = 0.0;
+            start.yaw = 0.0;
             P::plan(env, scene, start)
         });
     }
@@ -85,36 +100,55 @@ impl BucketPlan for ScriptedScoop {
     }
 }
 
-/// Bucket waypoints of the scripted pour: lift, carry the lip over the beaker, tilt the
-/// opening down about the lip, hold.
+/// Bucket waypoints of the scripted pour: lift, turn the open front sideways (towards the
+/// robot's centre line) while carrying the lip over the beaker, lower it, tilt the opening
+/// down about the lip, hold. The lip stops [`POUR_LIP_BACK`] short of the pour point and
+/// [`POUR_LIP_DROP`] below it: poured from the pour point itself at 2 kHz, a quarter of the
+/// clay (flung along the open front) landed beyond the beaker's far wall.
+///
+/// The turn keeps the pour within the Panda's reach: the bucket hangs 20 cm below the hand,
+/// so tilting it by [`POUR_PITCH`] swings the hand 19 cm along the open front. Tilted
+/// forward (along world +x, the bucket's heading at rest) that put the hand beyond the
+/// Panda's reach over the beaker; IK then failed and the bucket drifted back towards the
+/// robot in `pd_ee_delta_pose`. Sideways the hand stays about 70 cm from the robot's base.
 #[derive(Clone, Debug)]
 pub struct PourPlan {
     waypoints: Vec<(u32, BucketPose)>,
 }
 
 impl PourPlan {
-    /// Plans the pour from the bucket's pose `start` to the pour point `pour` (m, world).
+    /// Plans the pour from the bucket's pose `start` (its yaw taken as 0) to the pour point
+    /// `pour` (m, world; [`Fill::pour_point`]).
     pub fn new(start: BucketPose, pour: Vec3) -> Self {
         let hx = super::excavate_scene::BUCKET_INNER_HALF[0];
-        // Plate centre that puts the lip at `pour` for a given pitch.
+        // Open front towards −y for a beaker left of the centre line (y > 0), else +y: the
+        // tilt swings the hand towards the centre line.
+        let yaw = -std::f32::consts::FRAC_PI_2.copysign(pour.y);
+        let heading = glam::Quat::from_rotation_z(yaw);
+        // The clay leaves the lip moving along the open front: aim the lip short of `pour`.
+        let lip = pour - heading * Vec3::new(POUR_LIP_BACK, 0.0, POUR_LIP_DROP);
+        // Plate centre that puts the lip at `lip` for a given pitch.
         let centre = |pitch: f32| BucketPose {
-            position: pour - Vec3::new(hx * pitch.cos(), 0.0, hx * pitch.sin()),
+            position: lip - heading * Vec3::new(hx * pitch.cos(), 0.0, hx * pitch.sin()),
             pitch,
+            yaw,
         };
         let lifted = BucketPose {
             position: start.position + Vec3::new(0.0, 0.0, 0.04),
             pitch: 0.0,
+            yaw: 0.0,
         };
         let mut above = centre(0.0);
         above.position.z += 0.02;
+        let t = POUR_CARRY_STEPS;
         Self {
             waypoints: vec![
-                (0, start),
+                (0, BucketPose { yaw: 0.0, ..start }),
                 (6, lifted),
-                (16, above),
-                (20, centre(0.0)),
-                (24, centre(0.3 * POUR_PITCH)),
-                (36, centre(POUR_PITCH)),
+                (t, above),
+                (t + 4, centre(0.0)),
+                (t + 8, centre(0.3 * POUR_PITCH)),
+                (t + 8 + POUR_TILT_STEPS, centre(POUR_PITCH)),
                 (MAX_EPISODE_STEPS, centre(POUR_PITCH)),
             ],
         }
