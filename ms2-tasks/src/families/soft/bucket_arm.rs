@@ -65,6 +65,11 @@ pub fn bucket_task_cameras(
         base_position,
         0.0,
     );
+    with_base_camera(robot_cameras, base)
+}
+
+/// `robot_cameras` with `base` first, in place of the robot's camera of the same uid.
+pub fn with_base_camera(robot_cameras: Vec<CameraConfig>, base: CameraConfig) -> Vec<CameraConfig> {
     let mut cameras: Vec<CameraConfig> = robot_cameras
         .into_iter()
         .filter(|c| c.uid != base.uid)

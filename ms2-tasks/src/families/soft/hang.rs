@@ -31,7 +31,7 @@ use ms2_physics::{ActorDesc, ActorKind, ArticulationId, BodyId, Pose3, ShapeDesc
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use rand::Rng;
 
-use super::bucket_arm::BucketArm;
+use super::bucket_arm::{with_base_camera, BucketArm};
 use super::hang_scene::{
     hang_terms, rope_solver, sign, HangTerms, Pinch, RodPose, RopeStart, GRASP_ARC,
     HANG_MPM_FREQ_HZ, ROPE_COLOR, ROPE_SPACING,
@@ -250,12 +250,7 @@ impl Task for Hang {
             [0.45, 0.0, 0.5],
             [0.0, std::f32::consts::PI / 5.0, std::f32::consts::PI],
         );
-        let mut cameras: Vec<CameraConfig> = robot_cameras
-            .into_iter()
-            .filter(|c| c.uid != base.uid)
-            .collect();
-        cameras.insert(0, base);
-        cameras
+        with_base_camera(robot_cameras, base)
     }
 
     /// ManiSkill2's Hang render camera: at (0.2, 1, 0.5), Euler (0, 0.2, 4.4), fov 1 rad.
