@@ -2,7 +2,7 @@
 //!
 //! Two kinds of assets:
 //! - **written by the ms2 developers** and compiled in: the primitive Panda descriptions
-//!   ([`PANDA_URDF`], [`PANDA_BUCKET_URDF`]) and the xMate3 with a Robotiq gripper
+//!   ([`PANDA_URDF`], [`PANDA_BUCKET_URDF`], [`PANDA_STICK_URDF`]) and the xMate3 with a Robotiq gripper
 //!   ([`XMATE3_ROBOTIQ_URDF`]), built from URDF primitives (boxes and cylinders for
 //!   visuals; boxes and capsules for collision), so they need no mesh files;
 //! - **fetched, never part of the repository**: published files such as Franka's
@@ -98,6 +98,26 @@ pub const PANDA_BUCKET_INNER_HALF: [f64; 3] = [0.04, 0.035, 0.04];
 
 /// Half thickness (m) of the bucket's plate and walls.
 pub const PANDA_BUCKET_WALL_HALF: f64 = 0.003;
+
+/// URDF of the Panda with a stick fixed to `panda_hand` (link `stick`, joint `stick_joint`),
+/// the writing tool of the soft-body task Write (ManiSkill2's `panda_stick`). Generated from
+/// [`PANDA_URDF`] by `tools/gen_panda_stick_urdf.py`; the arm, hand and fingers are unchanged,
+/// so the TCP chain and the controllers are those of the Panda.
+///
+/// ```
+/// assert!(ms2_assets::PANDA_STICK_URDF.contains("stick_joint"));
+/// ```
+pub const PANDA_STICK_URDF: &str = include_str!("../robots/panda/panda_stick.urdf");
+
+/// Centre (m) of the stick on the `panda_hand` frame's z axis (the stick is a capsule along
+/// that axis): ManiSkill2's stick spans 5-15 cm below the hand between its end-cap centres.
+pub const PANDA_STICK_CENTER_IN_HAND_Z: f64 = 0.1;
+
+/// Radius (m) of the stick's capsule (ManiSkill2: 8 mm).
+pub const PANDA_STICK_RADIUS: f64 = 0.008;
+
+/// Half length (m) of the stick's capsule between its end-cap centres (ManiSkill2: 5 cm).
+pub const PANDA_STICK_HALF_LENGTH: f64 = 0.05;
 
 /// URDF of ManiSkill2's second robot, `xmate3_robotiq`: a ROKAE xMate3 7-joint arm with a
 /// Robotiq two-finger gripper, written for ms2 from the arm's published kinematics (joint

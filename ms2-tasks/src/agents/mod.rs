@@ -10,6 +10,7 @@
 //! |---|---|---|
 //! | `panda` | Franka Panda, two-finger gripper, ManiSkill2's base pose | every mode of [`ms2_control::RobotConfig::panda`] |
 //! | `panda_bucket` | the Panda with a bucket fixed to its hand (soft-body tasks) | the same |
+//! | `panda_stick` | the Panda with a stick fixed to its hand (Write) | the same |
 //! | `panda_avoid_obstacles` | the Panda at the world origin with PandaAvoidObstacles' cameras (ManiSkill2's `PandaRealSensed435Config`) | the same as `panda` |
 //! | `mobile_panda_single_arm` | holonomic base (x, y, yaw) with a lift and one Panda; three overhead cameras on the base (ManiSkill2's MS1 robot) | `base_pd_joint_vel_arm_<mode>` for ManiSkill2's ten arm modes, `base_pd_joint_vel_arm_pd_joint_vel` first |
 //! | `mobile_panda_dual_arm` | the same base with two Pandas (left and right) | the same |
@@ -45,7 +46,8 @@ pub use panda::{
     ROBOT_STATIC_QVEL,
 };
 pub use panda_model::{
-    panda_bucket_model, panda_model, PandaModel, PandaModelSource, PANDA_DESCRIPTION_ENV,
+    panda_bucket_model, panda_model, panda_stick_model, PandaModel, PandaModelSource,
+    PANDA_DESCRIPTION_ENV,
 };
 pub use xmate3::{XMATE3_MODEL, XMATE3_ROBOTIQ};
 
@@ -175,6 +177,7 @@ impl RobotSpec {
 pub const ROBOTS: &[RobotSpec] = &[
     panda::PANDA,
     panda::PANDA_BUCKET,
+    panda::PANDA_STICK,
     panda::PANDA_AVOID_OBSTACLES,
     xmate3::XMATE3_ROBOTIQ,
     mobile_panda::MOBILE_PANDA_SINGLE_ARM,

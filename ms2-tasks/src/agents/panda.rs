@@ -1,5 +1,6 @@
-//! ManiSkill2's Panda (`panda`) and the Panda carrying a bucket (`panda_bucket`): the
-//! [`GripperArmModel`] of the Panda and the two registered robots built from it.
+//! ManiSkill2's Panda (`panda`), the Panda carrying a bucket (`panda_bucket`) and the Panda
+//! carrying a stick (`panda_stick`): the [`GripperArmModel`] of the Panda and the registered
+//! robots built from it.
 
 use std::sync::OnceLock;
 
@@ -51,6 +52,32 @@ pub const PANDA_BUCKET: RobotSpec = RobotSpec {
             &model.desc,
             &PANDA_MODEL,
             "panda_bucket",
+        )?;
+        Ok(Box::new(agent))
+    },
+};
+
+/// The `panda_stick` robot: the Panda with a stick fixed to its hand
+/// (`ms2_assets::PANDA_STICK_URDF`), ManiSkill2's robot of Write. ManiSkill2's `panda_stick`
+/// has no fingers (and no gripper action); ms2's keeps the Panda's fingers and its control
+/// modes, as `panda_bucket` does.
+pub const PANDA_STICK: RobotSpec = RobotSpec {
+    name: "panda_stick",
+    description: "the Panda with a stick fixed to its hand (ms2_assets::PANDA_STICK_URDF; the \
+                  real Panda's meshes on its links when fetched)",
+    control_modes: panda_control_modes,
+    mode_prefix: "",
+    cameras: crate::sensors::CameraConfig::panda_defaults,
+    render_camera: crate::sensors::CameraConfig::render_camera,
+    build: |world, mode, timing| {
+        let model = super::panda_model::panda_stick_model()?;
+        let agent = GripperArmAgent::build(
+            world,
+            mode,
+            timing,
+            &model.desc,
+            &PANDA_MODEL,
+            "panda_stick",
         )?;
         Ok(Box::new(agent))
     },

@@ -128,11 +128,11 @@ fn load_panda_model() -> Result<PandaModel, EnvError> {
     }
 }
 
-/// Links of the bucket Panda whose collision shapes come from the real Panda when it is in use:
-/// the arm up to the wrist. `panda_link7`, the hand and the fingers keep the bucket
-/// description's primitive shapes: link 7, link 8, the hand and the bucket are fixed together
+/// Links of a tool-carrying Panda whose collision shapes come from the real Panda when it is in
+/// use: the arm up to the wrist. `panda_link7`, the hand and the fingers keep the tool
+/// description's primitive shapes: link 7, link 8, the hand and the tool are fixed together
 /// into the one rigid body the MPM coupling carries, and the coupling reads primitive shapes only.
-const BUCKET_PANDA_REAL_COLLISION_LINKS: [&str; 7] = [
+const TOOL_PANDA_REAL_COLLISION_LINKS: [&str; 7] = [
     "panda_link0",
     "panda_link1",
     "panda_link2",
@@ -150,16 +150,41 @@ const BUCKET_PANDA_REAL_COLLISION_LINKS: [&str; 7] = [
 pub fn panda_bucket_model() -> Result<&'static PandaModel, EnvError> {
     static MODEL: OnceLock<Result<PandaModel, String>> = OnceLock::new();
     MODEL
-        .get_or_init(|| load_panda_bucket_model().map_err(|e| e.to_string()))
+        .get_or_init(|| {
+            load_tool_panda_model(
+                ms2_assets::PANDA_BUCKET_URDF,
+                "ms2-assets/robots/panda/panda_bucket.urdf",
+            )
+            .map_err(|e| e.to_string())
+        })
         .as_ref()
         .map_err(|e| EnvError::Asset(e.clone()))
 }
 
-fn load_panda_bucket_model() -> Result<PandaModel, EnvError> {
+/// The Panda carrying a stick (`panda_stick`, Write's robot), parsed once per process:
+/// [`ms2_assets::PANDA_STICK_URDF`] with the real Panda's meshes as [`panda_bucket_model`]
+/// takes them; the stick stays the description's capsule.
+pub fn panda_stick_model() -> Result<&'static PandaModel, EnvError> {
+    static MODEL: OnceLock<Result<PandaModel, String>> = OnceLock::new();
+    MODEL
+        .get_or_init(|| {
+            load_tool_panda_model(
+                ms2_assets::PANDA_STICK_URDF,
+                "ms2-assets/robots/panda/panda_stick.urdf",
+            )
+            .map_err(|e| e.to_string())
+        })
+        .as_ref()
+        .map_err(|e| EnvError::Asset(e.clone()))
+}
+
+/// Parses `urdf` (a Panda with a tool fixed to its hand, named `label` in errors) and gives
+/// its Panda links the real Panda's visuals and arm collision hulls when that is in use.
+fn load_tool_panda_model(urdf: &str, label: &str) -> Result<PandaModel, EnvError> {
     let mut desc = parse_urdf_str(
-        ms2_assets::PANDA_BUCKET_URDF,
+        urdf,
         std::path::Path::new("."),
-        "ms2-assets/robots/panda/panda_bucket.urdf",
+        label,
         &UrdfLoadOptions::default(),
     )?;
     let panda = panda_model()?;
@@ -169,7 +194,7 @@ fn load_panda_bucket_model() -> Result<PandaModel, EnvError> {
                 continue;
             };
             link.visuals = real.visuals.clone();
-            if BUCKET_PANDA_REAL_COLLISION_LINKS.contains(&link.name.as_str()) {
+            if TOOL_PANDA_REAL_COLLISION_LINKS.contains(&link.name.as_str()) {
                 link.collisions = real.collisions.clone();
             }
         }

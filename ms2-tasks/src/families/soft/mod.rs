@@ -1,12 +1,15 @@
 //! Soft-body tasks on the MPM solver two-way coupled with the rigid world: `Excavate-v0` and
 //! `Fill-v0`, both with the Panda carrying a bucket (`panda_bucket`, ManiSkill2's
-//! `robot="panda"` with its bucket configuration), and `Hang-v0` with the plain Panda.
+//! `robot="panda"` with its bucket configuration), `Hang-v0` with the plain Panda and
+//! `Write-v0` with the Panda holding a stick (`panda_stick`).
 //!
 //! [`bucket_arm`] is the family's shared base and its one soft component (the clay coupled to
 //! the hand); [`excavate_scene`] the Excavate bed, goal and scoop (and a standalone kinematic
 //! scene); [`excavate`] and [`fill`] the tasks' hooks; [`scripted`] their oracle policies.
 //! [`hang_scene`] is Hang's rope, rod and success terms, [`hang`] its hooks (on the same
-//! base, coupled to the fingers and the rod), [`hang_policy`] its oracle.
+//! base, coupled to the fingers and the rod), [`hang_policy`] its oracle. [`write_targets`] is
+//! Write's characters, goals and IoU, [`write`] its hooks (on the same base, the clay coupled
+//! to the stick), [`write_policy`] its oracle.
 
 pub mod bucket_arm;
 pub mod excavate;
@@ -16,6 +19,9 @@ pub mod hang;
 pub mod hang_policy;
 pub mod hang_scene;
 pub mod scripted;
+pub mod write;
+pub mod write_policy;
+pub mod write_targets;
 
 use crate::config::ObsMode;
 use crate::registry::{Registrar, TaskRegistration};
@@ -79,6 +85,28 @@ pub const HANG: TaskSpec = TaskSpec {
     assets: &[],
 };
 
+/// `Write-v0`'s robot: `robot="panda"` builds the Panda holding a stick.
+const PANDA_WITH_STICK: &[RobotChoice] = &[RobotChoice {
+    uid: "panda",
+    agent: "panda_stick",
+}];
+
+/// `Write-v0`'s spec.
+pub const WRITE: TaskSpec = TaskSpec {
+    env_id: "Write-v0",
+    family: "soft",
+    summary: "write a character into a clay slab with a stick",
+    max_episode_steps: write::MAX_EPISODE_STEPS,
+    robots: PANDA_WITH_STICK,
+    control_modes: &[],
+    default_control_mode: DEFAULT_CONTROL_MODE,
+    obs_modes: SOFT_OBS_MODES,
+    non_privileged_extra_keys: &["tcp_pose", "goal"],
+    goal_marker: None,
+    soft_bodies: true,
+    assets: &[],
+};
+
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
     r.add(
@@ -92,5 +120,9 @@ pub fn register(r: &mut Registrar) {
     r.add(
         TaskRegistration::new(HANG, |cfg| Ok(Box::new(hang::Hang::new(cfg)?)))
             .scripted(hang_policy::HangPolicy::boxed),
+    );
+    r.add(
+        TaskRegistration::new(WRITE, |cfg| Ok(Box::new(write::Write::new(cfg)?)))
+            .scripted(write_policy::WritePolicy::boxed),
     );
 }
