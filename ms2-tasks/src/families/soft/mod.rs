@@ -7,6 +7,10 @@
 //! scene); [`excavate`] and [`fill`] the tasks' hooks; [`scripted`] their oracle policies.
 //! [`hang_scene`] is Hang's rope, rod and success terms, [`hang`] its hooks (on the same
 //! base, coupled to the fingers and the rod), [`hang_policy`] its oracle.
+//! `Pinch-v0`: [`pinch`] its hooks (the plain Panda, the plasticine coupled to the fingers),
+//! [`pinch_scene`] the block and the level generator, [`pinch_plan`] the pinch sequences,
+//! [`pinch_level`] the levels and their cache, [`chamfer`] the shape metric, [`pinch_policy`]
+//! its oracle.
 
 pub mod bucket_arm;
 pub mod excavate;
@@ -15,6 +19,12 @@ pub mod fill;
 pub mod hang;
 pub mod hang_policy;
 pub mod hang_scene;
+pub mod chamfer;
+pub mod pinch;
+pub mod pinch_level;
+pub mod pinch_plan;
+pub mod pinch_policy;
+pub mod pinch_scene;
 pub mod scripted;
 
 use crate::config::ObsMode;
@@ -79,6 +89,22 @@ pub const HANG: TaskSpec = TaskSpec {
     assets: &[],
 };
 
+/// `Pinch-v0`'s spec.
+pub const PINCH: TaskSpec = TaskSpec {
+    env_id: "Pinch-v0",
+    family: "soft",
+    summary: "deform a block of plasticine into a target shape with the fingers",
+    max_episode_steps: pinch::MAX_EPISODE_STEPS,
+    robots: PANDA,
+    control_modes: &[],
+    default_control_mode: DEFAULT_CONTROL_MODE,
+    obs_modes: SOFT_OBS_MODES,
+    non_privileged_extra_keys: &["tcp_pose", "target_points"],
+    goal_marker: None,
+    soft_bodies: true,
+    assets: &[],
+};
+
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
     r.add(
@@ -92,5 +118,9 @@ pub fn register(r: &mut Registrar) {
     r.add(
         TaskRegistration::new(HANG, |cfg| Ok(Box::new(hang::Hang::new(cfg)?)))
             .scripted(hang_policy::HangPolicy::boxed),
+    );
+    r.add(
+        TaskRegistration::new(PINCH, |cfg| Ok(Box::new(pinch::Pinch::new(cfg)?)))
+            .scripted(pinch_policy::PinchPolicy::boxed),
     );
 }
