@@ -7,8 +7,8 @@ use ms2_tasks::families::soft::pinch::Pinch;
 use ms2_tasks::families::soft::pinch_level::{
     level_path, load_or_generate, LevelError, PinchLevel, LEVEL_FORMAT,
 };
-use ms2_tasks::families::soft::pinch_plan::PinchMove;
-use ms2_tasks::families::soft::pinch_scene::{block_points, simulate_pinches, BLOCK_PARTICLES};
+use ms2_tasks::families::soft::pinch_plan::sample_moves;
+use ms2_tasks::families::soft::pinch_scene::{block_points, BLOCK_PARTICLES};
 use ms2_tasks::{info_get, make_env, make_scripted_policy, EnvConfig, InfoValue};
 
 fn pinch_env(obs_mode: &str) -> ms2_tasks::Env {
@@ -76,23 +76,27 @@ fn level_files_round_trip_and_a_malformed_one_is_an_error_naming_it() {
 
 #[test]
 fn a_pinch_dents_the_block_and_levels_repeat() {
+    // A level of one pinch: the robot pinches the block once (about 85 control steps).
+    let seed = (0..).find(|&s| sample_moves(s).len() == 1).unwrap();
+    let level = PinchLevel::generate(seed).unwrap();
+    assert_eq!(level.problem(), None);
     let block = block_points();
-    let pinch = PinchMove {
-        centre: [0.0, 0.0],
-        yaw: 0.3,
-        tip_z: 0.012,
-        gap: 0.016,
-    };
-    let end = simulate_pinches(&block, &[pinch], 2000.0).unwrap();
+    let end = level.target_points();
     assert_eq!(end.len(), BLOCK_PARTICLES);
     let [a, b] = chamfer_l4(&block, &end).unwrap();
-    // The fingers pushed 2.4 cm of clay together on each side: the shape moved by millimetres.
-    assert!(a + b > 0.004, "pinched block within {} m of the block", a + b);
+    assert_eq!(level.deformed_distance, [a, b]);
+    // The fingers pushed centimetres of clay together: the shape moved by millimetres.
+    assert!(
+        a + b > 0.004,
+        "pinched block within {} m of the block",
+        a + b
+    );
     // Nothing left the domain or fell through the floor.
-    assert!(end.iter().all(|p| p.z > -1e-3 && p.truncate().length() < 0.09));
+    assert!(end
+        .iter()
+        .all(|p| p.z > -1e-3 && p.truncate().length() < 0.09));
     // The generator is deterministic.
-    let again = simulate_pinches(&block, &[pinch], 2000.0).unwrap();
-    assert_eq!(again, end);
+    assert_eq!(PinchLevel::generate(seed).unwrap(), level);
 }
 
 #[test]
@@ -110,24 +114,30 @@ fn resets_are_seeded_and_observe_the_target() {
     let target = first.get("extra/target_points").unwrap().as_f32().unwrap();
     assert_eq!(target.len(), 4 * BLOCK_PARTICLES);
     assert!(target.chunks(4).all(|p| p[3] == 1.0));
-    assert_eq!(first.get("extra/tcp_pose").unwrap().as_f32().unwrap().len(), 7);
+    assert_eq!(
+        first.get("extra/tcp_pose").unwrap().as_f32().unwrap().len(),
+        7
+    );
     let pinch = env.task().unwrap().downcast_ref::<Pinch>().unwrap();
     let level_0 = pinch.level().unwrap().seed;
     let e = pinch.pinch_eval(env.task_scene().unwrap()).unwrap();
     // The start is the block: its distance to the target is the level's.
-    assert!((e.distance - e.start_distance).abs() < 1e-3 * e.start_distance, "{e:?}");
+    assert!(
+        (e.distance - e.start_distance).abs() < 1e-3 * e.start_distance,
+        "{e:?}"
+    );
     assert!(e.progress.abs() < 1e-3 && !e.success, "{e:?}");
     let (again, _) = env.reset(Some(0), false).unwrap();
     assert_eq!(again, first, "seed 0 twice");
     let mut levels = vec![level_0];
-    for seed in 1..4 {
+    for seed in 1..3 {
         env.reset(Some(seed), false).unwrap();
         let pinch = env.task().unwrap().downcast_ref::<Pinch>().unwrap();
         levels.push(pinch.level().unwrap().seed);
     }
     levels.sort();
     levels.dedup();
-    assert!(levels.len() >= 2, "seeds 0-3 drew levels {levels:?}");
+    assert!(levels.len() >= 2, "seeds 0-2 drew levels {levels:?}");
     let mut state = pinch_env("state");
     let (flat, _) = state.reset(Some(0), false).unwrap();
     let ms2_tasks::Space::Box(space) = state.observation_space() else {
@@ -164,7 +174,11 @@ fn state_round_trip_is_bit_exact() {
         d.step(&hold).unwrap();
     }
     assert_eq!(c.get_state(), d.get_state(), "two restored runs diverged");
-    assert_eq!(c.get_state(), a.get_state(), "a restored run left the original");
+    assert_eq!(
+        c.get_state(),
+        a.get_state(),
+        "a restored run left the original"
+    );
 }
 
 #[test]
@@ -175,11 +189,15 @@ fn the_scripted_first_pinch_brings_the_shape_towards_the_target() {
     policy.reset(&env);
     let progress = |env: &ms2_tasks::Env| {
         let pinch = env.task().unwrap().downcast_ref::<Pinch>().unwrap();
-        pinch.pinch_eval(env.task_scene().unwrap()).unwrap().progress
+        pinch
+            .pinch_eval(env.task_scene().unwrap())
+            .unwrap()
+            .progress
     };
     assert!(progress(&env).abs() < 1e-3);
-    // The first pinch's close ends at step 4 + 16 + 10 + 16 = 46.
-    for _ in 0..50 {
+    // The first pinch's fingers are open again at step 4 + 16 + 10 + 16 + 8 + 12 = 66 (its
+    // squeeze first pushes the clay beyond the target; it springs back when they open).
+    for _ in 0..70 {
         let act = policy.act(&env);
         env.step(&act).unwrap();
     }

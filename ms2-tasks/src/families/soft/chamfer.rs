@@ -180,7 +180,14 @@ mod tests {
         );
         let bad = [Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0)];
         let e = chamfer_l4(&a, &bad).unwrap_err();
-        assert!(matches!(e, ChamferError::NonFinite { which: "second", index: 1, .. }));
+        assert!(matches!(
+            e,
+            ChamferError::NonFinite {
+                which: "second",
+                index: 1,
+                ..
+            }
+        ));
         assert!(e.to_string().contains("point 1 of the second cloud"), "{e}");
     }
 }

@@ -13,13 +13,13 @@
 //! its oracle.
 
 pub mod bucket_arm;
+pub mod chamfer;
 pub mod excavate;
 pub mod excavate_scene;
 pub mod fill;
 pub mod hang;
 pub mod hang_policy;
 pub mod hang_scene;
-pub mod chamfer;
 pub mod pinch;
 pub mod pinch_level;
 pub mod pinch_plan;

@@ -64,6 +64,27 @@ pub const MAX_DENSE_REWARD: f64 = 0.2;
 /// Floats of task state before the particles.
 const STATE_HEADER: usize = 2;
 
+thread_local! {
+    /// The level a level generator plays on this thread (see [`play_provisional_level`]).
+    static PROVISIONAL: std::cell::RefCell<Option<Arc<PinchLevel>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` with every `Pinch-v0` reset on this thread playing `level` with the arm at
+/// [`ARM_START`] (no noise): how the level generator has the robot pinch the block
+/// (`pinch_level::PinchLevel::generate`). Restores normal resets afterwards.
+pub fn play_provisional_level<R>(level: Arc<PinchLevel>, f: impl FnOnce() -> R) -> R {
+    PROVISIONAL.with(|p| *p.borrow_mut() = Some(level));
+    let out = f();
+    PROVISIONAL.with(|p| *p.borrow_mut() = None);
+    out
+}
+
+/// The level [`play_provisional_level`] set on this thread, if any.
+fn provisional_level() -> Option<Arc<PinchLevel>> {
+    PROVISIONAL.with(|p| p.borrow().clone())
+}
+
 /// The evaluation of a state.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PinchEvaluation {
@@ -158,7 +179,11 @@ impl Pinch {
             distance,
             start_distance,
             success: distance < SUCCESS_FRACTION * start_distance,
-            progress: 1.0 - distance / start_distance,
+            progress: if start_distance > 0.0 {
+                1.0 - distance / start_distance
+            } else {
+                0.0
+            },
             reach: current.nearest_distance(bottom),
             tilt: cross.clamp(-1.0, 1.0).asin(),
         })
@@ -197,7 +222,11 @@ impl Task for Pinch {
             512,
             1.0,
             [-0.05, 0.7, 0.3],
-            [0.0, std::f32::consts::PI / 10.0, -std::f32::consts::FRAC_PI_2],
+            [
+                0.0,
+                std::f32::consts::PI / 10.0,
+                -std::f32::consts::FRAC_PI_2,
+            ],
         )
     }
 
@@ -235,17 +264,27 @@ impl Task for Pinch {
     ) -> Result<(), EnvError> {
         let TaskScene { world, agent } = scene;
         agent.set_base_pose(Pose3::translation(BASE_X, 0.0, 0.0));
+        let noise = if provisional_level().is_some() {
+            0.0
+        } else {
+            ARM_NOISE
+        };
         let mut qpos: Vec<f32> = ARM_START
             .iter()
-            .map(|q| q + rng.random_range(-ARM_NOISE..ARM_NOISE))
+            .map(|q| q + noise * rng.random_range(-1.0..1.0))
             .collect();
         qpos.resize(agent.qpos(world.as_ref()).len(), START_FINGER_QPOS);
         agent.set_joint_state(world.as_mut(), &qpos)
     }
 
     fn initialize_task(&mut self, scene: &TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
-        let seed = rng.random_range(Split::Train.seeds());
-        let level = self.fetch_level(seed)?;
+        let level = match provisional_level() {
+            Some(level) => level,
+            None => {
+                let seed = rng.random_range(Split::Train.seeds());
+                self.fetch_level(seed)?
+            }
+        };
         self.use_level(level.clone())?;
         let dt = self.arm.soft_config(SoftConfig::default()).substep_dt;
         let (solver, _) = plasticine_solver(dt, &level.init_points())?;
@@ -266,7 +305,12 @@ impl Task for Pinch {
             "target_points",
             ObsValue::Array(Array {
                 shape: vec![target.len(), 4],
-                data: ArrayData::F32(target.iter().flat_map(|p| [p[0], p[1], p[2], 1.0]).collect()),
+                data: ArrayData::F32(
+                    target
+                        .iter()
+                        .flat_map(|p| [p[0], p[1], p[2], 1.0])
+                        .collect(),
+                ),
             }),
         );
     }

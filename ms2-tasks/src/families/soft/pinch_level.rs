@@ -2,13 +2,13 @@
 //!
 //! ManiSkill2 ships its levels as HDF5 files (`pinch/levels/*.h5` in its asset directory);
 //! ms2 has no HDF5 reader in Rust and makes its own levels procedurally, as ManiSkill2 made
-//! its: a seeded sequence of pinches ([`sample_moves`]) applied to the plasticine block by
-//! the Panda's finger pads ([`simulate_pinches`], kinematic fingers along the scripted
-//! schedule), the end state being the target. A level is a pure function of its seed (and the
+//! its: a seeded sequence of pinches ([`super::pinch_plan::sample_moves`]) applied to the plasticine block by
+//! the robot in the env itself (the arm at its noise-free start, the scripted policy playing
+//! the pinches closed loop, [`PinchLevel::generate`]), the end state being the target. A level is a pure function of its seed (and the
 //! generator's version, [`LEVEL_FORMAT`]); generated levels are cached as JSON under the asset
 //! directory ([`level_path`]), written to a temporary file and renamed into place.
 //!
-//! Splits: the env draws its levels from the train split (level seeds
+//! Splits (ManiSkill2 ships a fixed set of levels too): the env draws its levels from the train split (level seeds
 //! `0..`[`TRAIN_LEVELS`]); the test split is [`TEST_LEVELS`] seeds from [`TEST_SEED_BASE`]
 //! (held out: no env episode draws them; evaluate a policy on them with [`Split::seeds`]).
 
@@ -17,22 +17,23 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::chamfer::chamfer_l4;
-use super::pinch_plan::{sample_moves, PinchMove};
-use super::pinch_scene::{block_points, BLOCK_PARTICLES};
+use super::pinch_plan::PinchMove;
+use super::pinch_scene::BLOCK_PARTICLES;
 use crate::error::EnvError;
 
 /// Format tag of a level file; changes whenever the generator's output would (the block, the
 /// pinch sampling, the schedule or the physics), so stale caches are not read.
-pub const LEVEL_FORMAT: &str = "ms2-pinch-level-v1";
+pub const LEVEL_FORMAT: &str = "ms2-pinch-level-v3";
 /// Levels of the train split (seeds `0..TRAIN_LEVELS`).
-pub const TRAIN_LEVELS: u64 = 50;
+pub const TRAIN_LEVELS: u64 = 20;
 /// First seed of the test split.
 pub const TEST_SEED_BASE: u64 = 1_000_000;
 /// Levels of the test split.
 pub const TEST_LEVELS: u64 = 20;
 /// MPM rate (Hz) at which levels are generated, whatever the env's `mpm_freq`.
 pub const LEVEL_MPM_FREQ_HZ: f64 = 2000.0;
+/// Control steps the clay rests after the last pinch before its shape is taken.
+pub const SETTLE_STEPS: u32 = 10;
 
 /// A split of the levels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,20 +108,57 @@ pub struct PinchLevel {
 }
 
 impl PinchLevel {
-    /// Generates level `seed` (simulates its pinches; a few seconds).
+    /// Generates level `seed`: a `Pinch-v0` env (MPM at [`LEVEL_MPM_FREQ_HZ`], default
+    /// control mode) plays a provisional level (the block, the seed's pinches) with the arm at
+    /// its noise-free start; the scripted policy pinches; the clay rests [`SETTLE_STEPS`]
+    /// control steps; its particles are the target. Tens of seconds on one core.
     #[cfg(feature = "rapier")]
     pub fn generate(seed: u64) -> Result<Self, LevelError> {
+        use super::chamfer::chamfer_l4;
+        use super::pinch::play_provisional_level;
+        use super::pinch_plan::{sample_moves, PinchPlan};
+        use super::pinch_policy::PinchPolicy;
+        use super::pinch_scene::block_points;
         let fail = |reason: String| LevelError::Generation { seed, reason };
         let moves = sample_moves(seed);
-        let init = block_points();
-        let target = super::pinch_scene::simulate_pinches(&init, &moves, LEVEL_MPM_FREQ_HZ)
-            .map_err(|e| fail(e.to_string()))?;
-        let deformed_distance = chamfer_l4(&init, &target).map_err(|e| fail(e.to_string()))?;
+        let init: Vec<[f32; 3]> = block_points().iter().map(|p| p.to_array()).collect();
+        // Start distance 0: the provisional episode never succeeds (nor terminates).
+        let provisional = Self {
+            format: LEVEL_FORMAT.to_owned(),
+            seed,
+            moves: moves.clone(),
+            init: init.clone(),
+            target: init.clone(),
+            deformed_distance: [0.0, 0.0],
+        };
+        let steps = PinchPlan::new(&moves, Vec3::ZERO, 0.0).duration() + SETTLE_STEPS;
+        let target = play_provisional_level(std::sync::Arc::new(provisional), || {
+            let mut cfg = crate::EnvConfig::new("Pinch-v0");
+            cfg.obs_mode = "none".to_owned();
+            cfg.mpm_freq = Some(LEVEL_MPM_FREQ_HZ);
+            let mut env = crate::make_env(&cfg)?;
+            env.reset(Some(seed), false)?;
+            let mut policy = PinchPolicy::boxed(&env)?;
+            policy.reset(&env);
+            for _ in 0..steps {
+                let action = policy.act(&env);
+                env.step(&action)?;
+            }
+            let pinch = env
+                .task()
+                .and_then(|t| t.downcast_ref::<super::pinch::Pinch>());
+            let soft = pinch.and_then(|p| p.arm().soft());
+            Ok::<_, EnvError>(soft.map(|s| s.solver().positions().to_vec()))
+        })
+        .map_err(|e| fail(e.to_string()))?
+        .ok_or_else(|| fail("the env has no plasticine".to_owned()))?;
+        let start: Vec<Vec3> = init.iter().map(|&p| Vec3::from_array(p)).collect();
+        let deformed_distance = chamfer_l4(&start, &target).map_err(|e| fail(e.to_string()))?;
         Ok(Self {
             format: LEVEL_FORMAT.to_owned(),
             seed,
             moves,
-            init: init.iter().map(|p| p.to_array()).collect(),
+            init,
             target: target.iter().map(|p| p.to_array()).collect(),
             deformed_distance,
         })
@@ -141,7 +179,10 @@ impl PinchLevel {
     /// positive finite deformed distance.
     pub fn problem(&self) -> Option<String> {
         if self.format != LEVEL_FORMAT {
-            return Some(format!("format {:?}, expected {LEVEL_FORMAT:?}", self.format));
+            return Some(format!(
+                "format {:?}, expected {LEVEL_FORMAT:?}",
+                self.format
+            ));
         }
         for (name, points) in [("init", &self.init), ("target", &self.target)] {
             if points.len() != BLOCK_PARTICLES {
@@ -154,13 +195,20 @@ impl PinchLevel {
                 .iter()
                 .position(|p| p.iter().any(|c| !c.is_finite() || c.abs() > 0.2))
             {
-                return Some(format!("{name}[{i}] = {:?} is not a finite point within 0.2 m of the origin", points[i]));
+                return Some(format!(
+                    "{name}[{i}] = {:?} is not a finite point within 0.2 m of the origin",
+                    points[i]
+                ));
             }
         }
         if let Some(m) = self.moves.iter().find(|m| !m.is_valid()) {
             return Some(format!("invalid pinch {m:?}"));
         }
-        if !self.deformed_distance.iter().all(|d| d.is_finite() && *d > 0.0) {
+        if !self
+            .deformed_distance
+            .iter()
+            .all(|d| d.is_finite() && *d > 0.0)
+        {
             return Some(format!(
                 "deformed_distance {:?} must be finite and > 0",
                 self.deformed_distance

@@ -34,8 +34,10 @@ pub const PINCH_COUNT_RANGE: (usize, usize) = (1, 3);
 /// Control steps of the start (the robot settles before moving).
 pub const START_STEPS: u32 = 4;
 /// Control steps of each phase of a pinch: travel above the pinch, descend, close, hold,
-/// open, rise.
-pub const PHASE_STEPS: [u32; 6] = [16, 10, 16, 4, 6, 8];
+/// open, rise. The hold and the open leave the Panda's finger drives time to catch up with
+/// the schedule (they lag it by about 0.3 s): a hand that rises while its fingers still
+/// squeeze lifts a lump of clay off the block.
+pub const PHASE_STEPS: [u32; 6] = [16, 10, 16, 8, 12, 8];
 
 /// One pinch: where (centre), which way (yaw of the fingers' closing axis), how deep (the
 /// pads' bottom height) and how far the fingers close (the gap between the pads).
@@ -117,7 +119,10 @@ impl PinchPlan {
             finger: OPEN_FINGER,
         }];
         let mut step = START_STEPS;
-        waypoints.push(Waypoint { step, ..waypoints[0] });
+        waypoints.push(Waypoint {
+            step,
+            ..waypoints[0]
+        });
         for m in moves {
             let above = Vec2::from(m.centre).extend(TRAVEL_TIP_Z + TIP_BELOW_TCP);
             let down = Vec2::from(m.centre).extend(m.tip_z + TIP_BELOW_TCP);
@@ -193,7 +198,10 @@ mod tests {
             let plan = PinchPlan::new(&moves, Vec3::new(0.0, 0.0, 0.2), 0.0);
             assert!(plan.duration() < 300, "seed {seed}: {}", plan.duration());
         }
-        assert!(counts[1] > 0 && counts[2] > 0 && counts[3] > 0, "{counts:?}");
+        assert!(
+            counts[1] > 0 && counts[2] > 0 && counts[3] > 0,
+            "{counts:?}"
+        );
         assert_ne!(sample_moves(0), sample_moves(1));
     }
 
