@@ -204,3 +204,19 @@ fn the_scripted_first_pinch_brings_the_shape_towards_the_target() {
     let p = progress(&env);
     assert!(p > 0.2, "progress after the first pinch: {p}");
 }
+
+/// In `pointcloud`, the cameras see the plasticine: points on the block's top and sides,
+/// where the ground would be centimetres lower.
+#[cfg(feature = "render")]
+#[test]
+fn the_point_cloud_shows_the_block() {
+    let mut env = pinch_env("pointcloud");
+    let (obs, _) = env.reset(Some(0), false).unwrap();
+    let xyzw = obs.get("pointcloud/xyzw").unwrap().as_f32().unwrap();
+    let on_block = xyzw
+        .chunks_exact(4)
+        .filter(|p| p[3] == 1.0 && p[0].abs() < 0.035 && p[1].abs() < 0.035 && p[2] > 0.01)
+        .filter(|p| p[2] < 0.05)
+        .count();
+    assert!(on_block > 100, "{on_block} points on the block");
+}
