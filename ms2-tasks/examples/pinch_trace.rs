@@ -2,13 +2,24 @@
 //! finger openings, Chamfer distance and progress.
 //!
 //! `cargo run --release -p ms2-tasks --example pinch_trace -- [seed=0] [steps=300]
-//! [control_mode=pd_joint_delta_pos] [every=5]`
+//! [control_mode=pd_joint_delta_pos] [every=5] [level]`: with a level seed last, the episode
+//! plays that level with the arm at its noise-free start, as the level generator did.
 
-use ms2_tasks::families::soft::pinch::Pinch;
+use ms2_tasks::families::soft::pinch::{play_provisional_level, Pinch};
+use ms2_tasks::families::soft::pinch_level::load_or_generate;
 use ms2_tasks::{make_env, make_scripted_policy, EnvConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
+    if let Some(level) = args.get(5) {
+        let dir = ms2_assets::store::asset_dir();
+        let level = load_or_generate(&dir, level.parse()?)?;
+        return play_provisional_level(std::sync::Arc::new(level), || run(&args));
+    }
+    run(&args)
+}
+
+fn run(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
     let seed: u64 = args.get(1).map(|s| s.parse()).transpose()?.unwrap_or(0);
     let steps: u32 = args.get(2).map(|s| s.parse()).transpose()?.unwrap_or(300);
     let mut cfg = EnvConfig::new("Pinch-v0");

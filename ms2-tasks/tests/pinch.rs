@@ -195,9 +195,9 @@ fn the_scripted_first_pinch_brings_the_shape_towards_the_target() {
             .progress
     };
     assert!(progress(&env).abs() < 1e-3);
-    // The first pinch's fingers are open again at step 4 + 16 + 10 + 16 + 8 + 12 = 66 (its
+    // The first pinch's fingers are open again at step 4 + 16 + 6 + 10 + 16 + 8 + 12 = 72 (its
     // squeeze first pushes the clay beyond the target; it springs back when they open).
-    for _ in 0..70 {
+    for _ in 0..76 {
         let act = policy.act(&env);
         env.step(&act).unwrap();
     }

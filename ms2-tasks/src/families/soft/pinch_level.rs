@@ -23,7 +23,7 @@ use crate::error::EnvError;
 
 /// Format tag of a level file; changes whenever the generator's output would (the block, the
 /// pinch sampling, the schedule or the physics), so stale caches are not read.
-pub const LEVEL_FORMAT: &str = "ms2-pinch-level-v3";
+pub const LEVEL_FORMAT: &str = "ms2-pinch-level-v4";
 /// Levels of the train split (seeds `0..TRAIN_LEVELS`).
 pub const TRAIN_LEVELS: u64 = 20;
 /// First seed of the test split.

@@ -33,11 +33,13 @@ pub const GAP_RANGE: (f32, f32) = (0.014, 0.03);
 pub const PINCH_COUNT_RANGE: (usize, usize) = (1, 3);
 /// Control steps of the start (the robot settles before moving).
 pub const START_STEPS: u32 = 4;
-/// Control steps of each phase of a pinch: travel above the pinch, descend, close, hold,
-/// open, rise. The hold and the open leave the Panda's finger drives time to catch up with
-/// the schedule (they lag it by about 0.3 s): a hand that rises while its fingers still
-/// squeeze lifts a lump of clay off the block.
-pub const PHASE_STEPS: [u32; 6] = [16, 10, 16, 8, 12, 8];
+/// Control steps of each phase of a pinch: travel above the pinch, wait there, descend,
+/// close, hold, open, rise. The wait lets the arm settle on the pinch whatever path brought
+/// it there (the replay starts elsewhere than the level's generator); the hold and the open
+/// leave the Panda's finger drives time to catch up with the schedule (they lag it by about
+/// 0.3 s): a hand that rises while its fingers still squeeze lifts a lump of clay off the
+/// block.
+pub const PHASE_STEPS: [u32; 7] = [16, 6, 10, 16, 8, 12, 8];
 
 /// One pinch: where (centre), which way (yaw of the fingers' closing axis), how deep (the
 /// pads' bottom height) and how far the fingers close (the gap between the pads).
@@ -129,6 +131,7 @@ impl PinchPlan {
             let half_gap = 0.5 * m.gap;
             let phases = [
                 (above, OPEN_FINGER),
+                (above, OPEN_FINGER),
                 (down, OPEN_FINGER),
                 (down, half_gap),
                 (down, half_gap),
@@ -214,7 +217,8 @@ mod tests {
             gap: 0.02,
         };
         let plan = PinchPlan::new(&[m], Vec3::new(0.0, 0.0, 0.2), 0.0);
-        let close_end = (START_STEPS + PHASE_STEPS[0] + PHASE_STEPS[1] + PHASE_STEPS[2]) as f32;
+        let close_end = START_STEPS + PHASE_STEPS[..4].iter().sum::<u32>();
+        let close_end = close_end as f32;
         let (tcp, yaw, finger) = plan.at(close_end);
         assert!((tcp.z - (0.01 + TIP_BELOW_TCP)).abs() < 1e-6 && (finger - 0.01).abs() < 1e-6);
         assert!((yaw - 0.5).abs() < 1e-6 && (tcp.x - 0.01).abs() < 1e-6);

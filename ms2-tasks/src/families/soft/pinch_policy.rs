@@ -4,7 +4,9 @@
 //! ([`crate::scripted::oracle::TcpOracle`]).
 //!
 //! Each pinch's yaw is taken modulo π (the two fingers are mirror images) nearest to the yaw
-//! before it, so the hand turns at most a quarter turn between pinches.
+//! before it, so the hand turns at most a quarter turn between pinches; the first pinch keeps
+//! its sampled yaw, whatever the start (the reset's arm noise would otherwise flip the
+//! branch against the level generator's run, and the hand would approach turned by π).
 
 use glam::Vec3;
 
@@ -58,7 +60,8 @@ impl ScriptedPolicy for PinchPolicy {
         let tcp = scene.agent.tcp_pose(scene.world.as_ref());
         let p = tcp.translation.vector;
         let yaw = tcp_yaw(&tcp);
-        let moves = unwrap_yaws(&level.moves, yaw);
+        let first = level.moves.first().map_or(0.0, |m| m.yaw);
+        let moves = unwrap_yaws(&level.moves, first);
         self.plan = Some(PinchPlan::new(&moves, Vec3::new(p.x, p.y, p.z), yaw));
     }
 
