@@ -68,6 +68,23 @@ pub fn bucket_task_cameras(
     with_base_camera(robot_cameras, base)
 }
 
+/// A world camera at `position` (m) with ManiSkill2's Euler angles (roll, pitch, yaw; rad:
+/// `euler2quat(roll, pitch, yaw)`), `size`×`size` pixels, vertical field of view `fov_y` (rad),
+/// near plane 1 mm, far 10 m.
+pub fn world_camera(
+    uid: &str,
+    size: u32,
+    fov_y: f32,
+    position: [f32; 3],
+    rpy: [f32; 3],
+) -> CameraConfig {
+    let pose = Pose3::from_parts(
+        Translation3::from(position),
+        UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]),
+    );
+    CameraConfig::in_world(uid, size, size, fov_y, 0.001, 10.0, pose)
+}
+
 /// `robot_cameras` with `base` first, in place of the robot's camera of the same uid.
 pub fn with_base_camera(robot_cameras: Vec<CameraConfig>, base: CameraConfig) -> Vec<CameraConfig> {
     let mut cameras: Vec<CameraConfig> = robot_cameras

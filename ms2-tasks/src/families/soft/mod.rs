@@ -1,7 +1,7 @@
 //! Soft-body tasks on the MPM solver two-way coupled with the rigid world: `Excavate-v0` and
 //! `Fill-v0`, both with the Panda carrying a bucket (`panda_bucket`, ManiSkill2's
-//! `robot="panda"` with its bucket configuration), `Hang-v0` with the plain Panda and
-//! `Write-v0` with the Panda holding a stick (`panda_stick`).
+//! `robot="panda"` with its bucket configuration), `Hang-v0` and `Pinch-v0` with the plain
+//! Panda, and `Write-v0` with the Panda holding a stick (`panda_stick`).
 //!
 //! [`bucket_arm`] is the family's shared base and its one soft component (the clay coupled to
 //! the hand); [`excavate_scene`] the Excavate bed, goal and scoop (and a standalone kinematic
@@ -9,15 +9,24 @@
 //! [`hang_scene`] is Hang's rope, rod and success terms, [`hang`] its hooks (on the same
 //! base, coupled to the fingers and the rod), [`hang_policy`] its oracle. [`write_targets`] is
 //! Write's characters, goals and IoU, [`write`] its hooks (on the same base, the clay coupled
-//! to the stick), [`write_policy`] its oracle.
+//! to the stick), [`write_policy`] its oracle. [`pinch`] is Pinch's hooks (the plasticine
+//! coupled to the fingers), [`pinch_scene`] the block and the level generator, [`pinch_plan`]
+//! the pinch sequences, [`pinch_level`] the levels and their cache, [`chamfer`] the shape
+//! metric, [`pinch_policy`] its oracle.
 
 pub mod bucket_arm;
+pub mod chamfer;
 pub mod excavate;
 pub mod excavate_scene;
 pub mod fill;
 pub mod hang;
 pub mod hang_policy;
 pub mod hang_scene;
+pub mod pinch;
+pub mod pinch_level;
+pub mod pinch_plan;
+pub mod pinch_policy;
+pub mod pinch_scene;
 pub mod scripted;
 pub mod write;
 pub mod write_policy;
@@ -107,6 +116,22 @@ pub const WRITE: TaskSpec = TaskSpec {
     assets: &[],
 };
 
+/// `Pinch-v0`'s spec.
+pub const PINCH: TaskSpec = TaskSpec {
+    env_id: "Pinch-v0",
+    family: "soft",
+    summary: "deform a block of plasticine into a target shape with the fingers",
+    max_episode_steps: pinch::MAX_EPISODE_STEPS,
+    robots: PANDA,
+    control_modes: &[],
+    default_control_mode: DEFAULT_CONTROL_MODE,
+    obs_modes: SOFT_OBS_MODES,
+    non_privileged_extra_keys: &["tcp_pose", "target_points"],
+    goal_marker: None,
+    soft_bodies: true,
+    assets: &[],
+};
+
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
     r.add(
@@ -124,5 +149,9 @@ pub fn register(r: &mut Registrar) {
     r.add(
         TaskRegistration::new(WRITE, |cfg| Ok(Box::new(write::Write::new(cfg)?)))
             .scripted(write_policy::WritePolicy::boxed),
+    );
+    r.add(
+        TaskRegistration::new(PINCH, |cfg| Ok(Box::new(pinch::Pinch::new(cfg)?)))
+            .scripted(pinch_policy::PinchPolicy::boxed),
     );
 }
