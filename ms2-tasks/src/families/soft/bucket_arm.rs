@@ -84,6 +84,21 @@ pub fn bucket_render_camera(position: [f32; 3], yaw: f32) -> CameraConfig {
     pitched_camera("render_camera", 512, 1.0, position, yaw)
 }
 
+/// A world camera at `position` (m) with ManiSkill2's Euler angles (roll, pitch, yaw; rad).
+pub fn world_camera(
+    uid: &str,
+    size: u32,
+    fov_y: f32,
+    position: [f32; 3],
+    rpy: [f32; 3],
+) -> CameraConfig {
+    let pose = Pose3::from_parts(
+        Translation3::from(position),
+        UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]),
+    );
+    CameraConfig::in_world(uid, size, size, fov_y, 0.001, 10.0, pose)
+}
+
 /// Pose of the bucket frame in the hand frame (`ms2_assets::PANDA_BUCKET_IN_HAND`).
 pub fn hand_from_bucket() -> Isometry3<f32> {
     let ([x, y, z], [r, p, w]) = ms2_assets::PANDA_BUCKET_IN_HAND;

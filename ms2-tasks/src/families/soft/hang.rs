@@ -31,7 +31,7 @@ use ms2_physics::{ActorDesc, ActorKind, ArticulationId, BodyId, Pose3, ShapeDesc
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 use rand::Rng;
 
-use super::bucket_arm::{with_base_camera, BucketArm};
+use super::bucket_arm::{with_base_camera, world_camera, BucketArm};
 use super::hang_scene::{
     hang_terms, rope_solver, sign, HangTerms, Pinch, RodPose, RopeStart, GRASP_ARC,
     HANG_MPM_FREQ_HZ, ROPE_COLOR, ROPE_SPACING,
@@ -218,21 +218,6 @@ fn rod_shape() -> ShapeDesc {
     ShapeDesc::Box {
         half_extents: Vector3::from(ROD_HALF),
     }
-}
-
-/// A world camera at `position` (m) with ManiSkill2's Euler angles (roll, pitch, yaw; rad).
-fn world_camera(
-    uid: &str,
-    size: u32,
-    fov_y: f32,
-    position: [f32; 3],
-    rpy: [f32; 3],
-) -> CameraConfig {
-    let pose = Pose3::from_parts(
-        Translation3::from(position),
-        UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]),
-    );
-    CameraConfig::in_world(uid, size, size, fov_y, 0.001, 10.0, pose)
 }
 
 impl Task for Hang {

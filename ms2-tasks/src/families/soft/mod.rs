@@ -6,7 +6,9 @@
 //! the hand); [`excavate_scene`] the Excavate bed, goal and scoop (and a standalone kinematic
 //! scene); [`excavate`] and [`fill`] the tasks' hooks; [`scripted`] their oracle policies.
 //! [`hang_scene`] is Hang's rope, rod and success terms, [`hang`] its hooks (on the same
-//! base, coupled to the fingers and the rod), [`hang_policy`] its oracle.
+//! base, coupled to the fingers and the rod), [`hang_policy`] its oracle. [`pour_scene`] is
+//! Pour's bottle, beaker, water and success terms, [`pour`] its hooks, [`pour_policy`] its
+//! oracle.
 
 pub mod bucket_arm;
 pub mod excavate;
@@ -15,6 +17,9 @@ pub mod fill;
 pub mod hang;
 pub mod hang_policy;
 pub mod hang_scene;
+pub mod pour;
+pub mod pour_policy;
+pub mod pour_scene;
 pub mod scripted;
 
 use crate::config::ObsMode;
@@ -79,6 +84,22 @@ pub const HANG: TaskSpec = TaskSpec {
     assets: &[],
 };
 
+/// `Pour-v0`'s spec.
+pub const POUR: TaskSpec = TaskSpec {
+    env_id: "Pour-v0",
+    family: "soft",
+    summary: "pour water from a bottle into a beaker up to a marked line",
+    max_episode_steps: pour::MAX_EPISODE_STEPS,
+    robots: PANDA,
+    control_modes: &[],
+    default_control_mode: DEFAULT_CONTROL_MODE,
+    obs_modes: SOFT_OBS_MODES,
+    non_privileged_extra_keys: &["tcp_pose", "target"],
+    goal_marker: None,
+    soft_bodies: true,
+    assets: &[],
+};
+
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
     r.add(
@@ -92,5 +113,9 @@ pub fn register(r: &mut Registrar) {
     r.add(
         TaskRegistration::new(HANG, |cfg| Ok(Box::new(hang::Hang::new(cfg)?)))
             .scripted(hang_policy::HangPolicy::boxed),
+    );
+    r.add(
+        TaskRegistration::new(POUR, |cfg| Ok(Box::new(pour::Pour::new(cfg)?)))
+            .scripted(pour_policy::PourPolicy::boxed),
     );
 }
