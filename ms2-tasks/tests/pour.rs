@@ -69,8 +69,8 @@ fn water_stays_in_the_upright_bottle() {
         "the bottle moved: z {z}, cos {cos}"
     );
     // The water does not rise or splash out. It does sink: its mean height fell from 4.7 to
-    // 3.2 cm in 0.75 s on seed 0 (the penalty contact with the bottle's bottom holds the
-    // particles, not the grid, so the column compresses, as the floor did before
+    // 3.2 cm in 0.75 s on seed 0 (the velocity gradient does not see the bottle's bottom, only
+    // the capped penalty force holds the particles, so they pile up, as on the floor before
     // `Boundary::for_fluid`; an open issue, docs/tasks.md). The bound catches a worse collapse.
     let z1 = mean_height(&env);
     assert!(
