@@ -19,8 +19,10 @@ SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
 #: every reset rebuilds the scene: wide bowls, long tools; issue #16), PickClutterYCB-v0
 #: (20/30 on seeds 0-29 in pd_ee_delta_pose: neighbours in the way of its top-down grasp;
 #: issue #16), Hang-v0 (0/2: the rope tears at the fingertips once the lift takes its weight;
-#: issue #20; an episode takes minutes, so it is not run).
-KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0", "Hang-v0"}
+#: issue #20; an episode takes minutes, so it is not run), Pour-v0 (not solved yet: on seed 0
+#: the tilted bottle lets no water out by 99° and the MPM diverges; issue #20; an episode
+#: takes about 9 minutes, so it is not run).
+KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0", "Hang-v0", "Pour-v0"}
 
 
 def test_scripted_policy_success_rate(env_id):

@@ -1,7 +1,7 @@
 //! Soft-body tasks on the MPM solver two-way coupled with the rigid world: `Excavate-v0` and
 //! `Fill-v0`, both with the Panda carrying a bucket (`panda_bucket`, ManiSkill2's
-//! `robot="panda"` with its bucket configuration), `Hang-v0` and `Pinch-v0` with the plain
-//! Panda, and `Write-v0` with the Panda holding a stick (`panda_stick`).
+//! `robot="panda"` with its bucket configuration), `Hang-v0`, `Pinch-v0` and `Pour-v0` with
+//! the plain Panda, and `Write-v0` with the Panda holding a stick (`panda_stick`).
 //!
 //! [`bucket_arm`] is the family's shared base and its one soft component (the clay coupled to
 //! the hand); [`excavate_scene`] the Excavate bed, goal and scoop (and a standalone kinematic
@@ -12,7 +12,8 @@
 //! to the stick), [`write_policy`] its oracle. [`pinch`] is Pinch's hooks (the plasticine
 //! coupled to the fingers), [`pinch_scene`] the block and the level generator, [`pinch_plan`]
 //! the pinch sequences, [`pinch_level`] the levels and their cache, [`chamfer`] the shape
-//! metric, [`pinch_policy`] its oracle.
+//! metric, [`pinch_policy`] its oracle. [`pour_scene`] is Pour's bottle, beaker, water and
+//! success terms, [`pour`] its hooks, [`pour_policy`] its oracle.
 
 pub mod bucket_arm;
 pub mod chamfer;
@@ -27,6 +28,9 @@ pub mod pinch_level;
 pub mod pinch_plan;
 pub mod pinch_policy;
 pub mod pinch_scene;
+pub mod pour;
+pub mod pour_policy;
+pub mod pour_scene;
 pub mod scripted;
 pub mod write;
 pub mod write_policy;
@@ -132,6 +136,22 @@ pub const PINCH: TaskSpec = TaskSpec {
     assets: &[],
 };
 
+/// `Pour-v0`'s spec.
+pub const POUR: TaskSpec = TaskSpec {
+    env_id: "Pour-v0",
+    family: "soft",
+    summary: "pour water from a bottle into a beaker up to a marked line",
+    max_episode_steps: pour::MAX_EPISODE_STEPS,
+    robots: PANDA,
+    control_modes: &[],
+    default_control_mode: DEFAULT_CONTROL_MODE,
+    obs_modes: SOFT_OBS_MODES,
+    non_privileged_extra_keys: &["tcp_pose", "target"],
+    goal_marker: None,
+    soft_bodies: true,
+    assets: &[],
+};
+
 /// Registers the family.
 pub fn register(r: &mut Registrar) {
     r.add(
@@ -153,5 +173,9 @@ pub fn register(r: &mut Registrar) {
     r.add(
         TaskRegistration::new(PINCH, |cfg| Ok(Box::new(pinch::Pinch::new(cfg)?)))
             .scripted(pinch_policy::PinchPolicy::boxed),
+    );
+    r.add(
+        TaskRegistration::new(POUR, |cfg| Ok(Box::new(pour::Pour::new(cfg)?)))
+            .scripted(pour_policy::PourPolicy::boxed),
     );
 }

@@ -1,0 +1,83 @@
+//! Traces one scripted `Pour-v0` episode: every `every` control steps the TCP, the bottle's
+//! height and tilt, the water counts and the success terms, and the time per step.
+//!
+//! ```text
+//! cargo run --release -p ms2-tasks --example pour_trace -- [seed=0] [every=10] [steps=350]
+//! ```
+//! `MPM=<Hz>` sets `mpm_freq`; `MODE=<control mode>` the control mode; `IDLE=1` sends zero
+//! actions instead of the policy's.
+
+use std::time::Instant;
+
+use ms2_tasks::families::soft::pour::Pour;
+use ms2_tasks::{make_env, make_scripted_policy, EnvConfig, EnvError};
+
+fn main() -> Result<(), EnvError> {
+    let args: Vec<u64> = std::env::args()
+        .skip(1)
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    let seed = args.first().copied().unwrap_or(0);
+    let every = args.get(1).copied().unwrap_or(10).max(1) as u32;
+    let steps = args.get(2).copied().unwrap_or(350) as u32;
+    let mut env = make_env(&EnvConfig {
+        obs_mode: "state".to_owned(),
+        mpm_freq: std::env::var("MPM").ok().and_then(|v| v.parse().ok()),
+        control_mode: std::env::var("MODE").ok(),
+        ..EnvConfig::new("Pour-v0")
+    })?;
+    let mut policy = make_scripted_policy(&env)?;
+    let idle = std::env::var("IDLE").is_ok();
+    let reset_start = Instant::now();
+    env.reset(Some(seed), false)?;
+    policy.reset(&env);
+    println!("reset {:.2} s", reset_start.elapsed().as_secs_f64());
+    let start = Instant::now();
+    for step in 0..=steps {
+        if step % every == 0 || step == steps {
+            let (scene, task) = (env.task_scene().unwrap(), env.task().unwrap());
+            let pour = task.downcast_ref::<Pour>().unwrap();
+            let tcp = scene
+                .agent
+                .tcp_pose(scene.world.as_ref())
+                .translation
+                .vector;
+            let e = pour.pour_eval(scene).unwrap();
+            let b = e.bottle.translation.vector;
+            let c = e.terms.counts;
+            println!(
+                "step {step:3} tcp ({:.3} {:.3} {:.3}) bottle ({:.3} {:.3} {:.3}) cos {:.3} | in {} above {} band+ {} spilled {} | qvel {:.3} success {} | {:.2} s/step",
+                tcp.x, tcp.y, tcp.z, b.x, b.y, b.z, e.terms.upright_cosine,
+                c.in_beaker, c.above_line, c.above_band, c.spilled,
+                e.terms.max_joint_speed, e.terms.success,
+                start.elapsed().as_secs_f64() / f64::from(step.max(1)),
+            );
+        }
+        if step == steps {
+            break;
+        }
+        let action = if idle {
+            vec![0.0; env.action_space().size()]
+        } else {
+            policy.act(&env)
+        };
+        let out = env.step(&action)?;
+        if out.terminated || out.truncated {
+            println!(
+                "step {} done: terminated {} info {:?}",
+                step + 1,
+                out.terminated,
+                out.info
+            );
+            break;
+        }
+    }
+    let e = *env
+        .task()
+        .unwrap()
+        .downcast_ref::<Pour>()
+        .unwrap()
+        .episode();
+    println!("episode {e:?}");
+    Ok(())
+}

@@ -1,0 +1,147 @@
+//! `Pour-v0`: the water stays in the upright bottle, episodes start with the open gripper
+//! around the bottle and repeat by seed, the observation has its shapes, and a saved state
+//! restores bit-exactly. The success terms on constructed particle sets are unit tests of
+//! `families::soft::pour_scene`.
+
+use ms2_tasks::families::soft::pour::Pour;
+use ms2_tasks::families::soft::pour_scene::{
+    BOTTLE_BOTTOM, BOTTLE_HEIGHT, BOTTLE_INNER_RADIUS, WATER_HEIGHT,
+};
+use ms2_tasks::{make_env, EnvConfig};
+
+fn pour_env(obs_mode: &str) -> ms2_tasks::Env {
+    let mut cfg = EnvConfig::new("Pour-v0");
+    cfg.obs_mode = obs_mode.to_owned();
+    make_env(&cfg).unwrap()
+}
+
+/// Arm still, gripper open (normalized gripper action 1).
+fn hold(env: &ms2_tasks::Env) -> Vec<f32> {
+    let mut act = vec![0.0; env.action_space().size()];
+    if let Some(g) = act.last_mut() {
+        *g = 1.0;
+    }
+    act
+}
+
+/// Particles inside the bottle (in its frame: within its inner radius, above its bottom,
+/// below its mouth) and the bottle's height (m) and axis cosine.
+fn water_in_bottle(env: &ms2_tasks::Env) -> (usize, usize, f32, f32) {
+    let pour = env.task().unwrap().downcast_ref::<Pour>().unwrap();
+    let scene = env.task_scene().unwrap();
+    let pose = scene.world.body_pose(pour.bottle().unwrap()).unwrap();
+    let x = pour.arm().soft().unwrap().solver().positions();
+    let inv = pose.inverse();
+    let inside = x
+        .iter()
+        .filter(|p| {
+            let l = inv * nalgebra::Point3::new(p.x, p.y, p.z);
+            l.x.hypot(l.y) < BOTTLE_INNER_RADIUS + 0.001
+                && l.z > BOTTLE_BOTTOM - 0.002
+                && l.z < BOTTLE_HEIGHT
+        })
+        .count();
+    let axis = pose.rotation * nalgebra::Vector3::z();
+    (inside, x.len(), pose.translation.z, axis.z)
+}
+
+#[test]
+fn water_stays_in_the_upright_bottle() {
+    let mut env = pour_env("state");
+    env.reset(Some(0), false).unwrap();
+    let (inside, n, _, _) = water_in_bottle(&env);
+    assert_eq!(inside, n, "at the start");
+    let mean_height = |env: &ms2_tasks::Env| {
+        let pour = env.task().unwrap().downcast_ref::<Pour>().unwrap();
+        let x = pour.arm().soft().unwrap().solver().positions();
+        x.iter().map(|p| p.z).sum::<f32>() / x.len() as f32
+    };
+    let z0 = mean_height(&env);
+    // 0.75 s with the arm still and the gripper open: the water settles in the bottle.
+    let act = hold(&env);
+    for _ in 0..15 {
+        env.step(&act).unwrap();
+    }
+    let (inside, n, z, cos) = water_in_bottle(&env);
+    assert_eq!(inside, n, "water left the bottle");
+    assert!(
+        z.abs() < 0.003 && cos > 0.999,
+        "the bottle moved: z {z}, cos {cos}"
+    );
+    // The water does not rise or splash out. It does sink: its mean height fell from 4.7 to
+    // 3.2 cm in 0.75 s on seed 0 (the velocity gradient does not see the bottle's bottom, only
+    // the capped penalty force holds the particles, so they pile up, as on the floor before
+    // `Boundary::for_fluid`; an open issue, docs/tasks.md). The bound catches a worse collapse.
+    let z1 = mean_height(&env);
+    assert!(
+        z1 < z0 + 0.002 && z1 > 0.6 * z0,
+        "mean height {z0} -> {z1} m"
+    );
+}
+
+#[test]
+fn episodes_start_around_the_bottle_and_repeat_by_seed() {
+    let mut env = pour_env("particles");
+    assert_eq!(env.max_episode_steps(), 350);
+    let mut n = None;
+    let mut lines = Vec::new();
+    for seed in 0..4 {
+        let (obs, info) = env.reset(Some(seed), false).unwrap();
+        let x = obs.get("particles/x").unwrap().as_f32().unwrap();
+        assert!(x.len() / 3 > 9000, "{} particles", x.len() / 3);
+        assert_eq!(*n.get_or_insert(x.len()), x.len(), "seed {seed}");
+        let tcp = obs.get("extra/tcp_pose").unwrap().as_f32().unwrap();
+        let target = obs.get("extra/target").unwrap().as_f32().unwrap();
+        assert_eq!((tcp.len(), target.len()), (7, 1));
+        assert!((0.01..0.02).contains(&target[0]), "{target:?}");
+        lines.push(target[0]);
+        let pour = env.task().unwrap().downcast_ref::<Pour>().unwrap();
+        let e = *pour.episode();
+        // The TCP is on the bottle's axis at the drawn height (IK reached it).
+        let d = glam::Vec2::new(tcp[0], tcp[1]).distance(e.bottle_xy);
+        assert!(
+            d < 0.002 && (tcp[2] - e.tcp_height).abs() < 0.002,
+            "seed {seed}: {tcp:?} {e:?}"
+        );
+        let r = e.beaker_xy.length();
+        assert!((0.2..0.25).contains(&r) && e.beaker_xy.y >= 0.0, "{e:?}");
+        assert!((WATER_HEIGHT.0..WATER_HEIGHT.1).contains(&e.water_height));
+        let success = ms2_tasks::info_get(&info, "success");
+        assert_eq!(success, Some(ms2_tasks::InfoValue::Bool(false)));
+    }
+    lines.dedup();
+    assert_eq!(lines.len(), 4, "{lines:?}");
+    let (a, _) = env.reset(Some(2), false).unwrap();
+    let (b, _) = env.reset(Some(2), false).unwrap();
+    assert_eq!(a, b, "seed 2 twice");
+}
+
+#[test]
+fn state_round_trip_is_bit_exact() {
+    let mut a = pour_env("state");
+    let (obs, _) = a.reset(Some(1), false).unwrap();
+    // state: qpos 9, qvel 9, base_pose 7, tcp_pose 7, target 1.
+    assert_eq!(obs.as_f32().unwrap().len(), 33);
+    let act = hold(&a);
+    a.step(&act).unwrap();
+    let saved = a.get_state();
+    // Envs of the same seed, moved elsewhere first, restore it bit-exactly and then step
+    // identically (the coupling's pending reaction wrench on the bottle, from the step before
+    // the save, is not part of the state, as in the other soft tasks: a restored run is not
+    // the saved run's continuation to the bit).
+    let restore = || {
+        let mut c = pour_env("state");
+        c.reset(Some(1), false).unwrap();
+        for _ in 0..2 {
+            c.step(&vec![0.3; c.action_space().size()]).unwrap();
+        }
+        assert_ne!(c.get_state(), saved);
+        c.set_state(&saved).unwrap();
+        assert_eq!(c.get_state(), saved, "read back");
+        c
+    };
+    let (mut c, mut d) = (restore(), restore());
+    c.step(&act).unwrap();
+    d.step(&act).unwrap();
+    assert_eq!(c.get_state(), d.get_state(), "two restored runs diverged");
+}
