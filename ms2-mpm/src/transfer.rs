@@ -12,7 +12,7 @@ use glam::{Mat3, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::grid::{GridSpec, GridStorage, BLOCK};
-use crate::material::CompiledMaterial;
+use crate::material::{CompiledKind, CompiledMaterial};
 use crate::math::{left_stretch_x8, quadratic_weights, LeftStretch};
 use crate::parallel::SyncPtr;
 use crate::particles::{Binning, Particles};
@@ -167,7 +167,8 @@ fn accumulate_unit(
             f_out[pi - first] = f_new;
             let (base, fx, w) = quadratic_weights((x[pi] - origin) * inv_dx);
             let m = mass[pi];
-            let affine = (stress_scale * volume[pi]) * tau + m * c[pi];
+            let stress = (stress_scale * volume[pi]) * tau;
+            let affine = stress + m * c[pi];
             let mut mv = m * v[pi];
             if let Some(forces) = prm.forces {
                 mv += dt * forces[pi];
@@ -180,14 +181,22 @@ fn accumulate_unit(
             // only for r = the weighted centroid of the nodes the particle reaches. About the
             // particle, the stress would push clay off every surface it touches without
             // touching it (a frictionless cushion), and the APIC term would add
-            // m·C·Σ w·(x_i − x_p) each substep (a force ∝ 1/Δt).
+            // m·C·Σ w·(x_i − x_p) each substep (a force ∝ 1/Δt). Water's pressure is taken
+            // about the particle: the reachable nodes get the push the blocked ones would
+            // have had, the wall's reaction; without it nothing but the penalty force holds
+            // water against a coupled surface, and a column in a coupled container sank to
+            // 60 % of its volume in 0.8 s.
             let r = if blocked != 0 {
                 reachable_centroid(&w, blocked).unwrap_or(fx)
             } else {
                 fx
             };
             let a = affine * dx;
-            let m0 = (mv - a * r).extend(m);
+            let mut m0 = mv - a * r;
+            if blocked != 0 && mat.kind == CompiledKind::Water {
+                m0 += stress * dx * (r - fx);
+            }
+            let m0 = m0.extend(m);
             let (ax, ay, az) = (
                 a.x_axis.extend(0.0),
                 a.y_axis.extend(0.0),

@@ -1,10 +1,15 @@
 //! Water at ManiSkill2's Pour resolution: 5 mm grid cells, 2.5 mm particle spacing, 2 kHz
 //! substeps, bulk modulus 3.4e4 Pa (the first Lamé parameter of ManiSkill2's E 3e5 Pa,
 //! ν 0.1). A dam break: a column of water released in a closed tank collapses, spreads over
-//! the floor and keeps its volume, with no particle flung away.
+//! the floor and keeps its volume, with no particle flung away; a column in a container of
+//! coupled thin-walled boxes keeps its volume too.
 
 use glam::Vec3;
-use ms2_mpm::{sampling, Boundary, GridSpec, Material, MpmSolver, SolverConfig, WallKind};
+use ms2_mpm::rigid::{Motion, SimpleRigidWorld};
+use ms2_mpm::{
+    sampling, Boundary, Coupling, CouplingParams, GridSpec, Material, MpmSolver, SolverConfig,
+    WallKind,
+};
 
 /// Grid cell (m), as ManiSkill2's Pour.
 const DX: f32 = 0.005;
@@ -102,5 +107,70 @@ fn dam_break_spreads_and_keeps_its_volume() {
     assert!(
         s.positions().iter().all(|p| p.z >= -0.001 && p.x <= 0.201),
         "particles left the tank"
+    );
+}
+
+#[test]
+fn water_in_a_coupled_container_keeps_its_volume() {
+    // A cylinder of water (radius 2.4 cm, 8 cm tall) in a square container of coupled boxes:
+    // a 1 cm bottom plate 4.5 cm above the grid's floor and four 2 mm walls (thinner than a
+    // cell, so the blocked-node masks are at work). The water spreads over the 5 × 5 cm floor
+    // and rests: its mean height is the bottom plus half the spread column, and its volume
+    // ratio stays near 1. Before water's pressure pushed against the masked nodes, the
+    // column sank to J = 0.58 in 0.8 s.
+    let mut config = SolverConfig::new(GridSpec::new(Vec3::splat(-3.0 * DX), DX, [40, 40, 50]));
+    config.substep_dt = 5e-4;
+    config.boundary = Boundary::for_fluid(WallKind::Slip { friction: 0.5 });
+    let mut s = MpmSolver::new(config).expect("valid config");
+    let water = s
+        .add_material(Material::water(1000.0, BULK_MODULUS))
+        .expect("valid material");
+    let c = Vec3::new(0.085, 0.085, 0.0);
+    let (bottom, height) = (0.05, 0.08);
+    let pts = sampling::sample_cylinder(c + Vec3::Z * bottom, 0.024, height, SPACING);
+    let start_volume = pts.len() as f32 * SPACING.powi(3);
+    s.add_particles(&pts, water, SPACING.powi(3), Vec3::ZERO)
+        .expect("particles inside the domain");
+    let mut world = SimpleRigidWorld::new(s.config().gravity);
+    let still = Motion::Kinematic;
+    world.add_box(
+        Vec3::new(0.03, 0.03, 0.005),
+        300.0,
+        c + Vec3::Z * 0.045,
+        still,
+    );
+    for (x, y, hx, hy) in [
+        (0.026, 0.0, 0.001, 0.028),
+        (-0.026, 0.0, 0.001, 0.028),
+        (0.0, 0.026, 0.028, 0.001),
+        (0.0, -0.026, 0.028, 0.001),
+    ] {
+        world.add_box(
+            Vec3::new(hx, hy, 0.06),
+            300.0,
+            c + Vec3::new(x, y, 0.11),
+            still,
+        );
+    }
+    let mut coupling = Coupling::new(&world, CouplingParams::for_substep(1e-3)).expect("coupling");
+    coupling
+        .advance(&mut s, &mut world, 1600)
+        .expect("substeps");
+    let n = s.particle_count() as f32;
+    let mean_z = s.positions().iter().map(|p| p.z).sum::<f32>() / n;
+    // The container's floor is 5 × 5 cm inside its walls.
+    let depth = start_volume / (0.05 * 0.05);
+    let expected = bottom + 0.5 * depth;
+    assert!(
+        (mean_z - expected).abs() < 0.05 * depth,
+        "mean height {mean_z} m, expected {expected} m (a {depth} m deep layer)"
+    );
+    let j = mean_volume_ratio(&s);
+    assert!((j - 1.0).abs() < 0.06, "mean volume ratio {j}");
+    assert!(
+        s.positions()
+            .iter()
+            .all(|p| p.z > bottom && (p.truncate() - c.truncate()).abs().max_element() < 0.025),
+        "water left the container"
     );
 }

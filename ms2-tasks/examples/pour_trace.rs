@@ -45,6 +45,18 @@ fn main() -> Result<(), EnvError> {
             let e = pour.pour_eval(scene).unwrap();
             let b = e.bottle.translation.vector;
             let c = e.terms.counts;
+            let x = pour.arm().soft().unwrap().solver().positions();
+            let v = pour.arm().soft().unwrap().solver().velocities();
+            let inv = e.bottle.inverse();
+            let out = x
+                .iter()
+                .filter(|p| {
+                    let l = inv * nalgebra::Point3::new(p.x, p.y, p.z);
+                    l.x.hypot(l.y) > 0.0275 || l.z < -0.005 || l.z > 0.15
+                })
+                .count();
+            let vmax = v.iter().map(|v| v.length()).fold(0.0, f32::max);
+            print!("out {out} vmax {vmax:.2} ");
             println!(
                 "step {step:3} tcp ({:.3} {:.3} {:.3}) bottle ({:.3} {:.3} {:.3}) cos {:.3} | in {} above {} band+ {} spilled {} | qvel {:.3} success {} | {:.2} s/step",
                 tcp.x, tcp.y, tcp.z, b.x, b.y, b.z, e.terms.upright_cosine,

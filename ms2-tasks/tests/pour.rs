@@ -68,13 +68,19 @@ fn water_stays_in_the_upright_bottle() {
         z.abs() < 0.003 && cos > 0.999,
         "the bottle moved: z {z}, cos {cos}"
     );
-    // The water does not rise or splash out. It does sink: its mean height fell from 4.7 to
-    // 3.2 cm in 0.75 s on seed 0 (the velocity gradient does not see the bottle's bottom, only
-    // the capped penalty force holds the particles, so they pile up, as on the floor before
-    // `Boundary::for_fluid`; an open issue, docs/tasks.md). The bound catches a worse collapse.
+    // Weakly compressible: the water's mean height sinks by a few per cent of the column at
+    // most, and does not rise. (Before water's pressure pushed off coupled surfaces, ms2-mpm
+    // `tests/water.rs`, it fell from 4.7 to 3.2 cm here.)
+    let column = env
+        .task()
+        .unwrap()
+        .downcast_ref::<Pour>()
+        .unwrap()
+        .episode()
+        .water_height;
     let z1 = mean_height(&env);
     assert!(
-        z1 < z0 + 0.002 && z1 > 0.6 * z0,
+        z1 > z0 - 0.05 * column && z1 < z0 + 0.002,
         "mean height {z0} -> {z1} m"
     );
 }
