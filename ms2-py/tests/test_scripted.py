@@ -21,8 +21,10 @@ SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
 #: issue #16), Hang-v0 (0/2: the rope tears at the fingertips once the lift takes its weight;
 #: issue #20; an episode takes minutes, so it is not run), Pour-v0 (not solved yet: on seed 0
 #: the tilted bottle lets no water out by 99° and the MPM diverges; issue #20; an episode
-#: takes about 9 minutes, so it is not run).
-KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0", "Hang-v0", "Pour-v0"}
+#: takes about 9 minutes, so it is not run), Write-v0 (1/5 on seeds 0-4: the marks of
+#: characters with corners miss their goals' IoU of 0.8; issue #20; an episode takes minutes,
+#: so it is not run).
+KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0", "Hang-v0", "Pour-v0", "Write-v0"}
 
 
 def test_scripted_policy_success_rate(env_id):

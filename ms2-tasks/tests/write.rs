@@ -91,26 +91,6 @@ fn a_stroke_pressed_into_the_clay_writes_its_goal() {
         written_pixels(&written),
         written_pixels(&goal)
     );
-    if std::env::var("WRITE_DEBUG").is_ok() {
-        for gy in [20usize, 32, 44] {
-            let row =
-                |im: &[i32]| -> Vec<i32> { (24..41).map(|gx| im[gy * IMAGE_SIZE + gx]).collect() };
-            println!(
-                "row {gy}: goal {:?}\n        clay {:?}",
-                row(&goal),
-                row(&written)
-            );
-        }
-        for gx in [31usize, 32, 33] {
-            let col =
-                |im: &[i32]| -> Vec<i32> { (24..42).map(|gy| im[gy * IMAGE_SIZE + gx]).collect() };
-            println!(
-                "col {gx}: goal {:?}\n        clay {:?}",
-                col(&goal),
-                col(&written)
-            );
-        }
-    }
     assert!(iou > 0.8, "iou {iou}");
     // The goal of a stroke 3 cm aside is not written by it.
     let aside = height_image(&goal_particles(&one_stroke([0.2, 0.8], [0.2, 0.2])));

@@ -15,9 +15,9 @@
 //!   ManiSkill2's Write start ([`ARM_START`]) plus U(−0.1, 0.1) rad per joint; the clay's jitter.
 //! - Success: the IoU of the clay's marks with the goal's
 //!   ([`super::write_targets::mark_iou`]) above 0.8.
-//! - Dense reward (ManiSkill2's, not normalised: `normalized_dense` is the same): IoU
-//!   + 0.1 · (1 − tanh(10 · distance from 2 cm beyond the stick frame to the nearest
-//!   particle)) + 0.1 · (1 − the stick frame's z axis' angle to straight down).
+//! - Dense reward (ManiSkill2's, not normalised: `normalized_dense` is the same): the IoU plus
+//!   0.1 · (1 − tanh(10 · distance from 2 cm beyond the stick frame to the nearest particle))
+//!   plus 0.1 · (1 − the stick frame's z axis' angle to straight down).
 //! - `extra` observation: `tcp_pose` (7, ManiSkill2's end effector: the stick frame,
 //!   [`STICK_FRAME_IN_HAND_Z`] along the hand's z axis), `goal` (64 × 64 float32: the goal's
 //!   height image in mm, clipped to 0-255, columns reversed as ManiSkill2 shows it).
