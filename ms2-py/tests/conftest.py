@@ -59,7 +59,20 @@ def obs_differs(a, b) -> bool:
     )
 
 
-@pytest.fixture(params=EVERY_TASK)
+#: Tasks whose simulation is known to fail on some inputs, run as non-strict expected failures
+#: in the every-task sweeps: Pour-v0's MPM water diverges under random actions once water leaves
+#: the tilted bottle (issue #20, docs/tasks.md).
+KNOWN_UNSTABLE = {"Pour-v0"}
+
+
+@pytest.fixture(
+    params=[
+        pytest.param(t, marks=pytest.mark.xfail(reason=f"{t}: known divergence, issue #20"))
+        if t in KNOWN_UNSTABLE
+        else t
+        for t in EVERY_TASK
+    ]
+)
 def env_id(request):
     """Every registered task."""
     return request.param

@@ -131,6 +131,8 @@ PENALISED_REWARDS = {
     "OpenCabinetDoor-v1",
     "PushChair-v1",
     "MoveBucket-v1",
+    "Pinch-v0",
+    "Pour-v0",
 }
 
 
