@@ -122,6 +122,8 @@ pub struct BucketArm {
     hand: Option<(ArticulationId, usize, BodyId)>,
     mpm_freq_hz: f64,
     particle_spacing_m: f32,
+    /// Segmentation name and linear RGB the cameras draw the particles with.
+    look: (&'static str, [f32; 3]),
 }
 
 impl Default for BucketArm {
@@ -132,6 +134,7 @@ impl Default for BucketArm {
             hand: None,
             mpm_freq_hz: DEFAULT_MPM_FREQ_HZ,
             particle_spacing_m: SoftConfig::default().particle_spacing,
+            look: (CLAY_SEGMENTATION_NAME, CLAY_COLOR),
         }
     }
 }
@@ -147,6 +150,15 @@ impl BucketArm {
             particle_spacing_m,
             ..Self::default()
         })
+    }
+
+    /// The same arm whose particles the cameras draw in `rgb` (linear, each channel in
+    /// `[0, 1]`) and segment as `name` (default: [`CLAY_COLOR`], [`CLAY_SEGMENTATION_NAME`]):
+    /// the rope, plasticine or water of the tasks that are not about clay.
+    #[must_use]
+    pub fn drawn_as(mut self, name: &'static str, rgb: [f32; 3]) -> Self {
+        self.look = (name, rgb);
+        self
     }
 
     /// `base` with this arm's MPM substep length.
@@ -293,7 +305,7 @@ impl BucketArm {
     }
 }
 
-/// The clay coupled to the arm is the bucket tasks' one soft component.
+/// The particles coupled to the arm are the soft tasks' one soft component.
 impl SoftComponent for BucketArm {
     fn mpm_freq(&self) -> f64 {
         self.mpm_freq_hz
@@ -319,20 +331,42 @@ impl SoftComponent for BucketArm {
         Some(particles.build())
     }
 
-    /// The clay as the cameras draw it: spheres of [`CLAY_RENDER_RADIUS_PER_SPACING`] ×
-    /// the particle spacing in [`CLAY_COLOR`], segmented as [`CLAY_SEGMENTATION_NAME`];
-    /// particles enclosed by neighbours on all sides are not drawn.
+    /// The particles as the cameras draw them: spheres of [`CLAY_RENDER_RADIUS_PER_SPACING`]
+    /// × the particle spacing in the arm's colour, segmented under its name (see
+    /// [`BucketArm::drawn_as`]); particles enclosed by neighbours on all sides are not drawn.
     fn particle_visuals(&self) -> Vec<ParticleVisual> {
         let particle_spacing_m = self.particle_spacing_m;
         vec![ParticleVisual {
-            name: CLAY_SEGMENTATION_NAME.to_owned(),
+            name: self.look.0.to_owned(),
             radius_m: CLAY_RENDER_RADIUS_PER_SPACING * particle_spacing_m,
-            rgb: CLAY_COLOR,
+            rgb: self.look.1,
             packing_spacing_m: Some(particle_spacing_m),
         }]
     }
 
     fn particle_positions(&self, _set: usize) -> &[Vec3] {
         self.soft.as_ref().map_or(&[], |s| s.solver().positions())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn particles_are_drawn_as_clay_unless_told_otherwise() {
+        let clay = BucketArm::default().particle_visuals();
+        assert_eq!(clay.len(), 1);
+        assert_eq!(clay[0].name, CLAY_SEGMENTATION_NAME);
+        assert_eq!(clay[0].rgb, CLAY_COLOR);
+
+        let water = BucketArm::default()
+            .drawn_as("water", [0.0, 0.5, 0.8])
+            .particle_visuals();
+        assert_eq!(water[0].name, "water");
+        assert_eq!(water[0].rgb, [0.0, 0.5, 0.8]);
+        // The look changes the colour and the name only, not the drawn size.
+        assert_eq!(water[0].radius_m, clay[0].radius_m);
+        assert_eq!(water[0].packing_spacing_m, clay[0].packing_spacing_m);
     }
 }

@@ -40,8 +40,7 @@ use crate::config::EnvConfig;
 use crate::error::EnvError;
 use crate::geometry::vectorize_pose;
 use crate::info::{Evaluation, InfoValue};
-use crate::obs::{DictBuilder, ObsValue};
-use crate::particles::ParticleVisual;
+use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
 use crate::sensors::CameraConfig;
@@ -68,8 +67,6 @@ pub const ARM_START: [f32; 7] = [
 /// Finger position (m per finger) at the start: the fingertips 8 mm apart (ManiSkill2's
 /// recorded starts: 2 mm, the rope pinched between them).
 pub const START_FINGER_QPOS: f32 = 0.004;
-/// Radius (m) of a drawn rope particle: above 1/√2 spacing, so the rope looks solid.
-const ROPE_RENDER_RADIUS: f32 = 0.8 * ROPE_SPACING;
 /// Floats of task state before the particles.
 const STATE_HEADER: usize = 10;
 
@@ -108,7 +105,7 @@ impl Hang {
         let mut cfg = cfg.clone();
         cfg.mpm_freq.get_or_insert(HANG_MPM_FREQ_HZ);
         Ok(Self {
-            arm: BucketArm::from_config(&cfg, ROPE_SPACING)?,
+            arm: BucketArm::from_config(&cfg, ROPE_SPACING)?.drawn_as("rope", ROPE_COLOR),
             ..Self::default()
         })
     }
@@ -402,39 +399,10 @@ impl Task for Hang {
     }
 
     fn soft(&self) -> Option<&dyn SoftComponent> {
-        Some(self)
+        Some(&self.arm)
     }
 
     fn soft_mut(&mut self) -> Option<&mut dyn SoftComponent> {
-        Some(self)
-    }
-}
-
-/// The rope coupled to the arm: [`BucketArm`]'s soft component, drawn as the noodle.
-impl SoftComponent for Hang {
-    fn mpm_freq(&self) -> f64 {
-        self.arm.mpm_freq()
-    }
-
-    fn after_physics_step(&mut self, world: &mut dyn RigidWorld) -> Result<(), EnvError> {
-        self.arm.after_physics_step(world)
-    }
-
-    fn particles_obs(&self) -> Option<ObsValue> {
-        self.arm.particles_obs()
-    }
-
-    /// The rope: spheres of 0.8 spacing in [`ROPE_COLOR`], segmented as `rope`.
-    fn particle_visuals(&self) -> Vec<ParticleVisual> {
-        vec![ParticleVisual {
-            name: "rope".to_owned(),
-            radius_m: ROPE_RENDER_RADIUS,
-            rgb: ROPE_COLOR,
-            packing_spacing_m: Some(ROPE_SPACING),
-        }]
-    }
-
-    fn particle_positions(&self, set: usize) -> &[Vec3] {
-        self.arm.particle_positions(set)
+        Some(&mut self.arm)
     }
 }

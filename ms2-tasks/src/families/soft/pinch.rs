@@ -40,7 +40,6 @@ use crate::error::EnvError;
 use crate::geometry::vectorize_pose;
 use crate::info::{Evaluation, InfoValue};
 use crate::obs::{Array, ArrayData, DictBuilder, ObsValue};
-use crate::particles::ParticleVisual;
 use crate::rigid_world::RigidWorld;
 use crate::seeding::EpisodeRng;
 use crate::sensors::CameraConfig;
@@ -119,7 +118,7 @@ impl Pinch {
     /// under the asset directory.
     pub fn new(cfg: &EnvConfig) -> Result<Self, EnvError> {
         Ok(Self {
-            arm: BucketArm::from_config(cfg, BLOCK_SPACING)?,
+            arm: BucketArm::from_config(cfg, BLOCK_SPACING)?.drawn_as("clay", PLASTICINE_COLOR),
             fingers: None,
             level: None,
             target: None,
@@ -357,39 +356,10 @@ impl Task for Pinch {
     }
 
     fn soft(&self) -> Option<&dyn SoftComponent> {
-        Some(self)
+        Some(&self.arm)
     }
 
     fn soft_mut(&mut self) -> Option<&mut dyn SoftComponent> {
-        Some(self)
-    }
-}
-
-/// The plasticine coupled to the fingers: [`BucketArm`]'s soft component, drawn in
-/// ManiSkill2's Pinch colour.
-impl SoftComponent for Pinch {
-    fn mpm_freq(&self) -> f64 {
-        self.arm.mpm_freq()
-    }
-
-    fn after_physics_step(&mut self, world: &mut dyn RigidWorld) -> Result<(), EnvError> {
-        self.arm.after_physics_step(world)
-    }
-
-    fn particles_obs(&self) -> Option<ObsValue> {
-        self.arm.particles_obs()
-    }
-
-    /// The plasticine: spheres of 0.8 spacing in [`PLASTICINE_COLOR`], segmented as `clay`.
-    fn particle_visuals(&self) -> Vec<ParticleVisual> {
-        let mut visuals = self.arm.particle_visuals();
-        for v in &mut visuals {
-            v.rgb = PLASTICINE_COLOR;
-        }
-        visuals
-    }
-
-    fn particle_positions(&self, set: usize) -> &[Vec3] {
-        self.arm.particle_positions(set)
+        Some(&mut self.arm)
     }
 }

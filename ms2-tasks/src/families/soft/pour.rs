@@ -42,8 +42,7 @@ use crate::config::EnvConfig;
 use crate::error::EnvError;
 use crate::geometry::vectorize_pose;
 use crate::info::{Evaluation, InfoValue};
-use crate::obs::{DictBuilder, ObsValue};
-use crate::particles::ParticleVisual;
+use crate::obs::DictBuilder;
 use crate::rigid_world::RigidWorld;
 use crate::scripted::oracle::panda_tcp_chain;
 use crate::seeding::EpisodeRng;
@@ -118,7 +117,7 @@ impl Pour {
     /// The task for `cfg` (its `mpm_freq`, see [`BucketArm::from_config`]).
     pub fn new(cfg: &EnvConfig) -> Result<Self, EnvError> {
         Ok(Self {
-            arm: BucketArm::from_config(cfg, WATER_SPACING)?,
+            arm: BucketArm::from_config(cfg, WATER_SPACING)?.drawn_as("water", WATER_COLOR),
             ..Self::default()
         })
     }
@@ -473,40 +472,10 @@ impl Task for Pour {
     }
 
     fn soft(&self) -> Option<&dyn SoftComponent> {
-        Some(self)
+        Some(&self.arm)
     }
 
     fn soft_mut(&mut self) -> Option<&mut dyn SoftComponent> {
-        Some(self)
-    }
-}
-
-/// The water coupled to the bottle and the beaker: [`BucketArm`]'s soft component, drawn
-/// blue.
-impl SoftComponent for Pour {
-    fn mpm_freq(&self) -> f64 {
-        self.arm.mpm_freq()
-    }
-
-    fn after_physics_step(&mut self, world: &mut dyn RigidWorld) -> Result<(), EnvError> {
-        self.arm.after_physics_step(world)
-    }
-
-    fn particles_obs(&self) -> Option<ObsValue> {
-        self.arm.particles_obs()
-    }
-
-    /// The water: spheres of 0.8 spacing in [`WATER_COLOR`], segmented as `water`.
-    fn particle_visuals(&self) -> Vec<ParticleVisual> {
-        vec![ParticleVisual {
-            name: "water".to_owned(),
-            radius_m: 0.8 * WATER_SPACING,
-            rgb: WATER_COLOR,
-            packing_spacing_m: Some(WATER_SPACING),
-        }]
-    }
-
-    fn particle_positions(&self, set: usize) -> &[Vec3] {
-        self.arm.particle_positions(set)
+        Some(&mut self.arm)
     }
 }
