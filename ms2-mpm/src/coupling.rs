@@ -29,7 +29,7 @@ use rayon::prelude::*;
 
 use crate::contact::ContactKernel;
 use crate::error::MpmError;
-use crate::grid::GridSpec;
+use crate::grid::{GridNodes, GridSpec};
 use crate::mesh::TriMesh;
 use crate::sdf::{Sdf, SdfVolume};
 use crate::solver::{MpmSolver, ParticleForces, ParticleView};
@@ -216,6 +216,9 @@ pub struct Coupling {
     impulses: Vec<[[f64; 3]; 2]>,
     accumulated_time: f64,
     last_wrenches: Vec<Wrench>,
+    /// Per body: the distance (m) from its surface within which grid nodes move with it
+    /// (`None`: penalty contact only). See [`Coupling::set_sticky_nodes`].
+    sticky_reach: Vec<Option<f32>>,
 }
 
 /// Particles per chunk of the parallel contact pass (fixed, so reductions are deterministic
@@ -285,9 +288,38 @@ impl Coupling {
             impulses: vec![[[0.0; 3]; 2]; n],
             accumulated_time: 0.0,
             last_wrenches: vec![Wrench::default(); n],
+            sticky_reach: vec![None; n],
         };
         coupling.sync_bodies(backend)?;
         Ok(coupling)
+    }
+
+    /// Makes material stick to `body` (ManiSkill2's grid-node contact with unbounded
+    /// friction): every grid node with mass closer than `reach_m` (m, > 0; negative distances
+    /// are inside) to one of the body's shapes takes the body's velocity at the node after
+    /// each grid update, and the body receives the momentum the nodes lose. The penalty
+    /// contact still acts on the particles. A gripper's pads made sticky hold a pinched rope
+    /// whose weight the penalty contact alone, acting on the few particles on the pads,
+    /// cannot carry. `None` turns it off. An error names a body index out of range or a
+    /// reach that is not finite and positive.
+    pub fn set_sticky_nodes(&mut self, body: usize, reach_m: Option<f32>) -> Result<(), MpmError> {
+        if body >= self.sticky_reach.len() {
+            return Err(MpmError::UnknownBody {
+                body,
+                count: self.sticky_reach.len(),
+            });
+        }
+        if let Some(r) = reach_m {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(MpmError::InvalidConfig {
+                    field: "sticky reach",
+                    value: r.to_string(),
+                    expected: "a finite distance > 0 (m)",
+                });
+            }
+        }
+        self.sticky_reach[body] = reach_m;
+        Ok(())
     }
 
     /// The contact constants.
@@ -516,5 +548,33 @@ impl ParticleForces for Coupling {
         masks: &mut [u32],
     ) -> bool {
         self.contact_pass(particles, Some(grid), dt, Some(forces), Some(masks))
+    }
+
+    /// The sticky bodies' nodes ([`Coupling::set_sticky_nodes`]) take the body's velocity;
+    /// the momentum they lose goes to the body (with its torque about the centre of mass).
+    fn constrain_grid_nodes(&mut self, nodes: &mut GridNodes<'_>, _dt: f32) {
+        for sh in &self.shapes {
+            let Some(reach) = self.sticky_reach[sh.body] else {
+                continue;
+            };
+            let body = &self.bodies[sh.body];
+            let margin = Vec3::splat((reach - self.params.contact_offset).max(0.0));
+            let acc = &mut self.impulses[sh.body];
+            nodes.for_each_in_box(sh.world_min - margin, sh.world_max + margin, |x, v, m| {
+                let local = sh.inverse_rotation * (x - sh.world_position);
+                if sh.sdf.distance_and_normal(local).0 >= reach {
+                    return;
+                }
+                let target = body.velocity_at(x);
+                // Momentum the node gives up, which the body takes.
+                let impulse = m * (*v - target);
+                let torque = (x - body.center_of_mass).cross(impulse);
+                for e in 0..3 {
+                    acc[0][e] += impulse[e] as f64;
+                    acc[1][e] += torque[e] as f64;
+                }
+                *v = target;
+            });
+        }
     }
 }

@@ -133,6 +133,78 @@ impl Default for Boundary {
     }
 }
 
+/// The grid nodes that carry mass in the current substep, after the grid update (velocity,
+/// gravity and the domain walls applied), as [`crate::ParticleForces::constrain_grid_nodes`]
+/// sees them: it may overwrite their velocities before they are transferred back to the
+/// particles.
+pub struct GridNodes<'a> {
+    storage: &'a mut GridStorage,
+    spec: &'a GridSpec,
+}
+
+impl<'a> GridNodes<'a> {
+    pub(crate) fn new(storage: &'a mut GridStorage, spec: &'a GridSpec) -> Self {
+        Self { storage, spec }
+    }
+
+    /// The grid's layout.
+    pub fn spec(&self) -> &GridSpec {
+        self.spec
+    }
+
+    /// Calls `f(position, velocity, mass)` on every node with mass whose position (m, world)
+    /// lies in the box `[lo, hi]`: `velocity` (m/s, world) may be changed in place, `mass`
+    /// (kg) is what the particles transferred. Nodes are visited in storage order, on the
+    /// calling thread.
+    pub fn for_each_in_box(&mut self, lo: Vec3, hi: Vec3, mut f: impl FnMut(Vec3, &mut Vec3, f32)) {
+        let spec = self.spec;
+        let inv_dx = 1.0 / spec.cell_size;
+        // Node index ranges of the box (real node indices, may be outside the resolution:
+        // blocks only cover what particles touched).
+        let first = ((lo - spec.origin) * inv_dx).ceil();
+        let last = ((hi - spec.origin) * inv_dx).floor();
+        if first.cmpgt(last).any() {
+            return;
+        }
+        let [_, py, pz] = self.storage.padded_blocks;
+        let b = BLOCK as i32;
+        let storage = &mut *self.storage;
+        for &block in &storage.active {
+            let block = block as usize;
+            let (bx, by, bz) = (block / (py * pz), (block / pz) % py, block % pz);
+            // Real node index of the block's first node along each axis.
+            let start = [bx, by, bz].map(|c| (c * BLOCK) as i32 - b);
+            let outside =
+                (0..3).any(|a| (start[a] + b - 1) < first[a] as i32 || start[a] > last[a] as i32);
+            if outside {
+                continue;
+            }
+            for l in 0..BLOCK_NODES {
+                let ijk = [
+                    start[0] + (l / (BLOCK * BLOCK)) as i32,
+                    start[1] + ((l / BLOCK) % BLOCK) as i32,
+                    start[2] + (l % BLOCK) as i32,
+                ];
+                if (0..3).any(|a| ijk[a] < first[a] as i32 || ijk[a] > last[a] as i32) {
+                    continue;
+                }
+                let node = &mut storage.nodes[block * BLOCK_NODES + l];
+                let m = node[3];
+                if m <= 0.0 {
+                    continue;
+                }
+                let x = spec.origin
+                    + spec.cell_size * Vec3::new(ijk[0] as f32, ijk[1] as f32, ijk[2] as f32);
+                let mut v = Vec3::new(node[0], node[1], node[2]);
+                f(x, &mut v, m);
+                node[0] = v.x;
+                node[1] = v.y;
+                node[2] = v.z;
+            }
+        }
+    }
+}
+
 /// Grid nodes: momentum then velocity (m/s, xyz) and mass (kg, w).
 pub(crate) struct GridStorage {
     pub nodes: Vec<[f32; 4]>,

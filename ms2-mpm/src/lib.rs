@@ -50,7 +50,7 @@ pub use coupling::{
     BodyState, CollisionShape, Coupling, CouplingParams, RigidBackend, ShapeGeometry,
 };
 pub use error::MpmError;
-pub use grid::{Boundary, GridSpec, WallKind};
+pub use grid::{Boundary, GridNodes, GridSpec, WallKind};
 pub use material::{Material, MaterialKind};
 pub use mesh::TriMesh;
 pub use particles::ParticleId;

@@ -3,7 +3,7 @@
 use glam::{Mat3, Vec3};
 
 use crate::error::MpmError;
-use crate::grid::{Boundary, GridSpec, GridStorage};
+use crate::grid::{Boundary, GridNodes, GridSpec, GridStorage};
 use crate::material::{CompiledMaterial, Material};
 use crate::particles::{sort_into_bins, Binning, ParticleId, Particles, SortScratch};
 use crate::transfer::{grid_to_particle, particle_to_grid, TransferParams, TransferScratch};
@@ -76,6 +76,12 @@ pub trait ParticleForces: Send {
         self.particle_forces(particles, dt, forces);
         self.blocked_nodes(particles, grid, masks)
     }
+
+    /// Runs after the grid update of each substep (node velocities with gravity and the
+    /// domain walls applied) and before the transfer back to the particles: may overwrite
+    /// node velocities, e.g. to make material stick to a moving body. `dt` is the substep
+    /// length (s). The default changes nothing.
+    fn constrain_grid_nodes(&mut self, _nodes: &mut GridNodes<'_>, _dt: f32) {}
 }
 
 /// Read-only view of the particles, in the solver's current order.
@@ -376,7 +382,7 @@ impl MpmSolver {
 
     fn substep_in_pool(
         &mut self,
-        external: Option<&mut dyn ParticleForces>,
+        mut external: Option<&mut dyn ParticleForces>,
     ) -> Result<(), MpmError> {
         let dt = self.config.substep_dt;
         if self.needs_sort {
@@ -384,7 +390,7 @@ impl MpmSolver {
         }
         let has_forces = external.is_some();
         let mut has_blocked = false;
-        if let Some(ext) = external {
+        if let Some(ext) = external.as_mut() {
             self.forces.clear();
             self.forces.resize(self.particles.len(), Vec3::ZERO);
             let p = &self.particles;
@@ -426,6 +432,9 @@ impl MpmSolver {
             dt,
             self.config.gravity,
         );
+        if let Some(ext) = external {
+            ext.constrain_grid_nodes(&mut GridNodes::new(&mut self.grid, &self.config.grid), dt);
+        }
         let (lo, hi) = self.usable_domain();
         let report = grid_to_particle(
             &params,

@@ -419,3 +419,91 @@ fn clay_near_a_thin_plate_keeps_its_momentum_when_nothing_touches_it() {
     }
     assert_eq!(coupling.last_wrenches()[plate].force, Vec3::ZERO);
 }
+
+/// A clay block on the floor under a kinematic plate that touches its top and then rises at
+/// 0.1 m/s for 0.3 s; returns the block's rise (m), the plate's (m) and the plate's mean
+/// vertical coupling force (N) over the last 50 rigid steps.
+fn lift_block_by_its_top(sticky_reach: Option<f32>) -> (f32, f32, f32) {
+    let mut s = solver(Boundary::uniform(WallKind::Slip { friction: 0.5 }));
+    let clay = s
+        .add_material(Material::clay(1000.0, 1e4, 0.3, 2e3))
+        .unwrap();
+    let (lo, _) = s.usable_domain();
+    let (block_lo, block_hi) = (
+        Vec3::new(0.14, 0.14, lo.z),
+        Vec3::new(0.18, 0.18, lo.z + 0.03),
+    );
+    let pts = sampling::sample_box(block_lo, block_hi, SPACING);
+    s.add_particles(&pts, clay, SPACING.powi(3), Vec3::ZERO)
+        .unwrap();
+    run(&mut s, 100);
+    let top = s.positions().iter().map(|p| p.z).fold(f32::MIN, f32::max);
+    let mut world = SimpleRigidWorld::new(Vec3::ZERO);
+    let half = Vec3::new(0.03, 0.03, 0.003);
+    let start = Vec3::new(0.16, 0.16, top + 0.0025 + half.z);
+    let plate = world.add_box(half, 1000.0, start, Motion::Kinematic);
+    let mut coupling =
+        Coupling::new(&world, CouplingParams::for_substep(s.config().substep_dt)).unwrap();
+    coupling.set_sticky_nodes(plate, sticky_reach).unwrap();
+    let before = center_of_mass(&s).z;
+    let rigid_dt = SUBSTEPS as f32 * s.config().substep_dt;
+    world.bodies[plate].linear_velocity = Vec3::new(0.0, 0.0, 0.1);
+    let mut pull = Vec::new();
+    for step in 0..150 {
+        world.step(rigid_dt);
+        coupling.advance(&mut s, &mut world, SUBSTEPS).unwrap();
+        if step >= 100 {
+            pull.push(coupling.last_wrenches()[plate].force.z);
+        }
+    }
+    let mean_pull = pull.iter().sum::<f32>() / pull.len() as f32;
+    (
+        center_of_mass(&s).z - before,
+        world.bodies[plate].position.z - start.z,
+        mean_pull,
+    )
+}
+
+#[test]
+fn sticky_nodes_carry_clay_that_hangs_from_a_rising_plate() {
+    // Penalty contact only pushes: a plate rising off the block's top leaves it on the floor.
+    let (rise, plate_rise, _) = lift_block_by_its_top(None);
+    assert!(
+        rise.abs() < 0.1 * plate_rise,
+        "block rose {rise} m without sticky nodes"
+    );
+    // Sticky nodes within a cell of the plate take its velocity: the block hangs from the
+    // plate and rises with it, and the plate carries its weight (pulled down).
+    let (rise, plate_rise, pull) = lift_block_by_its_top(Some(0.01));
+    assert!(
+        rise > 0.7 * plate_rise,
+        "block rose {rise} m while the sticky plate rose {plate_rise} m"
+    );
+    let weight = 1000.0 * 0.04 * 0.04 * 0.03 * 9.81;
+    assert!(
+        pull < -0.5 * weight && pull > -2.0 * weight,
+        "plate force {pull} N against the block's weight {weight} N"
+    );
+}
+
+#[test]
+fn sticky_nodes_refuse_bad_input() {
+    let world = {
+        let mut w = SimpleRigidWorld::new(Vec3::ZERO);
+        w.add_box(
+            Vec3::splat(0.01),
+            1000.0,
+            Vec3::splat(0.1),
+            Motion::Kinematic,
+        );
+        w
+    };
+    let mut coupling = Coupling::new(&world, CouplingParams::for_substep(5e-4)).unwrap();
+    assert!(coupling.set_sticky_nodes(1, Some(0.01)).is_err());
+    for bad in [0.0, -0.01, f32::NAN, f32::INFINITY] {
+        let err = coupling.set_sticky_nodes(0, Some(bad)).unwrap_err();
+        assert!(err.to_string().contains("sticky reach"), "{err}");
+    }
+    coupling.set_sticky_nodes(0, Some(0.01)).unwrap();
+    coupling.set_sticky_nodes(0, None).unwrap();
+}
