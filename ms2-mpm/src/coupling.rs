@@ -221,6 +221,11 @@ pub struct Coupling {
     sticky_reach: Vec<Option<f32>>,
 }
 
+/// Speed (m/s) along its outward normal at which a sticky surface pulls away from the
+/// material and lets it go (see [`Coupling::set_sticky_nodes`]): above the jitter of a
+/// held gripper, below an opening one.
+pub const STICKY_RELEASE_SPEED: f32 = 0.01;
+
 /// Particles per chunk of the parallel contact pass (fixed, so reductions are deterministic
 /// regardless of thread count; small, because particles are sorted by bin and those touching
 /// a tool are bunched together).
@@ -297,7 +302,11 @@ impl Coupling {
     /// Makes material stick to `body` (ManiSkill2's grid-node contact with unbounded
     /// friction): every grid node with mass closer than `reach_m` (m, > 0; negative distances
     /// are inside) to one of the body's shapes takes the body's velocity at the node after
-    /// each grid update, and the body receives the momentum the nodes lose. The penalty
+    /// each grid update, and the body receives the momentum the nodes lose; except where the
+    /// surface moves away from the node faster than [`STICKY_RELEASE_SPEED`] (an opening
+    /// gripper releases; a surface cannot pull material by adhesion). A reach of about one
+    /// grid cell makes sure some node lies within it wherever the surface is (nodes inside a
+    /// body receive no mass through it); the pads must then open by more than that to let go. The penalty
     /// contact still acts on the particles. A gripper's pads made sticky hold a pinched rope
     /// whose weight the penalty contact alone, acting on the few particles on the pads,
     /// cannot carry. `None` turns it off. An error names a body index out of range or a
@@ -562,10 +571,16 @@ impl ParticleForces for Coupling {
             let acc = &mut self.impulses[sh.body];
             nodes.for_each_in_box(sh.world_min - margin, sh.world_max + margin, |x, v, m| {
                 let local = sh.inverse_rotation * (x - sh.world_position);
-                if sh.sdf.distance_and_normal(local).0 >= reach {
+                let (d, n_local) = sh.sdf.distance_and_normal(local);
+                if d >= reach {
                     return;
                 }
                 let target = body.velocity_at(x);
+                // A surface that pulls away from the material lets it go: an opening gripper
+                // releases, and nothing is lifted by adhesion.
+                if target.dot(sh.world_rotation * n_local) < -STICKY_RELEASE_SPEED {
+                    return;
+                }
                 // Momentum the node gives up, which the body takes.
                 let impulse = m * (*v - target);
                 let torque = (x - body.center_of_mass).cross(impulse);

@@ -420,69 +420,141 @@ fn clay_near_a_thin_plate_keeps_its_momentum_when_nothing_touches_it() {
     assert_eq!(coupling.last_wrenches()[plate].force, Vec3::ZERO);
 }
 
-/// A clay block on the floor under a kinematic plate that touches its top and then rises at
-/// 0.1 m/s for 0.3 s; returns the block's rise (m), the plate's (m) and the plate's mean
-/// vertical coupling force (N) over the last 50 rigid steps.
-fn lift_block_by_its_top(sticky_reach: Option<f32>) -> (f32, f32, f32) {
-    let mut s = solver(Boundary::uniform(WallKind::Slip { friction: 0.5 }));
+/// A 4 × 4 × 3 cm clay block (1000 kg/m³) settled on the floor of the common 32³ grid; its
+/// bounds (m).
+fn settled_block(s: &mut MpmSolver) -> (Vec3, Vec3) {
     let clay = s
         .add_material(Material::clay(1000.0, 1e4, 0.3, 2e3))
         .unwrap();
     let (lo, _) = s.usable_domain();
-    let (block_lo, block_hi) = (
+    let pts = sampling::sample_box(
         Vec3::new(0.14, 0.14, lo.z),
         Vec3::new(0.18, 0.18, lo.z + 0.03),
+        SPACING,
     );
-    let pts = sampling::sample_box(block_lo, block_hi, SPACING);
     s.add_particles(&pts, clay, SPACING.powi(3), Vec3::ZERO)
         .unwrap();
-    run(&mut s, 100);
-    let top = s.positions().iter().map(|p| p.z).fold(f32::MIN, f32::max);
+    run(s, 100);
+    let lo = s.positions().iter().fold(Vec3::MAX, |a, p| a.min(*p));
+    let hi = s.positions().iter().fold(Vec3::MIN, |a, p| a.max(*p));
+    (lo, hi)
+}
+
+/// Two frictionless kinematic pads squeeze the block from ±x (1 mm each in 0.05 s), lift it
+/// at 0.1 m/s for 0.3 s, then open at 0.1 m/s for 0.1 s and stay 0.2 s. Returns the block's
+/// rise (m) at the top of the lift and at the end, and the pads' mean vertical coupling force
+/// (N) over the last 50 rigid steps of the lift. Timeline in 2 ms rigid steps: squeeze 25,
+/// lift 150, open 50 (1 cm each), stay 100.
+fn pinch_and_lift(sticky_reach: Option<f32>) -> (f32, f32, f32) {
+    let mut s = solver(Boundary::uniform(WallKind::Slip { friction: 0.5 }));
+    let (lo, hi) = settled_block(&mut s);
+    let half = Vec3::new(0.003, 0.03, 0.012);
+    let params = CouplingParams {
+        friction: 0.0,
+        ..CouplingParams::for_substep(s.config().substep_dt)
+    };
+    let z = lo.z + half.z;
+    let gap = params.contact_offset + half.x;
     let mut world = SimpleRigidWorld::new(Vec3::ZERO);
-    let half = Vec3::new(0.03, 0.03, 0.003);
-    let start = Vec3::new(0.16, 0.16, top + 0.0025 + half.z);
-    let plate = world.add_box(half, 1000.0, start, Motion::Kinematic);
-    let mut coupling =
-        Coupling::new(&world, CouplingParams::for_substep(s.config().substep_dt)).unwrap();
-    coupling.set_sticky_nodes(plate, sticky_reach).unwrap();
+    let pads = [
+        world.add_box(
+            half,
+            1000.0,
+            Vec3::new(lo.x - gap, 0.16, z),
+            Motion::Kinematic,
+        ),
+        world.add_box(
+            half,
+            1000.0,
+            Vec3::new(hi.x + gap, 0.16, z),
+            Motion::Kinematic,
+        ),
+    ];
+    let mut coupling = Coupling::new(&world, params).unwrap();
+    for pad in pads {
+        coupling.set_sticky_nodes(pad, sticky_reach).unwrap();
+    }
     let before = center_of_mass(&s).z;
     let rigid_dt = SUBSTEPS as f32 * s.config().substep_dt;
-    world.bodies[plate].linear_velocity = Vec3::new(0.0, 0.0, 0.1);
-    let mut pull = Vec::new();
-    for step in 0..150 {
+    let mut lift_force = Vec::new();
+    let mut lifted = 0.0;
+    for step in 0..325 {
+        let (inward, up) = match step {
+            0..25 => (0.02, 0.0),
+            25..175 => (0.0, 0.1),
+            175..225 => (-0.1, 0.0),
+            _ => (0.0, 0.0),
+        };
+        world.bodies[pads[0]].linear_velocity = Vec3::new(inward, 0.0, up);
+        world.bodies[pads[1]].linear_velocity = Vec3::new(-inward, 0.0, up);
         world.step(rigid_dt);
         coupling.advance(&mut s, &mut world, SUBSTEPS).unwrap();
-        if step >= 100 {
-            pull.push(coupling.last_wrenches()[plate].force.z);
+        if (125..175).contains(&step) {
+            let w = coupling.last_wrenches();
+            lift_force.push(w[pads[0]].force.z + w[pads[1]].force.z);
+        }
+        if step == 174 {
+            lifted = center_of_mass(&s).z - before;
         }
     }
-    let mean_pull = pull.iter().sum::<f32>() / pull.len() as f32;
-    (
-        center_of_mass(&s).z - before,
-        world.bodies[plate].position.z - start.z,
-        mean_pull,
-    )
+    let mean_force = lift_force.iter().sum::<f32>() / lift_force.len() as f32;
+    (lifted, center_of_mass(&s).z - before, mean_force)
 }
 
 #[test]
-fn sticky_nodes_carry_clay_that_hangs_from_a_rising_plate() {
-    // Penalty contact only pushes: a plate rising off the block's top leaves it on the floor.
-    let (rise, plate_rise, _) = lift_block_by_its_top(None);
+fn sticky_pads_lift_a_pinched_block_and_let_it_go_when_they_open() {
+    // Frictionless pads: the penalty contact alone cannot lift the block.
+    let (lifted, _, _) = pinch_and_lift(None);
     assert!(
-        rise.abs() < 0.1 * plate_rise,
-        "block rose {rise} m without sticky nodes"
+        lifted.abs() < 0.005,
+        "block rose {lifted} m between frictionless pads"
     );
-    // Sticky nodes within a cell of the plate take its velocity: the block hangs from the
-    // plate and rises with it, and the plate carries its weight (pulled down).
-    let (rise, plate_rise, pull) = lift_block_by_its_top(Some(0.01));
+    // Sticky nodes within a cell of the pads hold it: it rises with them (3 cm) and
+    // weighs on them, and falls back when they open.
+    let (lifted, end, force) = pinch_and_lift(Some(0.01));
     assert!(
-        rise > 0.7 * plate_rise,
-        "block rose {rise} m while the sticky plate rose {plate_rise} m"
+        lifted > 0.02,
+        "block rose {lifted} m while the sticky pads rose 0.03 m"
     );
     let weight = 1000.0 * 0.04 * 0.04 * 0.03 * 9.81;
     assert!(
-        pull < -0.5 * weight && pull > -2.0 * weight,
-        "plate force {pull} N against the block's weight {weight} N"
+        force < -0.5 * weight && force > -2.0 * weight,
+        "pads' force {force} N against the block's weight {weight} N"
+    );
+    assert!(
+        end < 0.3 * lifted,
+        "block still {end} m up after the pads opened"
+    );
+}
+
+#[test]
+fn a_sticky_surface_does_not_pull_material_by_adhesion() {
+    // A sticky plate touching the block's top and rising moves away from it along its own
+    // normal: the block stays on the floor.
+    let mut s = solver(Boundary::uniform(WallKind::Slip { friction: 0.5 }));
+    let (_, hi) = settled_block(&mut s);
+    let mut world = SimpleRigidWorld::new(Vec3::ZERO);
+    let half = Vec3::new(0.03, 0.03, 0.003);
+    let plate = world.add_box(
+        half,
+        1000.0,
+        Vec3::new(0.16, 0.16, hi.z + 0.0025 + half.z),
+        Motion::Kinematic,
+    );
+    let mut coupling =
+        Coupling::new(&world, CouplingParams::for_substep(s.config().substep_dt)).unwrap();
+    coupling.set_sticky_nodes(plate, Some(0.01)).unwrap();
+    let before = center_of_mass(&s).z;
+    world.bodies[plate].linear_velocity = Vec3::new(0.0, 0.0, 0.1);
+    let rigid_dt = SUBSTEPS as f32 * s.config().substep_dt;
+    for _ in 0..150 {
+        world.step(rigid_dt);
+        coupling.advance(&mut s, &mut world, SUBSTEPS).unwrap();
+    }
+    let rise = center_of_mass(&s).z - before;
+    assert!(
+        rise.abs() < 0.003,
+        "block rose {rise} m under a rising sticky plate"
     );
 }
 
