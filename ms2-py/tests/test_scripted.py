@@ -18,12 +18,12 @@ SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
 #: Known failures, documented in docs/tasks.md: PickSingleYCB-v0 (6/10 on seeds 0-9 since
 #: every reset rebuilds the scene: wide bowls, long tools; issue #16), PickClutterYCB-v0
 #: (20/30 on seeds 0-29 in pd_ee_delta_pose: neighbours in the way of its top-down grasp;
-#: issue #16), Hang-v0 (0/2: the rope tears at the fingertips once the lift takes its weight;
-#: issue #20; an episode takes minutes, so it is not run), Pour-v0 (not solved yet: on seed 0
-#: the tilted bottle lets no water out by 99° and the MPM diverges; issue #20; an episode
-#: takes about 9 minutes, so it is not run), Write-v0 (1/5 on seeds 0-4: the marks of
-#: characters with corners miss their goals' IoU of 0.8; issue #20; an episode takes minutes,
-#: so it is not run).
+#: issue #16), Hang-v0 (not solved yet: the sticky fingers lift the rope and lay it over the
+#: rod, but it slides off once they open; issue #20; an episode takes minutes, so it is not
+#: run), Pour-v0 (not solved yet: on seed 0 the tilted bottle lets no water out by 99° and the
+#: MPM diverges; issue #20; an episode takes about 9 minutes, so it is not run), Write-v0 (1/5
+#: on seeds 0-4: the marks of characters with corners miss their goals' IoU of 0.8; issue #20;
+#: an episode takes minutes, so it is not run).
 KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0", "Hang-v0", "Pour-v0", "Write-v0"}
 
 

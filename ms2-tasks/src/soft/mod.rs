@@ -189,6 +189,13 @@ impl SoftWorld {
         &self.solver
     }
 
+    /// Makes the soft material stick to coupled body `index` (ms2-mpm's
+    /// [`Coupling::set_sticky_nodes`]: grid nodes within `reach_m` of its surface move with
+    /// it), or not with `None`; an error names a bad index or reach.
+    pub fn set_sticky(&mut self, index: usize, reach_m: Option<f32>) -> Result<(), SoftSceneError> {
+        Ok(self.coupling.set_sticky_nodes(index, reach_m)?)
+    }
+
     /// Signed distance (m) from world point `p` to coupled body `index`'s surface.
     pub fn distance_to_body(&self, index: usize, p: Vec3) -> Result<f32, SoftSceneError> {
         Ok(self.coupling.distance_to_body(index, p)?)

@@ -67,6 +67,9 @@ pub const ARM_START: [f32; 7] = [
 /// Finger position (m per finger) at the start: the fingertips 8 mm apart (ManiSkill2's
 /// recorded starts: 2 mm, the rope pinched between them).
 pub const START_FINGER_QPOS: f32 = 0.004;
+/// Distance (m) from a finger's surface within which the rope's grid nodes move with the
+/// finger: one cell of the rope's grid.
+const FINGER_STICKY_REACH: f32 = 0.005;
 /// Floats of task state before the particles.
 const STATE_HEADER: usize = 10;
 
@@ -324,7 +327,17 @@ impl Task for Hang {
         // particles that touch the rod or the fingertips, which the default (1 ms) constants
         // let sink into them.
         let params = ms2_mpm::CouplingParams::for_substep(dt);
-        self.arm.couple_bodies(solver, world, others, params)
+        let finger_count = fingers.map_or(0, |f| f.len());
+        self.arm.couple_bodies(solver, world, others, params)?;
+        // The fingers hold the rope by sticky grid nodes, as ManiSkill2's grid contact does:
+        // the penalty contact acts on the few particles on the pads, which cannot carry the
+        // rope's weight (it tore at the fingertips when the lift began).
+        if let Some(soft) = self.arm.soft_mut() {
+            for finger in 0..finger_count {
+                soft.set_sticky(finger, Some(FINGER_STICKY_REACH))?;
+            }
+        }
+        Ok(())
     }
 
     fn extra_obs(&self, scene: &TaskScene, extra: &mut DictBuilder) {
