@@ -71,15 +71,14 @@ fn draw_path(out: &Path, name: &str, paths: &[(&[Vec3], [u8; 3])]) -> Result<(),
             // Pixel centres sit at integer image coordinates (the height image's convention).
             let col = (IMAGE_SIZE as f32 - 1.0 - fy + 0.5) * ZOOM as f32;
             let row = (IMAGE_SIZE as f32 - 1.0 - fx + 0.5) * ZOOM as f32;
-            if col >= 1.0 && row >= 1.0 && col < img.width() as f32 - 1.0 {
-                if row < img.height() as f32 - 1.0 {
-                    for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                        img.put_pixel(
-                            col as u32 + di - 1,
-                            row as u32 + dj - 1,
-                            image::Rgb(*colour),
-                        );
-                    }
+            let inside = col >= 1.0 && row >= 1.0;
+            if inside && col < img.width() as f32 - 1.0 && row < img.height() as f32 - 1.0 {
+                for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    img.put_pixel(
+                        col as u32 + di - 1,
+                        row as u32 + dj - 1,
+                        image::Rgb(*colour),
+                    );
                 }
             }
         }
@@ -176,6 +175,7 @@ fn robot(seed: u64, out: &Path) -> Result<(), Error> {
     let start = Instant::now();
     let (mut actual, mut planned) = (vec![tip(&env)], Vec::new());
     let (mut err_sum, mut err_max, mut n) = (0.0f32, 0.0f32, 0);
+    let mut first_success = None;
     for step in 0..200u32 {
         let r = env.step(&policy.act(&env))?;
         let p = tip(&env);
@@ -196,10 +196,19 @@ fn robot(seed: u64, out: &Path) -> Result<(), Error> {
                 );
             }
         }
-        if r.terminated || r.truncated {
+        // The episode ends on success; the writer goes on (`STOP=1`: not) to measure its
+        // whole character.
+        if r.terminated && first_success.is_none() {
+            first_success = Some(step + 1);
+            if std::env::var("STOP").is_ok() {
+                break;
+            }
+        }
+        if r.truncated {
             break;
         }
     }
+    println!("seed {seed}: first success after step {first_success:?}");
     println!(
         "seed {seed} [{}]: in-clay tracking error mean {:.1} mm max {:.1} mm over {n} steps; {:.0} s",
         character.id,
