@@ -11,7 +11,8 @@
 //! `<tag>_classes.png`: green = counted (written in one, near in the other), red = goal written
 //! but the clay not near, blue = clay written but the goal not near, dark grey = near only;
 //! the stick tip's path below the slab's top in yellow (robot: the actual tip, white the plan).
-//! `MPM=<Hz>` sets the robot's MPM rate. The PNGs' data are saved too (`<tag>_images.json`).
+//! The robot's episode goes on after its success (which ends it) to step 200, to measure the
+//! whole character; `STOP=1` stops at the success. `MPM=<Hz>` sets the robot's MPM rate. The PNGs' data are saved too (`<tag>_images.json`).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
