@@ -345,8 +345,8 @@ mod tests {
         };
         assert!(px(0.0, 0.05) < WRITTEN_BELOW_MM);
         assert!(px(0.0, -0.08) > NEAR_BELOW_MM);
-        // Its walls, 6 mm aside, are near but not written.
-        let wall = px(0.0, 0.044);
+        // Its walls, 6 mm aside (between the bars), are near but not written.
+        let wall = px(-0.025, 0.044);
         assert!((WRITTEN_BELOW_MM..NEAR_BELOW_MM).contains(&wall), "{wall}");
     }
 
