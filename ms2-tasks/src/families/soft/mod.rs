@@ -33,6 +33,7 @@ pub mod pour_policy;
 pub mod pour_scene;
 pub mod scripted;
 pub mod write;
+pub mod write_ideal;
 pub mod write_policy;
 pub mod write_targets;
 

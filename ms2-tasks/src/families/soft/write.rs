@@ -31,8 +31,8 @@ use rand::Rng;
 
 use super::bucket_arm::{with_base_camera, BucketArm};
 use super::write_targets::{
-    builtin_characters, goal_display, goal_particles, height_image, mark_iou, slab_lattice,
-    Character, TargetSplit, CONTACT_DISTANCE_M, IMAGE_SIZE, SLAB_SPACING_M,
+    builtin_characters, goal_display, goal_image, height_image, mark_iou, slab_lattice, Character,
+    TargetSplit, CONTACT_DISTANCE_M, IMAGE_SIZE, SLAB_SPACING_M,
 };
 use crate::adapters::mpm_rigid::pose_to_glam;
 use crate::config::EnvConfig;
@@ -131,7 +131,7 @@ impl Write {
                 "Write-v0: no characters to draw targets from".to_owned(),
             ));
         }
-        let goal_image = height_image(&goal_particles(&characters[0]));
+        let goal_image = goal_image(&characters[0]);
         Ok(Self {
             arm: BucketArm::from_config(cfg, SLAB_SPACING_M)?,
             characters,
@@ -150,7 +150,7 @@ impl Write {
         &self.characters[self.target]
     }
 
-    /// The goal's height image (row y, column x, mm; see [`super::write_targets`]).
+    /// The goal's height image (row y, column x, mm; [`super::write_targets::goal_image`]).
     pub fn goal_image(&self) -> &[i32] {
         &self.goal_image
     }
@@ -179,7 +179,7 @@ impl Write {
 
     fn set_target(&mut self, index: usize) {
         self.target = index.min(self.characters.len() - 1);
-        self.goal_image = height_image(&goal_particles(&self.characters[self.target]));
+        self.goal_image = goal_image(&self.characters[self.target]);
     }
 }
 

@@ -4,7 +4,7 @@
 //! Planned at reset from the privileged character: the stick turns straight down (keeping the
 //! hand's yaw at reset) while its tip moves above the first stroke's start; for every stroke
 //! it descends to [`PEN_TIP_Z_M`] at the stroke's start, traces the polyline at one speed,
-//! rises [`HOVER_HEIGHT`] above the slab and travels to the next stroke; at the end it lifts
+//! holding still [`DWELL_STEPS`] at the start, at every corner and at the end, rises [`HOVER_HEIGHT`] above the slab and travels to the next stroke; at the end it lifts
 //! clear of the clay and holds. The writing speed is chosen so that the whole plan ends by
 //! [`PLAN_END_STEP`]. Tip waypoints become TCP targets through the tip's offset in the TCP
 //! frame (measured at reset), then actions of the control mode ([`TcpOracle`]).
@@ -29,6 +29,10 @@ const FINAL_HEIGHT: f32 = 0.04;
 const APPROACH_STEPS: u32 = 16;
 /// Control steps of a descent into the clay or a rise out of it.
 const PLUNGE_STEPS: u32 = 5;
+/// Control steps the tip's command holds still at a stroke's start (after the descent), at
+/// each corner and at its end (before the rise), for the lagging arm to catch up (measured:
+/// the tip trails a moving command by about 9 mm, two control steps, in the clay).
+pub const DWELL_STEPS: u32 = 3;
 /// Tip travel (m) per control step between strokes, above the clay.
 const TRAVEL_PER_STEP: f32 = 0.012;
 /// Slowest and fastest writing (m of stroke per control step).
@@ -37,12 +41,12 @@ const WRITE_PER_STEP: (f32, f32) = (0.004, 0.008);
 pub const PLAN_END_STEP: u32 = 185;
 /// Offset (m) along the hand's z axis of the stick's lowest point: the capsule's centre,
 /// half length and radius (`ms2_assets::PANDA_STICK_*`).
-const TIP_IN_HAND_Z: f32 = (ms2_assets::PANDA_STICK_CENTER_IN_HAND_Z
+pub const TIP_IN_HAND_Z: f32 = (ms2_assets::PANDA_STICK_CENTER_IN_HAND_Z
     + ms2_assets::PANDA_STICK_HALF_LENGTH
     + ms2_assets::PANDA_STICK_RADIUS) as f32;
 
 /// A waypoint: the control step by whose end the tip is at the position (m, world).
-type Waypoint = (u32, Vec3);
+pub type Waypoint = (u32, Vec3);
 
 /// The policy (see the [module docs](self)).
 pub struct WritePolicy {
@@ -75,8 +79,10 @@ impl WritePolicy {
             .windows(2)
             .map(|w| w[0].last().map_or(0.0, |a| a.distance(w[1][0])))
             .sum();
+        let dwells: u32 = strokes.iter().map(|s| s.len() as u32).sum();
         let fixed = APPROACH_STEPS
             + 2 * PLUNGE_STEPS * strokes.len() as u32
+            + DWELL_STEPS * dwells
             + (travel / TRAVEL_PER_STEP).ceil() as u32
             + strokes.len() as u32;
         let budget = PLAN_END_STEP.saturating_sub(fixed).max(1) as f32;
@@ -100,9 +106,11 @@ impl WritePolicy {
             };
             go(&mut out, above, n);
             go(&mut out, first.extend(PEN_TIP_Z_M), PLUNGE_STEPS);
+            go(&mut out, first.extend(PEN_TIP_Z_M), DWELL_STEPS);
             for w in stroke.windows(2) {
                 let n = (w[0].distance(w[1]) / per_step).ceil() as u32;
                 go(&mut out, w[1].extend(PEN_TIP_Z_M), n);
+                go(&mut out, w[1].extend(PEN_TIP_Z_M), DWELL_STEPS);
             }
             let end = stroke[stroke.len() - 1].extend(hover);
             go(&mut out, end, PLUNGE_STEPS);
@@ -118,16 +126,22 @@ impl WritePolicy {
 
     /// The tip position to reach by the end of control step `step`, linearly interpolated.
     fn command(&self, step: u32) -> Option<Vec3> {
-        let s = step + 1;
-        for pair in self.waypoints.windows(2) {
-            let ((s0, p0), (s1, p1)) = (pair[0], pair[1]);
-            if s <= s1 {
-                let t = s.saturating_sub(s0) as f32 / (s1 - s0).max(1) as f32;
-                return Some(p0.lerp(p1, t));
-            }
-        }
-        self.waypoints.last().map(|w| w.1)
+        tip_command(&self.waypoints, step)
     }
+}
+
+/// The tip position (m, world) of `waypoints` ([`WritePolicy::plan`]) to reach by the end of
+/// control step `step`, linearly interpolated; `None` without waypoints.
+pub fn tip_command(waypoints: &[Waypoint], step: u32) -> Option<Vec3> {
+    let s = step + 1;
+    for pair in waypoints.windows(2) {
+        let ((s0, p0), (s1, p1)) = (pair[0], pair[1]);
+        if s <= s1 {
+            let t = s.saturating_sub(s0) as f32 / (s1 - s0).max(1) as f32;
+            return Some(p0.lerp(p1, t));
+        }
+    }
+    waypoints.last().map(|w| w.1)
 }
 
 impl ScriptedPolicy for WritePolicy {
