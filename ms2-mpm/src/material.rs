@@ -21,7 +21,9 @@ pub enum MaterialKind {
         yield_stress: f32,
     },
     /// Weakly compressible, inviscid fluid: pressure `p = K·(1 − J)` with `K` the bulk modulus
-    /// derived from Young's modulus and Poisson ratio (the first Lamé parameter).
+    /// derived from Young's modulus and Poisson ratio (the first Lamé parameter). The solver
+    /// caps `K` for its grid and substep ([`Material::stable_water_bulk_modulus`]) and keeps
+    /// `J` at most [`WATER_MAX_VOLUME_RATIO`].
     Water,
 }
 
