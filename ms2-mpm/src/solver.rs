@@ -203,7 +203,8 @@ impl MpmSolver {
             });
         }
         self.materials.push(material);
-        self.compiled.push(material.compile());
+        self.compiled
+            .push(material.compile_for_step(self.config.grid.cell_size, self.config.substep_dt));
         Ok(MaterialId(self.materials.len() as u16 - 1))
     }
 

@@ -268,7 +268,7 @@ pub(crate) fn grid_to_particle(
     let inv_dx = 1.0 / dx;
     let origin = spec.origin;
     let bins = grid.bins;
-    let mass = &p.mass;
+    let (mass, material) = (&p.mass, &p.material);
     let x_ptr = SyncPtr::new(p.x.as_mut_ptr());
     let v_ptr = SyncPtr::new(p.v.as_mut_ptr());
     let c_ptr = SyncPtr::new(p.c.as_mut_ptr());
@@ -354,11 +354,26 @@ pub(crate) fn grid_to_particle(
                     (b[1] - vel * fx.y) * s,
                     (b[2] - vel * fx.z) * s,
                 );
+                let moved = xs[q] + dt * vel;
+                let xn = moved.clamp(lo, hi);
+                // Water held at the domain's edge keeps no speed into it. Its velocity comes
+                // from the grid, whose walls stop it, unless every node of its stencil is
+                // blocked: water pressed into the table inside a coupled wall standing on it
+                // (Pour-v0's beaker) took its own update there, gravity and the penalty push
+                // out through the wall's bottom face, and fell ever faster in place.
+                let vel = if xn != moved
+                    && prm.materials[material[pi] as usize].kind == CompiledKind::Water
+                {
+                    let held_low = moved.cmplt(lo) & vel.cmplt(Vec3::ZERO);
+                    let held_high = moved.cmpgt(hi) & vel.cmpgt(Vec3::ZERO);
+                    Vec3::select(held_low | held_high, Vec3::ZERO, vel)
+                } else {
+                    vel
+                };
                 vs[q] = vel;
                 if !vel.is_finite() && diverged.is_none() {
                     diverged = Some(start + q);
                 }
-                let xn = (xs[q] + dt * vel).clamp(lo, hi);
                 xs[q] = xn;
                 let nb = crate::particles::base_node(xn, origin, inv_dx);
                 for a in 0..3 {

@@ -5,7 +5,8 @@
 //! cargo run --release -p ms2-tasks --example pour_trace -- [seed=0] [every=10] [steps=350]
 //! ```
 //! `MPM=<Hz>` sets `mpm_freq`; `MODE=<control mode>` the control mode; `IDLE=1` sends zero
-//! actions instead of the policy's.
+//! actions instead of the policy's; `FASTEST=1` prints the fastest particle's position and
+//! velocity.
 
 use std::time::Instant;
 
@@ -55,8 +56,26 @@ fn main() -> Result<(), EnvError> {
                     l.x.hypot(l.y) > 0.0275 || l.z < -0.005 || l.z > 0.15
                 })
                 .count();
-            let vmax = v.iter().map(|v| v.length()).fold(0.0, f32::max);
+            let (fastest, vmax) = v
+                .iter()
+                .map(|v| v.length())
+                .enumerate()
+                .fold((0, 0.0), |a, (i, s)| if s > a.1 { (i, s) } else { a });
             print!("out {out} vmax {vmax:.2} ");
+            if std::env::var("FASTEST").is_ok() && !x.is_empty() {
+                let (p, u) = (x[fastest], v[fastest]);
+                let rel = p.truncate() - pour.episode().beaker_xy;
+                print!(
+                    "(at {:.4} {:.4} {:.4}, v {:.2} {:.2} {:.2}, {:.4} m from the beaker's axis) ",
+                    p.x,
+                    p.y,
+                    p.z,
+                    u.x,
+                    u.y,
+                    u.z,
+                    rel.length()
+                );
+            }
             println!(
                 "step {step:3} tcp ({:.3} {:.3} {:.3}) bottle ({:.3} {:.3} {:.3}) cos {:.3} | in {} above {} band+ {} spilled {} | qvel {:.3} success {} | {:.2} s/step",
                 tcp.x, tcp.y, tcp.z, b.x, b.y, b.z, e.terms.upright_cosine,

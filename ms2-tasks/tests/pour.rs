@@ -70,7 +70,10 @@ fn water_stays_in_the_upright_bottle() {
     );
     // Weakly compressible: the water's mean height sinks by a few per cent of the column at
     // most, and does not rise. (Before water's pressure pushed off coupled surfaces, ms2-mpm
-    // `tests/water.rs`, it fell from 4.7 to 3.2 cm here.)
+    // `tests/water.rs`, it fell from 4.7 to 3.2 cm here.) Since water's bulk modulus is capped
+    // for the substep (1.68e4 Pa at this seed's 872 kg/m³, ms2-mpm
+    // `Material::stable_water_bulk_modulus`) and slides on the walls without friction, the
+    // undamped column sinks more: 4.70 -> 4.08 cm (8.3 % of its 7.4 cm), mean J 0.936.
     let column = env
         .task()
         .unwrap()
@@ -80,7 +83,7 @@ fn water_stays_in_the_upright_bottle() {
         .water_height;
     let z1 = mean_height(&env);
     assert!(
-        z1 > z0 - 0.05 * column && z1 < z0 + 0.002,
+        z1 > z0 - 0.1 * column && z1 < z0 + 0.002,
         "mean height {z0} -> {z1} m"
     );
 }
@@ -150,4 +153,89 @@ fn state_round_trip_is_bit_exact() {
     c.step(&act).unwrap();
     d.step(&act).unwrap();
     assert_eq!(c.get_state(), d.get_state(), "two restored runs diverged");
+}
+
+#[test]
+fn random_actions_spill_the_water_without_diverging() {
+    use rand::{Rng, SeedableRng};
+    // Uniform random actions (as the Python sweeps send) shake the bottle and splash drops
+    // out of it. Before water's bulk modulus was capped for the substep and its volume ratio
+    // bounded (ms2-mpm `Material::stable_water_bulk_modulus`), this run failed with
+    // `Diverged` at step 24.
+    let seed: u64 = std::env::var("POUR_RANDOM_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
+    let mut env = pour_env("state");
+    env.reset(Some(seed), false).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let space = env.action_space().clone();
+    let mut most_out = 0;
+    for step in 0..50 {
+        let act: Vec<f32> = space
+            .low
+            .iter()
+            .zip(&space.high)
+            .map(|(&lo, &hi)| rng.random_range(lo..=hi))
+            .collect();
+        env.step(&act)
+            .unwrap_or_else(|e| panic!("step {step}: {e}"));
+        let (inside, n, _, _) = water_in_bottle(&env);
+        most_out = most_out.max(n - inside);
+        let pour = env.task().unwrap().downcast_ref::<Pour>().unwrap();
+        let v = pour.arm().soft().unwrap().solver().velocities();
+        let vmax = v.iter().map(|v| v.length()).fold(0.0, f32::max);
+        println!(
+            "step {step}: {} out of the bottle, max speed {vmax:.2} m/s",
+            n - inside
+        );
+        assert!(vmax < 10.0, "step {step}: max speed {vmax} m/s");
+    }
+    assert!(most_out > 0, "no water left the bottle");
+}
+
+#[test]
+fn drops_falling_into_the_beaker_stay_finite() {
+    // Sixteen particles of the column moved out as lone drops 1.6 cm apart (no two share a
+    // grid node) 8-10 cm above the beaker, then 0.25 s: they fall into it. Before water's bulk
+    // modulus was capped for the substep (ms2-mpm `Material::stable_water_bulk_modulus`),
+    // a lone drop of this seed's 872 kg/m³ water oscillated ever harder between its pressure
+    // and its APIC matrix and the step failed with `Diverged`.
+    let mut env = pour_env("state");
+    env.reset(Some(0), false).unwrap();
+    let (beaker, n) = {
+        let pour = env.task().unwrap().downcast_ref::<Pour>().unwrap();
+        (pour.episode().beaker_xy, pour.arm().particle_count())
+    };
+    let mut state = env.get_state();
+    let first = state.len() - 24 * n;
+    for k in 0..16 {
+        let c = &mut state[first + 24 * k..first + 24 * (k + 1)];
+        let (i, j) = ((k % 4) as f32, (k / 4) as f32);
+        c[0] = beaker.x + 0.016 * (i - 1.5);
+        c[1] = beaker.y + 0.016 * (j - 1.5);
+        c[2] = 0.08 + 0.01 * ((k % 3) as f32);
+        c[3..6].copy_from_slice(&[0.0, 0.0, -0.2]);
+    }
+    env.set_state(&state).unwrap();
+    let act = hold(&env);
+    for step in 0..5 {
+        env.step(&act)
+            .unwrap_or_else(|e| panic!("step {step}: {e}"));
+    }
+    let pour = env.task().unwrap().downcast_ref::<Pour>().unwrap();
+    let solver = pour.arm().soft().unwrap().solver();
+    let vmax = solver
+        .velocities()
+        .iter()
+        .map(|v| v.length())
+        .fold(0.0, f32::max);
+    // Free fall from 10 cm: 1.4 m/s.
+    assert!(vmax < 2.0, "max speed {vmax} m/s");
+    let e = pour.pour_eval(env.task_scene().unwrap()).unwrap();
+    assert!(
+        e.terms.counts.in_beaker == 16,
+        "{} drops in the beaker",
+        e.terms.counts.in_beaker
+    );
 }

@@ -35,7 +35,7 @@ use super::bucket_arm::{with_base_camera, world_camera, BucketArm};
 use super::pour_scene::{
     beaker_shape, bottle_shape, line_shape, water_column, water_solver, PourTerms, WaterCounts,
     BEAKER_COLOR, BEAKER_HEIGHT, BOTTLE_COLOR, BOTTLE_DENSITY, BOTTLE_HEIGHT, LINE_COLOR,
-    LINE_HEIGHT, WATER_COLOR, WATER_DENSITY, WATER_HEIGHT, WATER_SPACING,
+    LINE_HEIGHT, WATER_COLOR, WATER_DENSITY, WATER_HEIGHT, WATER_SPACING, WATER_WALL_FRICTION,
 };
 use crate::adapters::mpm_rigid::pose_to_glam;
 use crate::config::EnvConfig;
@@ -406,8 +406,10 @@ impl Task for Pour {
         let bodies: Vec<BodyId> = self.bottle.into_iter().chain(self.beaker).collect();
         // The shared 1 ms contact constants: those of the 0.5 ms substep itself (four times
         // stiffer) made the water diverge when the carry started (seed 0, step 26).
-        let params =
-            ms2_mpm::CouplingParams::for_substep(dt.max(crate::soft::COUPLING_REFERENCE_SUBSTEP));
+        let params = ms2_mpm::CouplingParams {
+            friction: WATER_WALL_FRICTION,
+            ..ms2_mpm::CouplingParams::for_substep(dt.max(crate::soft::COUPLING_REFERENCE_SUBSTEP))
+        };
         self.arm
             .couple_bodies(solver, scene.world.as_ref(), bodies, params)
     }
