@@ -23,14 +23,18 @@ SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
 #: (20/30 on seeds 0-29 in pd_ee_delta_pose: neighbours in the way of its top-down grasp;
 #: issue #16), Hang-v0 (not solved yet: the sticky fingers lift the rope and lay it over the
 #: rod, but it slides off once they open; issue #20; an episode takes minutes, so it is not
-#: run), Pour-v0 (not solved yet: on seed 0 the tilted bottle lets no water out by 99° and the
-#: MPM diverges; issue #20; an episode takes about 9 minutes, so it is not run).
-KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0", "Hang-v0", "Pour-v0"}
+#: run).
+KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0", "Hang-v0"}
+#: Solved but too slow for this suite, measured with the Rust examples instead (docs/tasks.md):
+#: Pour-v0 (3/3 on seeds 0-2; an episode is about 10 minutes of one core).
+TOO_SLOW_HERE = {"Pour-v0": "an episode is about 10 minutes; 3/3 on seeds 0-2 (docs/tasks.md)"}
 
 
 def test_scripted_policy_success_rate(env_id):
     if env_id in KNOWN_FAILING:
         pytest.xfail(f"{env_id}: scripted policy below the floor (docs/tasks.md, known problem)")
+    if env_id in TOO_SLOW_HERE:
+        pytest.skip(f"{env_id}: {TOO_SLOW_HERE[env_id]}")
     soft = "particles" in ms2.Ms2Env(env_id).supported_obs_modes
     # The soft-body solutions are tuned in their envs' default pd_joint_delta_pos (they also
     # succeed in pd_ee_delta_pose: docs/tasks.md).
