@@ -124,6 +124,23 @@ pub struct BucketArm {
     particle_spacing_m: f32,
     /// Segmentation name and linear RGB the cameras draw the particles with.
     look: (&'static str, [f32; 3]),
+    /// A gripper whose fingers hold the material by sticky contact while closed, see
+    /// [`BucketArm::grip_with_sticky_fingers`].
+    sticky_grip: Option<StickyGrip>,
+}
+
+/// Fingers that hold the soft material by sticky grid contact while the gripper is closed.
+#[derive(Clone, Copy, Debug)]
+struct StickyGrip {
+    articulation: ArticulationId,
+    /// Link indices of the two fingers.
+    links: [usize; 2],
+    /// Coupled-body indices of the two fingers.
+    coupled: [usize; 2],
+    /// Reach (m) of the sticky contact.
+    reach_m: f32,
+    /// Distance (m) between the finger links above which the grip lets go.
+    open_above_m: f32,
 }
 
 impl Default for BucketArm {
@@ -135,6 +152,7 @@ impl Default for BucketArm {
             mpm_freq_hz: DEFAULT_MPM_FREQ_HZ,
             particle_spacing_m: SoftConfig::default().particle_spacing,
             look: (CLAY_SEGMENTATION_NAME, CLAY_COLOR),
+            sticky_grip: None,
         }
     }
 }
@@ -219,6 +237,28 @@ impl BucketArm {
     /// The coupled soft world, once an episode started.
     pub fn soft(&self) -> Option<&SoftWorld> {
         self.soft.as_ref()
+    }
+
+    /// Makes the two fingers (links `links` of `articulation`, coupled bodies `coupled` of
+    /// the soft world) hold the material by sticky grid contact within `reach_m` (m) while
+    /// the distance between the finger links is at most `open_above_m` (m), checked before
+    /// every soft step: a squeeze holds what friction would, an opened gripper lets go of all
+    /// of it (the sticky contact alone keeps material that wraps a fingertip).
+    pub fn grip_with_sticky_fingers(
+        &mut self,
+        articulation: ArticulationId,
+        links: [usize; 2],
+        coupled: [usize; 2],
+        reach_m: f32,
+        open_above_m: f32,
+    ) {
+        self.sticky_grip = Some(StickyGrip {
+            articulation,
+            links,
+            coupled,
+            reach_m,
+            open_above_m,
+        });
     }
 
     /// The coupled soft world, mutably (e.g. to make a body sticky), once an episode started.
@@ -317,10 +357,24 @@ impl SoftComponent for BucketArm {
     }
 
     fn after_physics_step(&mut self, world: &mut dyn RigidWorld) -> Result<(), EnvError> {
-        match &mut self.soft {
-            Some(soft) => Ok(soft.after_rigid_step(world)?),
-            None => Ok(()),
+        let Some(soft) = &mut self.soft else {
+            return Ok(());
+        };
+        if let Some(g) = self.sticky_grip {
+            let link = |l: usize| {
+                world
+                    .link_pose(g.articulation, l)
+                    .map(|p| p.translation.vector)
+            };
+            let closed = match (link(g.links[0]), link(g.links[1])) {
+                (Ok(a), Ok(b)) => (a - b).norm() <= g.open_above_m,
+                _ => false,
+            };
+            for body in g.coupled {
+                soft.set_sticky(body, closed.then_some(g.reach_m))?;
+            }
         }
+        Ok(soft.after_rigid_step(world)?)
     }
 
     fn particles_obs(&self) -> Option<ObsValue> {

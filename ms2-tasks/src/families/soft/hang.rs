@@ -70,6 +70,9 @@ pub const START_FINGER_QPOS: f32 = 0.004;
 /// Distance (m) from a finger's surface within which the rope's grid nodes move with the
 /// finger: one cell of the rope's grid.
 const FINGER_STICKY_REACH: f32 = 0.005;
+/// Distance (m) between the finger links above which the fingers let go of the rope: the
+/// start's 8 mm opened by 2 mm per finger.
+const FINGER_RELEASE_DISTANCE: f32 = 0.012;
 /// Floats of task state before the particles.
 const STATE_HEADER: usize = 10;
 
@@ -327,15 +330,18 @@ impl Task for Hang {
         // particles that touch the rod or the fingertips, which the default (1 ms) constants
         // let sink into them.
         let params = ms2_mpm::CouplingParams::for_substep(dt);
-        let finger_count = fingers.map_or(0, |f| f.len());
         self.arm.couple_bodies(solver, world, others, params)?;
-        // The fingers hold the rope by sticky grid nodes, as ManiSkill2's grid contact does:
-        // the penalty contact acts on the few particles on the pads, which cannot carry the
-        // rope's weight (it tore at the fingertips when the lift began).
-        if let Some(soft) = self.arm.soft_mut() {
-            for finger in 0..finger_count {
-                soft.set_sticky(finger, Some(FINGER_STICKY_REACH))?;
-            }
+        // The fingers hold the rope by sticky grid contact while closed, as ManiSkill2's grid
+        // contact does: the penalty contact acts on the few particles on the pads, which
+        // cannot carry the rope's weight (it tore at the fingertips when the lift began).
+        if let Some((art, left, right, _, _)) = self.fingers {
+            self.arm.grip_with_sticky_fingers(
+                art,
+                [left, right],
+                [0, 1],
+                FINGER_STICKY_REACH,
+                FINGER_RELEASE_DISTANCE,
+            );
         }
         Ok(())
     }
