@@ -37,6 +37,20 @@ fn dam() -> MpmSolver {
 }
 
 /// Mean volume ratio `J = det F` of the particles.
+/// A solver on a grid of `resolution` 5 mm cells from (−1.5, −1.5, −1.5) cm, 2 kHz, slip
+/// walls (friction 0.5) holding the face nodes as water needs, with water of `density`
+/// (kg/m³) and ManiSkill2's Pour bulk modulus.
+fn water_solver(resolution: [usize; 3], density: f32) -> (MpmSolver, ms2_mpm::MaterialId) {
+    let mut config = SolverConfig::new(GridSpec::new(Vec3::splat(-3.0 * DX), DX, resolution));
+    config.substep_dt = 5e-4;
+    config.boundary = Boundary::for_fluid(WallKind::Slip { friction: 0.5 });
+    let mut s = MpmSolver::new(config).expect("valid config");
+    let water = s
+        .add_material(Material::water(density, BULK_MODULUS))
+        .expect("valid material");
+    (s, water)
+}
+
 fn mean_volume_ratio(s: &MpmSolver) -> f32 {
     let f = s.deformation_gradients();
     f.iter().map(|f| f.determinant()).sum::<f32>() / f.len() as f32
@@ -118,13 +132,7 @@ fn water_in_a_coupled_container_keeps_its_volume() {
     // and rests: its mean height is the bottom plus half the spread column, and its volume
     // ratio stays near 1. Before water's pressure pushed against the masked nodes, the
     // column sank to J = 0.58 in 0.8 s.
-    let mut config = SolverConfig::new(GridSpec::new(Vec3::splat(-3.0 * DX), DX, [40, 40, 50]));
-    config.substep_dt = 5e-4;
-    config.boundary = Boundary::for_fluid(WallKind::Slip { friction: 0.5 });
-    let mut s = MpmSolver::new(config).expect("valid config");
-    let water = s
-        .add_material(Material::water(1000.0, BULK_MODULUS))
-        .expect("valid material");
+    let (mut s, water) = water_solver([40, 40, 50], 1000.0);
     let c = Vec3::new(0.085, 0.085, 0.0);
     let (bottom, height) = (0.05, 0.08);
     let pts = sampling::sample_cylinder(c + Vec3::Z * bottom, 0.024, height, SPACING);
@@ -179,13 +187,7 @@ fn water_in_a_coupled_container_keeps_its_volume() {
 /// grid node), thrown at up to 1 m/s in a tank 30 × 30 × 30 cm.
 fn spray(density: f32, drops: usize) -> MpmSolver {
     use rand::{Rng, SeedableRng};
-    let mut config = SolverConfig::new(GridSpec::new(Vec3::splat(-3.0 * DX), DX, [66; 3]));
-    config.substep_dt = 5e-4;
-    config.boundary = Boundary::for_fluid(WallKind::Slip { friction: 0.5 });
-    let mut s = MpmSolver::new(config).expect("valid config");
-    let water = s
-        .add_material(Material::water(density, BULK_MODULUS))
-        .expect("valid material");
+    let (mut s, water) = water_solver([66; 3], density);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
     for k in 0..drops {
         let at = Vec3::new(
@@ -246,13 +248,7 @@ fn water_caught_inside_a_wall_on_the_floor_stays_still() {
     // their stencils is across the plate's surface, so they take their own update, and the
     // nearest face pushes them down into the floor. Before water held at the domain's edge
     // lost its speed into it, some fell in place ever faster (10.7 m/s after 1 s).
-    let mut config = SolverConfig::new(GridSpec::new(Vec3::splat(-3.0 * DX), DX, [30, 30, 30]));
-    config.substep_dt = 5e-4;
-    config.boundary = Boundary::for_fluid(WallKind::Slip { friction: 0.5 });
-    let mut s = MpmSolver::new(config).expect("valid config");
-    let water = s
-        .add_material(Material::water(1000.0, BULK_MODULUS))
-        .expect("valid material");
+    let (mut s, water) = water_solver([30, 30, 30], 1000.0);
     let pts: Vec<Vec3> = (0..5)
         .map(|k| Vec3::new(0.0593 + 0.0001 * k as f32, 0.04 + 0.005 * k as f32, 0.0))
         .collect();
