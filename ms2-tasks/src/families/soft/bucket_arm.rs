@@ -261,11 +261,6 @@ impl BucketArm {
         });
     }
 
-    /// The coupled soft world, mutably (e.g. to make a body sticky), once an episode started.
-    pub fn soft_mut(&mut self) -> Option<&mut SoftWorld> {
-        self.soft.as_mut()
-    }
-
     /// World pose of the hand link (`None` before the hand is located).
     pub fn hand_pose(&self, world: &dyn RigidWorld) -> Option<Pose3> {
         let (art, link, _) = self.hand?;
