@@ -1,9 +1,10 @@
-//! Success rates of the scripted (oracle) policies over seeds `0..N`.
+//! Success rates of the scripted (oracle) policies over seeds `FIRST..FIRST + N`.
 //!
 //! ```text
-//! cargo run --release -p ms2-tasks --example scripted_rates -- [N=100] [control_mode=pd_joint_delta_pos] [env ids...]
+//! [FIRST_SEED=0] cargo run --release -p ms2-tasks --example scripted_rates -- [N=100] [control_mode=pd_joint_delta_pos] [env ids...]
 //! ```
-//! Prints one line per env: successes, rate, mean steps to success and wall time.
+//! Prints one line per env: successes, rate, mean steps to success and wall time. `FIRST_SEED`
+//! continues a sweep where an earlier run stopped (the slow soft-body tasks run in parts).
 
 use std::time::Instant;
 
@@ -26,6 +27,12 @@ fn run_episode(env: &mut ms2_tasks::Env, seed: u64) -> Result<Option<u32>, EnvEr
 fn main() -> Result<(), EnvError> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let n: u64 = args.first().and_then(|s| s.parse().ok()).unwrap_or(100);
+    let first: u64 = match std::env::var("FIRST_SEED") {
+        Ok(s) => s.parse().map_err(|_| {
+            EnvError::InvalidConfig(format!("FIRST_SEED must be a seed (u64), got {s:?}"))
+        })?,
+        Err(_) => 0,
+    };
     let mode = args
         .get(1)
         .cloned()
@@ -53,7 +60,7 @@ fn main() -> Result<(), EnvError> {
         let mut successes = 0u32;
         let mut steps_sum = 0u64;
         let mut failed = Vec::new();
-        for seed in 0..n {
+        for seed in first..first + n {
             match run_episode(&mut env, seed)? {
                 Some(steps) => {
                     successes += 1;
@@ -63,7 +70,8 @@ fn main() -> Result<(), EnvError> {
             }
         }
         println!(
-            "{id} {mode}: {successes}/{n} = {:.1} % success, mean {:.1} steps to success, {:.1} s; failed seeds {:?}",
+            "{id} {mode}, seeds {first}..{}: {successes}/{n} = {:.1} % success, mean {:.1} steps to success, {:.1} s; failed seeds {:?}",
+            first + n,
             100.0 * f64::from(successes) / n as f64,
             steps_sum as f64 / f64::from(successes.max(1)),
             start.elapsed().as_secs_f64(),
