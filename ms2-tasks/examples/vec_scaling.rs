@@ -1,0 +1,124 @@
+//! How far `VecEnv` on several threads can scale over one env, and what stops it: a state env
+//! with uniform random actions (the `ms2 bench` workload), without Python.
+//!
+//! ```text
+//! cargo run --release -p ms2-tasks --example vec_scaling -- [env=PickCube-v0] [mode=pd_ee_delta_pose] [steps=3000] [num_envs=2]
+//! ```
+//!
+//! Prints, all measured in this one process on the same machine:
+//! - one env stepped alone (env steps/s);
+//! - `VecEnv` with `num_envs` envs on rayon's pool, episodes auto-reset as `make_vec` does
+//!   (env steps/s and the ratio to the single env);
+//! - the **lockstep bound**: the `num_envs` envs stepped one after another on one thread, each
+//!   env step timed. A vector step lasts as long as its slowest env's (every env must finish
+//!   before the batch of observations returns), so with one env per core the best possible
+//!   ratio is `num_envs · mean(step) / mean(max over the envs of step)`, whatever the threading.
+//!   The spread of single-step costs (contacts come and go under random actions) sets it.
+//!
+//! Run it on an idle machine: the threaded row needs the cores to itself.
+
+use std::time::Instant;
+
+use ms2_tasks::seeding::episode_rng;
+use ms2_tasks::{make_env, EnvCommand, EnvConfig, EnvError, EpisodeRng, VecEnv};
+use rand::Rng;
+
+fn random_action(rng: &mut EpisodeRng, dim: usize) -> Vec<f32> {
+    (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect()
+}
+
+fn main() -> Result<(), EnvError> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let env_id = args.first().map_or("PickCube-v0", String::as_str);
+    let mode = args.get(1).map_or("pd_ee_delta_pose", String::as_str);
+    let steps: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3000);
+    let num_envs: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(2);
+    let cfg = EnvConfig {
+        obs_mode: "state".to_owned(),
+        control_mode: Some(mode.to_owned()),
+        ..EnvConfig::new(env_id)
+    };
+
+    // Lockstep: every env's step timed, envs taken in turn on this thread.
+    let mut envs = (0..num_envs)
+        .map(|_| make_env(&cfg))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut rngs: Vec<EpisodeRng> = (0..num_envs).map(|i| episode_rng(i as u64)).collect();
+    for (i, env) in envs.iter_mut().enumerate() {
+        env.reset(Some(i as u64), false)?;
+    }
+    let dim = envs[0].action_space().size();
+    let rounds = steps.div_ceil(num_envs);
+    let mut sum_mean = 0.0f64;
+    let mut sum_max = 0.0f64;
+    for _ in 0..rounds {
+        let mut slowest = 0.0f64;
+        let mut total = 0.0f64;
+        for (env, rng) in envs.iter_mut().zip(&mut rngs) {
+            let action = random_action(rng, dim);
+            let t = Instant::now();
+            let out = env.step(&action)?;
+            if out.terminated || out.truncated {
+                env.reset(None, false)?;
+            }
+            let dt = t.elapsed().as_secs_f64();
+            slowest = slowest.max(dt);
+            total += dt;
+        }
+        sum_mean += total / num_envs as f64;
+        sum_max += slowest;
+    }
+    let bound = num_envs as f64 * sum_mean / sum_max;
+    drop(envs);
+
+    // One env alone.
+    let mut env = make_env(&cfg)?;
+    let mut rng = episode_rng(0);
+    env.reset(Some(0), false)?;
+    let t = Instant::now();
+    for _ in 0..steps {
+        let out = env.step(&random_action(&mut rng, dim))?;
+        if out.terminated || out.truncated {
+            env.reset(None, false)?;
+        }
+    }
+    let single = steps as f64 / t.elapsed().as_secs_f64();
+    drop(env);
+
+    // The vector env, auto-resetting an env whose episode ended (make_vec's convention).
+    let mut vec_env = VecEnv::new(&cfg, num_envs)?;
+    let seeds: Vec<Option<u64>> = (0..num_envs as u64).map(Some).collect();
+    vec_env.reset(&seeds)?;
+    let mut needs_reset = vec![false; num_envs];
+    let mut rng = episode_rng(1);
+    let t = Instant::now();
+    for _ in 0..rounds {
+        let actions: Vec<Vec<f32>> = (0..num_envs)
+            .map(|_| random_action(&mut rng, dim))
+            .collect();
+        let commands: Vec<EnvCommand<'_>> = actions
+            .iter()
+            .zip(&needs_reset)
+            .map(|(a, &reset)| match reset {
+                true => EnvCommand::Reset { seed: None },
+                false => EnvCommand::Step(a),
+            })
+            .collect();
+        let outs = vec_env.run(&commands)?;
+        for (flag, out) in needs_reset.iter_mut().zip(outs) {
+            *flag = out.is_some_and(|o| o.terminated || o.truncated);
+        }
+    }
+    let vector = (rounds * num_envs) as f64 / t.elapsed().as_secs_f64();
+
+    println!(
+        "{env_id} {mode}, {} threads: single {single:.0} env steps/s; VecEnv({num_envs}) \
+         {vector:.0} env steps/s = {:.2}x single; lockstep bound {bound:.2}x \
+         (mean env step {:.0} µs, mean slowest of {num_envs} {:.0} µs)",
+        rayon::current_num_threads(),
+        vector / single,
+        1e6 * sum_mean / rounds as f64,
+        1e6 * sum_max / rounds as f64,
+    );
+    Ok(())
+}
