@@ -40,7 +40,11 @@ cargo clippy --workspace --all-targets -- -D warnings
 echo "[test] ms2-physics without its rapier engine (--no-default-features: the engine-neutral vocabulary)"
 cargo clippy -p ms2-physics --no-default-features --all-targets -- -D warnings
 echo "[test] cargo test (workspace, release profile)"
-cargo test --release --workspace --exclude ms2-py
+# Libraries, binaries, integration tests and examples marked `test = true`, then the doc tests.
+# The other examples are not built again in release here: clippy --all-targets above compiles
+# and lints every one of them, and no test runs an example binary (about 50 release links).
+cargo test --release --workspace --exclude ms2-py --lib --bins --tests
+cargo test --release --workspace --exclude ms2-py --doc
 echo "[test] ms2-tasks feature combinations (clippy --all-targets each; state-only tests)"
 # Every feature combination of ms2-tasks must build (lints only, not builds), and the
 # state-only runtime (`rapier` alone: no wgpu, no MPM, no planner) must pass its tests.
@@ -55,11 +59,16 @@ for features in "" rapier rapier,render rapier,soft rapier,demos; do
     cargo clippy -q -p ms2-tasks --all-targets --no-default-features --features "$features" -- -D warnings
 done
 echo "[test]   cargo test --release -p ms2-tasks --no-default-features --features rapier"
-cargo test --release -p ms2-tasks --no-default-features --features rapier
+cargo test --release -p ms2-tasks --no-default-features --features rapier --lib --tests
 echo "[test] ruff (ms2-py)"
 ruff check ms2-py
 echo "[test] pytest (ms2-py/tests)"
-python -m pytest -q ms2-py/tests
+# One worker process per core (pytest-xdist; PYTEST_WORKERS overrides): most tests simulate on
+# one thread, so two workers use both cores; conftest.py starts the minutes-long tests first so
+# that the short ones fill in around them. The full suite, loaded machine (load 8-10), two
+# workers: 3,782 s (2026-11-28), where one process took 5,472 s before the slow tasks' sweeps
+# were trimmed.
+python -m pytest -q -n "${PYTEST_WORKERS:-auto}" --dist load ms2-py/tests
 echo "[test] cargo package (every library crate packaged and built from its .crate alone)"
 bash scripts/check_packages.sh
 echo "[test] all tests passed in $(($(date +%s) - started)) s"

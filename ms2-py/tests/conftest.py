@@ -105,3 +105,28 @@ def preferred_control_mode(env_id: str) -> str | None:
 def make(env_id=MAIN_ID, **kwargs) -> gym.Env:
     """A gymnasium-made env without the passive checker's warnings."""
     return gym.make(env_id, disable_env_checker=True, **kwargs)
+
+
+#: Tests that took minutes in a full run though no slow task names them (pytest --durations).
+LONG_TESTS = (
+    "test_a_wheel_with_the_wrong_checksum_is_refused_naming_it",
+    "test_generated_soft_demos_replay_convert_and_render",
+    "test_run_uses_each_task_default_control_mode",
+    "[MoveBucket-v1",
+)
+
+
+def _start_rank(nodeid: str) -> int:
+    """0 for a slow task's scripted episodes (up to 10 minutes each), 1 for the other tests
+    that take minutes (a slow task's mode sweeps, the named long tests), 2 for the rest."""
+    slow = any(f"[{t}" in nodeid for t in SOFT_TASKS + SLOW_TO_MAKE)
+    if slow and "test_scripted_policy_success_rate" in nodeid:
+        return 0
+    return 1 if slow or any(name in nodeid for name in LONG_TESTS) else 2
+
+
+def pytest_collection_modifyitems(config, items):
+    """Runs the minutes-long tests first (the order is otherwise kept): with two workers
+    (``pytest -n 2 --dist load``, scripts/test.sh) the short ones then fill in around them,
+    instead of one worker finishing a 10-minute test alone at the end."""
+    items.sort(key=lambda item: _start_rank(item.nodeid))
