@@ -19,7 +19,15 @@ struct MaskGeometry {
     reach: f32,
     /// Per shape: the grid's x, y, z node steps (m) in the shape's local frame.
     steps: Vec<[Vec3; 3]>,
+    /// Per shape: half extents (m, shape frame) of a particle's stencil cube (its 3 × 3 × 3
+    /// nodes, two cells a side), `|x step| + |y step| + |z step|`, widened by a hair for
+    /// round-off.
+    stencil_half: Vec<Vec3>,
 }
+
+/// Widening (in cells) of a stencil's cube in the test that skips shapes it cannot reach:
+/// far above the round-off of the shape-frame coordinates, far below a cell.
+const STENCIL_SLACK: f32 = 1e-3;
 
 /// The contact model evaluated at one particle at a time (see [`crate::coupling`]).
 pub(crate) struct ContactKernel<'a> {
@@ -44,15 +52,23 @@ impl<'a> ContactKernel<'a> {
     ) -> Self {
         let masks = grid.map(|g| {
             let dx = g.cell_size;
+            let steps: Vec<[Vec3; 3]> = shapes
+                .iter()
+                .map(|sh| [Vec3::X, Vec3::Y, Vec3::Z].map(|a| sh.inverse_rotation * (dx * a)))
+                .collect();
+            let stencil_half = steps
+                .iter()
+                .map(|[ex, ey, ez]| {
+                    ex.abs() + ey.abs() + ez.abs() + Vec3::splat(STENCIL_SLACK * dx)
+                })
+                .collect();
             MaskGeometry {
                 origin: g.origin,
                 dx,
                 inv_dx: 1.0 / dx,
                 reach: 2.6 * dx,
-                steps: shapes
-                    .iter()
-                    .map(|sh| [Vec3::X, Vec3::Y, Vec3::Z].map(|a| sh.inverse_rotation * (dx * a)))
-                    .collect(),
+                steps,
+                stencil_half,
             }
         });
         Self {
@@ -65,34 +81,70 @@ impl<'a> ContactKernel<'a> {
         }
     }
 
+    /// Extra reach (m) of a shape's world bounds within which a particle is looked at:
+    /// its stencil's (the blocked-node masks), or none.
+    pub fn reach(&self) -> f32 {
+        self.masks.as_ref().map_or(0.0, |g| g.reach)
+    }
+
     /// The contact force (N, world) on the particle at `x` (m) moving at `v` (m/s) of mass
     /// `m` (kg), and its blocked-node mask (bit `(i·3 + j)·3 + k` for stencil node
-    /// `base + (i, j, k)`). Adds the opposite impulse (N·s) and angular impulse about the
-    /// body's centre of mass (N·m·s) to `acc[body]`.
+    /// `base + (i, j, k)`), against the shapes `candidates` (indices in increasing order; a
+    /// shape left out must be one whose world bounds, widened by [`Self::reach`], do not
+    /// contain `x`). Adds the opposite impulse (N·s) and angular impulse about the body's
+    /// centre of mass (N·m·s) to `acc[body]`.
     #[inline]
-    pub fn particle(&self, x: Vec3, v: Vec3, m: f32, acc: &mut [[[f64; 3]; 2]]) -> (Vec3, u32) {
+    pub fn particle(
+        &self,
+        x: Vec3,
+        v: Vec3,
+        m: f32,
+        candidates: &[u16],
+        acc: &mut [[[f64; 3]; 2]],
+    ) -> (Vec3, u32) {
         let p = self.params;
-        let reach = self.masks.as_ref().map_or(0.0, |g| g.reach);
+        let reach = self.reach();
         let mut total = Vec3::ZERO;
         let mut mask = 0u32;
-        for (s, sh) in self.shapes.iter().enumerate() {
+        // World position of the stencil's first node, once a shape needs it.
+        let mut node0 = None;
+        for &s in candidates {
+            let s = usize::from(s);
+            let sh = &self.shapes[s];
             let lo = sh.world_min - Vec3::splat(reach);
             let hi = sh.world_max + Vec3::splat(reach);
             if x.cmplt(lo).any() || x.cmpgt(hi).any() {
                 continue;
             }
+            // The stencil nodes in the shape's frame, if the stencil's cube can reach the
+            // shape's solid: every segment from the particle to a node lies in that cube, so
+            // a shape out of its reach blocks none of them.
+            let stencil = self.masks.as_ref().and_then(|g| {
+                let n0 = *node0.get_or_insert_with(|| g.first_node(x));
+                let n0 = sh.inverse_rotation * (n0 - sh.world_position);
+                let [ex, ey, ez] = g.steps[s];
+                let centre = n0 + ex + ey + ez;
+                let half = g.stencil_half[s];
+                let apart =
+                    (centre - half).cmpgt(sh.solid_max) | (centre + half).cmplt(sh.solid_min);
+                (!apart.any()).then_some((g, n0))
+            });
+            let in_contact_box = !(x.cmplt(sh.world_min).any() || x.cmpgt(sh.world_max).any());
+            let pushes = self.with_forces && in_contact_box;
+            if stencil.is_none() && !pushes {
+                continue;
+            }
             let local = sh.inverse_rotation * (x - sh.world_position);
             let (d, n_local) = sh.sdf.distance_and_normal(local);
-            if let Some(g) = &self.masks {
+            if let Some((g, n0)) = stencil {
                 // No segment to a stencil node (at most `reach` long) can touch a solid
                 // farther away than that.
                 if d <= g.reach {
-                    mask |= self.blocked_by_shape(g, s, sh, x, local);
+                    mask |= Self::blocked_by_shape(g, s, sh, n0, local);
                 }
             }
-            let in_contact_box = !(x.cmplt(sh.world_min).any() || x.cmpgt(sh.world_max).any());
             let depth = p.contact_offset - d;
-            if !self.with_forces || !in_contact_box || depth <= 0.0 {
+            if !pushes || depth <= 0.0 {
                 continue;
             }
             let n = sh.world_rotation * n_local;
@@ -122,20 +174,16 @@ impl<'a> ContactKernel<'a> {
         (total, mask)
     }
 
-    /// Mask of the stencil nodes of the particle at `x` (world; `local` in shape `s`'s
-    /// frame) whose segment from the particle passes through shape `s`.
+    /// Mask of the stencil nodes (the first at `n0`, in shape `s`'s frame) whose segment
+    /// from the particle (at `local`, in the same frame) passes through shape `s`.
     #[inline]
     fn blocked_by_shape(
-        &self,
         g: &MaskGeometry,
         s: usize,
         sh: &CoupledShape,
-        x: Vec3,
+        n0: Vec3,
         local: Vec3,
     ) -> u32 {
-        let (base, _, _) = quadratic_weights((x - g.origin) * g.inv_dx);
-        let node0 = g.origin + g.dx * Vec3::new(base[0] as f32, base[1] as f32, base[2] as f32);
-        let n0 = sh.inverse_rotation * (node0 - sh.world_position);
         let [ex, ey, ez] = g.steps[s];
         let mut mask = 0u32;
         for i in 0..3 {
@@ -156,6 +204,15 @@ impl<'a> ContactKernel<'a> {
             }
         }
         mask
+    }
+}
+
+impl MaskGeometry {
+    /// World position (m) of the first node of the stencil of the particle at `x`.
+    #[inline]
+    fn first_node(&self, x: Vec3) -> Vec3 {
+        let (base, _, _) = quadratic_weights((x - self.origin) * self.inv_dx);
+        self.origin + self.dx * Vec3::new(base[0] as f32, base[1] as f32, base[2] as f32)
     }
 }
 
@@ -184,7 +241,146 @@ fn segment_touches_box(a: Vec3, b: Vec3, h: Vec3) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::coupling::{CollisionShape, Coupling, RigidBackend, ShapeGeometry};
+    use crate::mesh::TriMesh;
+    use crate::solver::{ParticleForces, ParticleView};
+    use glam::Quat;
     use rand::{Rng, SeedableRng};
+
+    /// Bodies at fixed poses, for the mask tests.
+    struct Bodies(Vec<(CollisionShape, BodyState)>);
+
+    impl RigidBackend for Bodies {
+        fn body_count(&self) -> usize {
+            self.0.len()
+        }
+        fn collision_shapes(&self, body: usize) -> Vec<CollisionShape> {
+            vec![self.0[body].0.clone()]
+        }
+        fn body_state(&self, body: usize) -> BodyState {
+            self.0[body].1
+        }
+        fn apply_coupling_wrench(&mut self, _body: usize, _force: Vec3, _torque: Vec3) {}
+    }
+
+    /// The blocked-node mask of the particle at `x`, every node of every shape within reach
+    /// tested (what the kernel did before it skipped the shapes a stencil cannot reach).
+    fn every_node_mask(coupling: &Coupling, grid: &GridSpec, x: Vec3) -> u32 {
+        let (dx, reach) = (grid.cell_size, 2.6 * grid.cell_size);
+        let (base, _, _) = quadratic_weights((x - grid.origin) / dx);
+        let node0 = grid.origin + dx * Vec3::new(base[0] as f32, base[1] as f32, base[2] as f32);
+        let mut mask = 0;
+        for sh in &coupling.shapes {
+            let (lo, hi) = (
+                sh.world_min - Vec3::splat(reach),
+                sh.world_max + Vec3::splat(reach),
+            );
+            if x.cmplt(lo).any() || x.cmpgt(hi).any() {
+                continue;
+            }
+            let local = sh.inverse_rotation * (x - sh.world_position);
+            if sh.sdf.distance_and_normal(local).0 > reach {
+                continue;
+            }
+            let [ex, ey, ez] = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| sh.inverse_rotation * (dx * a));
+            let n0 = sh.inverse_rotation * (node0 - sh.world_position);
+            for i in 0..3 {
+                for j in 0..3 {
+                    for k in 0..3 {
+                        let node = n0 + ex * i as f32 + ey * j as f32 + ez * k as f32;
+                        let hit = match sh.sdf {
+                            Sdf::Box { half_extents } => {
+                                segment_touches_box(local, node, half_extents)
+                            }
+                            _ => sh.sdf.segment_hits(local, node),
+                        };
+                        if hit {
+                            mask |= 1 << ((i * 3 + j) * 3 + k);
+                        }
+                    }
+                }
+            }
+        }
+        mask
+    }
+
+    #[test]
+    fn skipping_unreachable_shapes_keeps_every_mask() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let geometries = [
+            ShapeGeometry::Box {
+                half_extents: Vec3::new(0.02, 0.002, 0.015),
+            },
+            ShapeGeometry::Box {
+                half_extents: Vec3::new(0.001, 0.03, 0.01),
+            },
+            ShapeGeometry::Cylinder {
+                half_height: 0.004,
+                radius: 0.025,
+            },
+            ShapeGeometry::Capsule {
+                half_height: 0.02,
+                radius: 0.004,
+            },
+            ShapeGeometry::Sphere { radius: 0.008 },
+            ShapeGeometry::TriMesh(TriMesh::cuboid(Vec3::new(0.012, 0.003, 0.02))),
+        ];
+        let bodies = geometries
+            .into_iter()
+            .map(|g| {
+                let mut r = |a: f32| rng.random_range(-a..a);
+                let state = BodyState {
+                    position: Vec3::new(r(0.03), r(0.03), r(0.03)),
+                    rotation: Quat::from_euler(glam::EulerRot::XYZ, r(3.0), r(3.0), r(3.0)),
+                    linear_velocity: Vec3::ZERO,
+                    angular_velocity: Vec3::ZERO,
+                    center_of_mass: Vec3::ZERO,
+                };
+                (CollisionShape::at_body_origin(g), state)
+            })
+            .collect();
+        let backend = Bodies(bodies);
+        let mut coupling =
+            Coupling::new(&backend, crate::CouplingParams::for_substep(1e-3)).unwrap();
+        let grid = GridSpec::new(Vec3::splat(-0.1), 0.005, [40; 3]);
+        let n = 20_000;
+        let positions: Vec<Vec3> = (0..n)
+            .map(|_| {
+                Vec3::new(
+                    rng.random_range(-0.07..0.07),
+                    rng.random_range(-0.07..0.07),
+                    rng.random_range(-0.07..0.07),
+                )
+            })
+            .collect();
+        let (velocities, masses, ids) = (
+            vec![Vec3::ZERO; n],
+            vec![1e-4; n],
+            (0..n as u32).collect::<Vec<_>>(),
+        );
+        let view = ParticleView {
+            positions: &positions,
+            velocities: &velocities,
+            masses: &masses,
+            ids: &ids,
+        };
+        let mut masks = vec![0u32; n];
+        assert!(coupling.blocked_nodes(view, &grid, &mut masks));
+        let mut blocked = 0;
+        for (x, &mask) in positions.iter().zip(&masks) {
+            assert_eq!(
+                mask,
+                every_node_mask(&coupling, &grid, *x),
+                "particle at {x:?}"
+            );
+            blocked += usize::from(mask != 0);
+        }
+        // Both kinds of particles were exercised.
+        assert!(
+            blocked > 1000 && blocked < n - 1000,
+            "{blocked} of {n} blocked"
+        );
+    }
 
     #[test]
     fn separating_axis_test_agrees_with_the_slab_test() {

@@ -195,6 +195,10 @@ pub(crate) struct CoupledShape {
     /// Cached each sync: world bounds inflated by the contact offset.
     pub(crate) world_min: Vec3,
     pub(crate) world_max: Vec3,
+    /// Bounds (m, shape frame) of the points where the distance can be negative (empty,
+    /// min above max, if nowhere).
+    pub(crate) solid_min: Vec3,
+    pub(crate) solid_max: Vec3,
 }
 
 /// Force (N) and torque about the centre of mass (N·m), world frame.
@@ -210,7 +214,7 @@ pub struct Wrench {
 /// impulses accumulated during the soft substeps of the current rigid step.
 pub struct Coupling {
     params: CouplingParams,
-    shapes: Vec<CoupledShape>,
+    pub(crate) shapes: Vec<CoupledShape>,
     bodies: Vec<BodyState>,
     /// Accumulated impulse (N·s) and angular impulse (N·m·s) per body, f64.
     impulses: Vec<[[f64; 3]; 2]>,
@@ -272,8 +276,11 @@ impl Coupling {
                         value: format!("{:?} {:?}", s.position_in_body, s.rotation_in_body),
                     });
                 }
+                let (solid_min, solid_max) = sdf.solid_bounds();
                 shapes.push(CoupledShape {
                     body,
+                    solid_min,
+                    solid_max,
                     sdf,
                     position_in_body: s.position_in_body,
                     rotation_in_body: s.rotation_in_body.normalize(),
@@ -284,6 +291,13 @@ impl Coupling {
                     world_max: Vec3::ZERO,
                 });
             }
+        }
+        if shapes.len() > usize::from(u16::MAX) {
+            return Err(MpmError::InvalidConfig {
+                field: "collision shapes",
+                value: shapes.len().to_string(),
+                expected: "at most 65535 shapes over all bodies",
+            });
         }
         let n = backend.body_count();
         let mut coupling = Self {
@@ -501,6 +515,8 @@ impl Coupling {
             no_masks.resize(n, 0);
             &mut no_masks
         });
+        let reach = Vec3::splat(kernel.reach());
+        let shapes = &self.shapes;
         let partial: Vec<(Vec<[[f64; 3]; 2]>, bool)> = forces
             .par_chunks_mut(CHUNK)
             .zip(masks.par_chunks_mut(CHUNK))
@@ -508,14 +524,33 @@ impl Coupling {
             .map(|(ci, (f_out, m_out))| {
                 let mut acc = vec![[[0.0f64; 3]; 2]; nb];
                 let mut any = false;
+                let first = ci * CHUNK;
+                let xs = &particles.positions[first..first + f_out.len()];
+                // The shapes whose widened bounds meet the chunk's: the others are out of
+                // every one of its particles' reach.
+                let (lo, hi) = xs.iter().fold(
+                    (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+                    |(lo, hi), &x| (lo.min(x), hi.max(x)),
+                );
+                let candidates: Vec<u16> = (0..shapes.len())
+                    .filter(|&s| {
+                        let sh = &shapes[s];
+                        !((sh.world_min - reach).cmpgt(hi).any()
+                            || (sh.world_max + reach).cmplt(lo).any())
+                    })
+                    .map(|s| s as u16)
+                    .collect();
+                if candidates.is_empty() {
+                    return (acc, any);
+                }
                 for (k, (f, mask)) in f_out.iter_mut().zip(m_out.iter_mut()).enumerate() {
-                    let i = ci * CHUNK + k;
+                    let i = first + k;
                     let (x, v, m) = (
                         particles.positions[i],
                         particles.velocities[i],
                         particles.masses[i],
                     );
-                    (*f, *mask) = kernel.particle(x, v, m, &mut acc);
+                    (*f, *mask) = kernel.particle(x, v, m, &candidates, &mut acc);
                     any |= *mask != 0;
                 }
                 (acc, any)
