@@ -3,7 +3,7 @@
 //! [`crate::ParticleForces::blocked_nodes`]). One signed-distance query per particle and
 //! shape serves both.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use crate::coupling::{BodyState, CoupledShape, CouplingParams};
 use crate::grid::GridSpec;
@@ -17,6 +17,9 @@ struct MaskGeometry {
     inv_dx: f32,
     /// A stencil node is at most 1.5·√3 < 2.6 cells from its particle (m).
     reach: f32,
+    /// A particle's stencil cube reaches 1.5 cells from it along each axis (m; widened by a
+    /// hair).
+    stencil_reach: f32,
     /// Per shape: the grid's x, y, z node steps (m) in the shape's local frame.
     steps: Vec<[Vec3; 3]>,
     /// Per shape: half extents (m, shape frame) of a particle's stencil cube (its 3 × 3 × 3
@@ -67,6 +70,7 @@ impl<'a> ContactKernel<'a> {
                 dx,
                 inv_dx: 1.0 / dx,
                 reach: 2.6 * dx,
+                stencil_reach: (1.5 + STENCIL_SLACK) * dx,
                 steps,
                 stencil_half,
             }
@@ -82,9 +86,9 @@ impl<'a> ContactKernel<'a> {
     }
 
     /// Extra reach (m) of a shape's world bounds within which a particle is looked at:
-    /// its stencil's (the blocked-node masks), or none.
+    /// its stencil cube's (the blocked-node masks), or none.
     pub fn reach(&self) -> f32 {
-        self.masks.as_ref().map_or(0.0, |g| g.reach)
+        self.masks.as_ref().map_or(0.0, |g| g.stencil_reach)
     }
 
     /// The contact force (N, world) on the particle at `x` (m) moving at `v` (m/s) of mass
@@ -106,8 +110,8 @@ impl<'a> ContactKernel<'a> {
         let reach = self.reach();
         let mut total = Vec3::ZERO;
         let mut mask = 0u32;
-        // World position of the stencil's first node, once a shape needs it.
-        let mut node0 = None;
+        // The stencil's first node (world).
+        let node0 = self.masks.as_ref().map(|g| g.first_node(x));
         for &s in candidates {
             let s = usize::from(s);
             let sh = &self.shapes[s];
@@ -118,10 +122,17 @@ impl<'a> ContactKernel<'a> {
             }
             // The stencil nodes in the shape's frame, if the stencil's cube can reach the
             // shape's solid: every segment from the particle to a node lies in that cube, so
-            // a shape out of its reach blocks none of them.
-            let stencil = self.masks.as_ref().and_then(|g| {
-                let n0 = *node0.get_or_insert_with(|| g.first_node(x));
-                let n0 = sh.inverse_rotation * (n0 - sh.world_position);
+            // a shape out of its reach blocks none of them. First the world bounds, then the
+            // shape's own frame.
+            let stencil = self.masks.as_ref().zip(node0).and_then(|(g, node0)| {
+                let slack = Vec3::splat(STENCIL_SLACK * g.dx);
+                let last = node0 + Vec3::splat(2.0 * g.dx);
+                if (node0 - slack).cmpgt(sh.world_max).any()
+                    || (last + slack).cmplt(sh.world_min).any()
+                {
+                    return None;
+                }
+                let n0 = sh.inverse_rotation * (node0 - sh.world_position);
                 let [ex, ey, ez] = g.steps[s];
                 let centre = n0 + ex + ey + ez;
                 let half = g.stencil_half[s];
@@ -184,20 +195,16 @@ impl<'a> ContactKernel<'a> {
         n0: Vec3,
         local: Vec3,
     ) -> u32 {
+        if let Sdf::Box { half_extents } = sh.sdf {
+            return box_mask(local, n0, g.steps[s], half_extents);
+        }
         let [ex, ey, ez] = g.steps[s];
         let mut mask = 0u32;
         for i in 0..3 {
             for j in 0..3 {
                 let nij = n0 + ex * i as f32 + ey * j as f32;
                 for k in 0..3 {
-                    let node_local = nij + ez * k as f32;
-                    let hit = match &sh.sdf {
-                        Sdf::Box { half_extents } => {
-                            segment_touches_box(local, node_local, *half_extents)
-                        }
-                        sdf => sdf.segment_hits(local, node_local),
-                    };
-                    if hit {
+                    if sh.sdf.segment_hits(local, nij + ez * k as f32) {
                         mask |= 1 << ((i * 3 + j) * 3 + k);
                     }
                 }
@@ -205,6 +212,61 @@ impl<'a> ContactKernel<'a> {
         }
         mask
     }
+}
+
+/// The stencil offsets `(i, j, k)` of the 27 nodes, node `(i·3 + j)·3 + k` in lane
+/// `n % 4` of group `n / 4` (the 28th lane repeats the last node).
+const NODE_LANES: [[[f32; 4]; 3]; 7] = {
+    let mut out = [[[0.0; 4]; 3]; 7];
+    let mut n = 0;
+    while n < 28 {
+        let node = if n < 27 { n } else { 26 };
+        out[n / 4][0][n % 4] = (node / 9) as f32;
+        out[n / 4][1][n % 4] = (node / 3 % 3) as f32;
+        out[n / 4][2][n % 4] = (node % 3) as f32;
+        n += 1;
+    }
+    out
+};
+
+/// [`segment_touches_box`] from `a` to each stencil node `n0 + i·ex + j·ey + k·ez` (all in
+/// the box's frame), four nodes at a time: bit `(i·3 + j)·3 + k` set where the segment meets
+/// the box. Each lane does the scalar test's operations in the same order, so the bits are
+/// the same.
+#[inline]
+fn box_mask(a: Vec3, n0: Vec3, [ex, ey, ez]: [Vec3; 3], h: Vec3) -> u32 {
+    let half = Vec4::splat(0.5);
+    let (ax, ay, az) = (Vec4::splat(a.x), Vec4::splat(a.y), Vec4::splat(a.z));
+    let (hx, hy, hz) = (Vec4::splat(h.x), Vec4::splat(h.y), Vec4::splat(h.z));
+    let mut mask = 0u32;
+    for (group, [i, j, k]) in NODE_LANES.iter().enumerate() {
+        let (i, j, k) = (
+            Vec4::from_array(*i),
+            Vec4::from_array(*j),
+            Vec4::from_array(*k),
+        );
+        let node = |c: usize| {
+            Vec4::splat(n0[c])
+                + Vec4::splat(ex[c]) * i
+                + Vec4::splat(ey[c]) * j
+                + Vec4::splat(ez[c]) * k
+        };
+        let (bx, by, bz) = (node(0), node(1), node(2));
+        let (mx, my, mz) = (half * (ax + bx), half * (ay + by), half * (az + bz));
+        let (dx, dy, dz) = (half * (bx - ax), half * (by - ay), half * (bz - az));
+        let (ex, ey, ez) = (dx.abs(), dy.abs(), dz.abs());
+        let apart = mx.abs().cmpgt(hx + ex) | my.abs().cmpgt(hy + ey) | mz.abs().cmpgt(hz + ez);
+        // |mid × half| against the box's radius on each axis e_k × d.
+        let (cx, cy, cz) = (
+            (my * dz - dy * mz).abs(),
+            (mz * dx - dz * mx).abs(),
+            (mx * dy - dx * my).abs(),
+        );
+        let separated =
+            cx.cmpgt(hy * ez + hz * ey) | cy.cmpgt(hx * ez + hz * ex) | cz.cmpgt(hx * ey + hy * ex);
+        mask |= (!(apart | separated)).bitmask() << (4 * group);
+    }
+    mask & ((1 << 27) - 1)
 }
 
 impl MaskGeometry {
@@ -217,9 +279,9 @@ impl MaskGeometry {
 }
 
 /// Whether the segment `a → b` meets the closed box `[-h, h]` (all in the box's frame), by
-/// separating axes: the box's three face normals and the three cross products of the
+/// separating axes (the scalar reference of [`box_mask`]): the box's three face normals and the three cross products of the
 /// segment's direction with them. No division, unlike a slab test.
-#[inline(always)]
+#[cfg(test)]
 fn segment_touches_box(a: Vec3, b: Vec3, h: Vec3) -> bool {
     let mid = 0.5 * (a + b);
     let half = 0.5 * (b - a);
