@@ -1,9 +1,9 @@
 //! Cost of a soft-body env step, and a fingerprint of where the steps lead: seed `seed`'s
 //! scripted episode of `<env_id>`, `steps` env steps after the reset, in obs mode `obs_mode`.
-//! Prints the reset's time, the steps' mean wall time (ms per env step, env steps/s) and a hash
-//! of the final `get_state` and observation bits, so two builds can be checked to simulate
-//! bit-identically (same hash) and compared for speed (`perf stat -e task-clock` on a loaded
-//! machine).
+//! Prints the reset's time, the steps' mean wall time (ms per env step, env steps/s), a hash
+//! of the final `get_state` and observation bits (`hash`) and one of every step's reward and
+//! info (`outcome`), so two builds can be checked to simulate bit-identically (same hashes)
+//! and compared for speed (`perf stat -e task-clock` on a loaded machine).
 //!
 //! ```text
 //! RAYON_NUM_THREADS=1 cargo run --release -p ms2-tasks --example soft_step_cost -- \
@@ -51,9 +51,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t1 = Instant::now();
     let mut last_obs = None;
     let mut taken = 0u32;
+    let mut outcome = 0xcbf2_9ce4_8422_2325u64;
     for _ in 0..steps {
         let out = env.step(&policy.act(&env))?;
         taken += 1;
+        let bits = out.reward.to_bits();
+        outcome = fold(fold(outcome, bits as u32), (bits >> 32) as u32);
+        outcome = format!("{:?}", out.info)
+            .bytes()
+            .fold(outcome, |h, b| fold(h, u32::from(b)));
         last_obs = Some(out.obs);
         if out.terminated || out.truncated {
             break;
@@ -69,7 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     println!(
         "{env_id} {obs_mode} seed {seed}: reset {reset_s:.2} s, {taken} steps, {:.1} ms/step, \
-         {:.2} env steps/s, hash {hash:016x}",
+         {:.2} env steps/s, hash {hash:016x}, outcome {outcome:016x}",
         1e3 * step_s / f64::from(taken.max(1)),
         f64::from(taken) / step_s
     );
