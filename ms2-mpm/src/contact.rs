@@ -110,8 +110,8 @@ impl<'a> ContactKernel<'a> {
         let reach = self.reach();
         let mut total = Vec3::ZERO;
         let mut mask = 0u32;
-        // The stencil's first node (world).
-        let node0 = self.masks.as_ref().map(|g| g.first_node(x));
+        // The stencil's first node (world), once a shape is near.
+        let mut node0 = None;
         for &s in candidates {
             let s = usize::from(s);
             let sh = &self.shapes[s];
@@ -124,7 +124,8 @@ impl<'a> ContactKernel<'a> {
             // shape's solid: every segment from the particle to a node lies in that cube, so
             // a shape out of its reach blocks none of them. First the world bounds, then the
             // shape's own frame.
-            let stencil = self.masks.as_ref().zip(node0).and_then(|(g, node0)| {
+            let stencil = self.masks.as_ref().and_then(|g| {
+                let node0 = *node0.get_or_insert_with(|| g.first_node(x));
                 let slack = Vec3::splat(STENCIL_SLACK * g.dx);
                 let last = node0 + Vec3::splat(2.0 * g.dx);
                 if (node0 - slack).cmpgt(sh.world_max).any()
