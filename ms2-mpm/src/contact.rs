@@ -9,6 +9,7 @@ use crate::coupling::{BodyState, CoupledShape, CouplingParams};
 use crate::grid::GridSpec;
 use crate::math::quadratic_weights;
 use crate::sdf::Sdf;
+use crate::solver::ParticleView;
 
 /// What the blocked-node test needs of the grid, and each shape's grid steps in its frame.
 struct MaskGeometry {
@@ -83,6 +84,48 @@ impl<'a> ContactKernel<'a> {
             with_forces,
             masks,
         }
+    }
+
+    /// [`Self::particle`] for the particles `first .. first + forces.len()` of `particles`
+    /// (forces and masks into `forces` and `masks`), against the shapes whose bounds, widened
+    /// by [`Self::reach`], meet the chunk's (the others are out of every one of its particles'
+    /// reach). Returns the impulses per body and whether any mask bit was set.
+    pub fn chunk(
+        &self,
+        particles: ParticleView<'_>,
+        first: usize,
+        forces: &mut [Vec3],
+        masks: &mut [u32],
+    ) -> (Vec<[[f64; 3]; 2]>, bool) {
+        let mut acc = vec![[[0.0f64; 3]; 2]; self.bodies.len()];
+        let mut any = false;
+        let xs = &particles.positions[first..first + forces.len()];
+        let (lo, hi) = xs.iter().fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), &x| (lo.min(x), hi.max(x)),
+        );
+        let reach = Vec3::splat(self.reach());
+        let candidates: Vec<u16> = (0..self.shapes.len())
+            .filter(|&s| {
+                let sh = &self.shapes[s];
+                !((sh.world_min - reach).cmpgt(hi).any() || (sh.world_max + reach).cmplt(lo).any())
+            })
+            .map(|s| s as u16)
+            .collect();
+        if candidates.is_empty() {
+            return (acc, any);
+        }
+        for (k, (f, mask)) in forces.iter_mut().zip(masks.iter_mut()).enumerate() {
+            let i = first + k;
+            let (x, v, m) = (
+                particles.positions[i],
+                particles.velocities[i],
+                particles.masses[i],
+            );
+            (*f, *mask) = self.particle(x, v, m, &candidates, &mut acc);
+            any |= *mask != 0;
+        }
+        (acc, any)
     }
 
     /// Extra reach (m) of a shape's world bounds within which a particle is looked at:
@@ -306,7 +349,7 @@ mod tests {
     use super::*;
     use crate::coupling::{CollisionShape, Coupling, RigidBackend, ShapeGeometry};
     use crate::mesh::TriMesh;
-    use crate::solver::{ParticleForces, ParticleView};
+    use crate::solver::ParticleForces;
     use glam::Quat;
     use rand::{Rng, SeedableRng};
 

@@ -495,7 +495,6 @@ impl Coupling {
             return false;
         }
         let n = particles.positions.len();
-        let nb = self.bodies.len();
         let kernel = ContactKernel::new(
             &self.shapes,
             &self.bodies,
@@ -515,46 +514,11 @@ impl Coupling {
             no_masks.resize(n, 0);
             &mut no_masks
         });
-        let reach = Vec3::splat(kernel.reach());
-        let shapes = &self.shapes;
         let partial: Vec<(Vec<[[f64; 3]; 2]>, bool)> = forces
             .par_chunks_mut(CHUNK)
             .zip(masks.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(ci, (f_out, m_out))| {
-                let mut acc = vec![[[0.0f64; 3]; 2]; nb];
-                let mut any = false;
-                let first = ci * CHUNK;
-                let xs = &particles.positions[first..first + f_out.len()];
-                // The shapes whose widened bounds meet the chunk's: the others are out of
-                // every one of its particles' reach.
-                let (lo, hi) = xs.iter().fold(
-                    (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-                    |(lo, hi), &x| (lo.min(x), hi.max(x)),
-                );
-                let candidates: Vec<u16> = (0..shapes.len())
-                    .filter(|&s| {
-                        let sh = &shapes[s];
-                        !((sh.world_min - reach).cmpgt(hi).any()
-                            || (sh.world_max + reach).cmplt(lo).any())
-                    })
-                    .map(|s| s as u16)
-                    .collect();
-                if candidates.is_empty() {
-                    return (acc, any);
-                }
-                for (k, (f, mask)) in f_out.iter_mut().zip(m_out.iter_mut()).enumerate() {
-                    let i = first + k;
-                    let (x, v, m) = (
-                        particles.positions[i],
-                        particles.velocities[i],
-                        particles.masses[i],
-                    );
-                    (*f, *mask) = kernel.particle(x, v, m, &candidates, &mut acc);
-                    any |= *mask != 0;
-                }
-                (acc, any)
-            })
+            .map(|(ci, (f_out, m_out))| kernel.chunk(particles, ci * CHUNK, f_out, m_out))
             .collect();
         let mut any = false;
         for (chunk, chunk_any) in partial {
