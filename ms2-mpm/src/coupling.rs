@@ -195,6 +195,10 @@ pub(crate) struct CoupledShape {
     /// Cached each sync: world bounds inflated by the contact offset.
     pub(crate) world_min: Vec3,
     pub(crate) world_max: Vec3,
+    /// Bounds (m, shape frame) of the points where the distance can be negative (empty,
+    /// min above max, if nowhere).
+    pub(crate) solid_min: Vec3,
+    pub(crate) solid_max: Vec3,
 }
 
 /// Force (N) and torque about the centre of mass (N·m), world frame.
@@ -210,7 +214,7 @@ pub struct Wrench {
 /// impulses accumulated during the soft substeps of the current rigid step.
 pub struct Coupling {
     params: CouplingParams,
-    shapes: Vec<CoupledShape>,
+    pub(crate) shapes: Vec<CoupledShape>,
     bodies: Vec<BodyState>,
     /// Accumulated impulse (N·s) and angular impulse (N·m·s) per body, f64.
     impulses: Vec<[[f64; 3]; 2]>,
@@ -272,8 +276,11 @@ impl Coupling {
                         value: format!("{:?} {:?}", s.position_in_body, s.rotation_in_body),
                     });
                 }
+                let (solid_min, solid_max) = sdf.solid_bounds();
                 shapes.push(CoupledShape {
                     body,
+                    solid_min,
+                    solid_max,
                     sdf,
                     position_in_body: s.position_in_body,
                     rotation_in_body: s.rotation_in_body.normalize(),
@@ -284,6 +291,13 @@ impl Coupling {
                     world_max: Vec3::ZERO,
                 });
             }
+        }
+        if shapes.len() > usize::from(u16::MAX) {
+            return Err(MpmError::InvalidConfig {
+                field: "collision shapes",
+                value: shapes.len().to_string(),
+                expected: "at most 65535 shapes over all bodies",
+            });
         }
         let n = backend.body_count();
         let mut coupling = Self {
@@ -481,7 +495,6 @@ impl Coupling {
             return false;
         }
         let n = particles.positions.len();
-        let nb = self.bodies.len();
         let kernel = ContactKernel::new(
             &self.shapes,
             &self.bodies,
@@ -505,21 +518,7 @@ impl Coupling {
             .par_chunks_mut(CHUNK)
             .zip(masks.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(ci, (f_out, m_out))| {
-                let mut acc = vec![[[0.0f64; 3]; 2]; nb];
-                let mut any = false;
-                for (k, (f, mask)) in f_out.iter_mut().zip(m_out.iter_mut()).enumerate() {
-                    let i = ci * CHUNK + k;
-                    let (x, v, m) = (
-                        particles.positions[i],
-                        particles.velocities[i],
-                        particles.masses[i],
-                    );
-                    (*f, *mask) = kernel.particle(x, v, m, &mut acc);
-                    any |= *mask != 0;
-                }
-                (acc, any)
-            })
+            .map(|(ci, (f_out, m_out))| kernel.chunk(particles, ci * CHUNK, f_out, m_out))
             .collect();
         let mut any = false;
         for (chunk, chunk_any) in partial {

@@ -83,6 +83,19 @@ impl Sdf {
         }
     }
 
+    /// Local axis-aligned bounds `(min, max)` (m) of the points where
+    /// [`Self::distance_and_normal`] can be negative: [`Self::local_bounds`] for the analytic
+    /// shapes; for a sampled volume, the lattice cells next to a sample below a quarter cell
+    /// (a cell whose corners are all above that interpolates to a positive distance), an
+    /// empty box (min above max) if there are none, and everywhere if one is on the
+    /// lattice's edge.
+    pub(crate) fn solid_bounds(&self) -> (Vec3, Vec3) {
+        match self {
+            Sdf::Volume(vol) => vol.solid_bounds(),
+            _ => self.local_bounds(),
+        }
+    }
+
     /// Local axis-aligned bounds `(min, max)` (m) of the region where the distance is ≤ 0.
     pub fn local_bounds(&self) -> (Vec3, Vec3) {
         let h = match self {
@@ -206,6 +219,42 @@ impl SdfVolume {
                 (self.dims[1] - 1) as f32,
                 (self.dims[2] - 1) as f32,
             ) * self.cell_size
+    }
+
+    /// See [`Sdf::solid_bounds`].
+    fn solid_bounds(&self) -> (Vec3, Vec3) {
+        let threshold = 0.25 * self.cell_size;
+        let (mut lo, mut hi) = ([usize::MAX; 3], [0usize; 3]);
+        for (i, &d) in self.values.iter().enumerate() {
+            if d >= threshold {
+                continue;
+            }
+            let s = [
+                i / (self.dims[1] * self.dims[2]),
+                (i / self.dims[2]) % self.dims[1],
+                i % self.dims[2],
+            ];
+            if (0..3).any(|a| s[a] == 0 || s[a] + 1 == self.dims[a]) {
+                // Solid at the lattice's edge: beyond it the distance extrapolates from there.
+                return (Vec3::splat(f32::MIN), Vec3::splat(f32::MAX));
+            }
+            for a in 0..3 {
+                lo[a] = lo[a].min(s[a].saturating_sub(1));
+                hi[a] = hi[a].max((s[a] + 1).min(self.dims[a] - 1));
+            }
+        }
+        if lo[0] == usize::MAX {
+            return (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
+        }
+        let at = |s: [usize; 3]| {
+            self.origin + Vec3::new(s[0] as f32, s[1] as f32, s[2] as f32) * self.cell_size
+        };
+        // Widened by a cell: the lattice's own round-off, and `distance_and_normal`'s cell
+        // index, which clamps at the lattice's last cell.
+        (
+            at(lo) - Vec3::splat(self.cell_size),
+            at(hi) + Vec3::splat(self.cell_size),
+        )
     }
 
     #[inline]
