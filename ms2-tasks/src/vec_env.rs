@@ -1,8 +1,6 @@
 //! [`VecEnv`]: several envs stepped in parallel on rayon's thread pool, their cameras rendered
 //! in one batch.
 
-use std::sync::{Mutex, PoisonError};
-
 use rayon::prelude::*;
 
 use crate::config::EnvConfig;
@@ -214,68 +212,32 @@ type Simulated = Option<(StepOutput, Vec<ms2_render::Camera>)>;
 
 /// Runs the commands' physics in parallel, then `prepare` on each env that ran a command (in
 /// visual modes: pose its render scene and cameras); `None` for [`EnvCommand::Keep`].
-///
-/// The calling thread takes part: it and up to `threads - 1` jobs on rayon's pool each take the
-/// next env not yet taken until none is left. The caller (Python's thread, between two vector
-/// steps) starts on an env at once instead of waking a worker and sleeping until the batch is
-/// done, and a faster env's thread takes the next env (with more envs than threads). Every env
-/// runs its own command alone, so the outputs do not depend on which thread ran which env.
 fn simulate<C: Send>(
     envs: &mut [Env],
     commands: &[EnvCommand<'_>],
     prepare: impl Fn(&mut Env) -> Result<C, EnvError> + Sync,
 ) -> Result<Vec<Option<(StepOutput, C)>>, EnvError> {
-    type Outcome<C> = Result<Option<(StepOutput, C)>, EnvError>;
-    let n = envs.len();
-    let queue = Mutex::new(envs.iter_mut().zip(commands).enumerate());
-    let outcomes: Vec<Mutex<Option<Outcome<C>>>> = (0..n).map(|_| Mutex::new(None)).collect();
-    let work = || loop {
-        let next = queue.lock().unwrap_or_else(PoisonError::into_inner).next();
-        let Some((i, (env, command))) = next else {
-            break;
-        };
-        let outcome = run_command(env, *command, &prepare);
-        *outcomes[i].lock().unwrap_or_else(PoisonError::into_inner) = Some(outcome);
-    };
-    let helpers = rayon::current_num_threads().min(n).saturating_sub(1);
-    rayon::in_place_scope(|scope| {
-        for _ in 0..helpers {
-            scope.spawn(|_| work());
-        }
-        work();
-    });
-    outcomes
-        .into_iter()
-        .map(|slot| {
-            slot.into_inner()
-                .unwrap_or_else(PoisonError::into_inner)
-                .unwrap_or_else(|| Err(EnvError::InvalidConfig("an env was not run".to_owned())))
+    envs.par_iter_mut()
+        .zip(commands.par_iter())
+        .map(|(env, command)| {
+            let out = match *command {
+                EnvCommand::Keep => return Ok(None),
+                EnvCommand::Step(action) => env.step_deferred(action)?,
+                EnvCommand::Reset { seed } => {
+                    let (obs, info) = env.reset_deferred(seed)?;
+                    StepOutput {
+                        obs,
+                        reward: 0.0,
+                        terminated: false,
+                        truncated: false,
+                        info,
+                    }
+                }
+            };
+            let prepared = prepare(env)?;
+            Ok(Some((out, prepared)))
         })
         .collect()
-}
-
-/// One env's command, then `prepare` (see [`simulate`]).
-fn run_command<C>(
-    env: &mut Env,
-    command: EnvCommand<'_>,
-    prepare: &impl Fn(&mut Env) -> Result<C, EnvError>,
-) -> Result<Option<(StepOutput, C)>, EnvError> {
-    let out = match command {
-        EnvCommand::Keep => return Ok(None),
-        EnvCommand::Step(action) => env.step_deferred(action)?,
-        EnvCommand::Reset { seed } => {
-            let (obs, info) = env.reset_deferred(seed)?;
-            StepOutput {
-                obs,
-                reward: 0.0,
-                terminated: false,
-                truncated: false,
-                info,
-            }
-        }
-    };
-    let prepared = prepare(env)?;
-    Ok(Some((out, prepared)))
 }
 
 /// Submits every camera of the simulated envs in one batch.
