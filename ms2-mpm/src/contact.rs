@@ -24,6 +24,9 @@ struct MaskGeometry {
 /// The contact model evaluated at one particle at a time (see [`crate::coupling`]).
 pub(crate) struct ContactKernel<'a> {
     shapes: &'a [CoupledShape],
+    /// Per body: whether it is sticky now ([`crate::Coupling::set_sticky_nodes`]); a sticky
+    /// body blocks no stencil node (its nodes take its velocity instead).
+    sticky: &'a [bool],
     bodies: &'a [BodyState],
     params: &'a CouplingParams,
     dt: f32,
@@ -33,9 +36,10 @@ pub(crate) struct ContactKernel<'a> {
 
 impl<'a> ContactKernel<'a> {
     /// A kernel for the current shape poses; forces only if `with_forces`, blocked-node
-    /// masks only if `grid` is given.
+    /// masks (of the bodies not `sticky`) only if `grid` is given.
     pub fn new(
         shapes: &'a [CoupledShape],
+        sticky: &'a [bool],
         bodies: &'a [BodyState],
         params: &'a CouplingParams,
         dt: f32,
@@ -57,6 +61,7 @@ impl<'a> ContactKernel<'a> {
         });
         Self {
             shapes,
+            sticky,
             bodies,
             params,
             dt,
@@ -85,8 +90,11 @@ impl<'a> ContactKernel<'a> {
             let (d, n_local) = sh.sdf.distance_and_normal(local);
             if let Some(g) = &self.masks {
                 // No segment to a stencil node (at most `reach` long) can touch a solid
-                // farther away than that.
-                if d <= g.reach {
+                // farther away than that. A sticky body's nodes, inside it too, take its
+                // velocity (ManiSkill2's grid contact): the particles deposit on them and
+                // move with it, where a blocked node would stand in with the particle's own
+                // free update and let it slide off.
+                if d <= g.reach && !self.sticky[sh.body] {
                     mask |= self.blocked_by_shape(g, s, sh, x, local);
                 }
             }

@@ -70,6 +70,10 @@ pub const START_FINGER_QPOS: f32 = 0.004;
 /// Distance (m) from a finger's surface within which the rope's grid nodes move with the
 /// finger: one cell of the rope's grid.
 const FINGER_STICKY_REACH: f32 = 0.005;
+/// Distance (m) from the rod's surface within which the rope's grid nodes stay still, as
+/// ManiSkill2's sticky grid contact on every coupled body holds its noodle on the rod (with
+/// the penalty contact's friction the rope slid off the rod towards its heavier side).
+pub const ROD_STICKY_REACH: f32 = 0.005;
 /// Distance (m) between the finger links above which the fingers let go of the rope: the
 /// start's 8 mm opened by 2 mm per finger.
 const FINGER_RELEASE_DISTANCE: f32 = 0.012;
@@ -331,6 +335,8 @@ impl Task for Hang {
         // let sink into them.
         let params = ms2_mpm::CouplingParams::for_substep(dt);
         self.arm.couple_bodies(solver, world, others, params)?;
+        // Coupled bodies 0 and 1 are the fingers, 2 the rod.
+        self.arm.make_sticky(2, ROD_STICKY_REACH)?;
         // The fingers hold the rope by sticky grid contact while closed, as ManiSkill2's grid
         // contact does: the penalty contact acts on the few particles on the pads, which
         // cannot carry the rope's weight (it tore at the fingertips when the lift began).
