@@ -7,7 +7,9 @@
 //! floats at a seeded pose in front of it ([`RodPose::from_unit`]). The rope is coupled
 //! two-way to both fingers and the rod (the coupled solver shared with the bucket tasks,
 //! [`BucketArm`], with no bucket on the hand; ManiSkill2 couples every link, ms2 the ones the
-//! rope can reach and the coupling can read: the real Panda's hand is a convex hull).
+//! rope can reach and the coupling can read: the real Panda's hand is a convex hull). As in
+//! ManiSkill2, the rope sticks to the rod ([`ROD_STICKY_REACH`]) and to the fingers while
+//! they are closed.
 //!
 //! - Rates: MPM at 4 kHz by default ([`HANG_MPM_FREQ_HZ`]), physics 500 Hz, control 20 Hz.
 //! - Episode (seeded): the rod's distance, direction and height; where along the rope the
