@@ -36,6 +36,9 @@ const STENCIL_SLACK: f32 = 1e-3;
 /// The contact model evaluated at one particle at a time (see [`crate::coupling`]).
 pub(crate) struct ContactKernel<'a> {
     shapes: &'a [CoupledShape],
+    /// Per body: whether it is sticky now ([`crate::Coupling::set_sticky_nodes`]); a sticky
+    /// body blocks no stencil node (its nodes take its velocity instead).
+    sticky: &'a [bool],
     bodies: &'a [BodyState],
     params: &'a CouplingParams,
     dt: f32,
@@ -45,9 +48,10 @@ pub(crate) struct ContactKernel<'a> {
 
 impl<'a> ContactKernel<'a> {
     /// A kernel for the current shape poses; forces only if `with_forces`, blocked-node
-    /// masks only if `grid` is given.
+    /// masks (of the bodies not `sticky`) only if `grid` is given.
     pub fn new(
         shapes: &'a [CoupledShape],
+        sticky: &'a [bool],
         bodies: &'a [BodyState],
         params: &'a CouplingParams,
         dt: f32,
@@ -78,6 +82,7 @@ impl<'a> ContactKernel<'a> {
         });
         Self {
             shapes,
+            sticky,
             bodies,
             params,
             dt,
@@ -193,8 +198,11 @@ impl<'a> ContactKernel<'a> {
             let (d, n_local) = sh.sdf.distance_and_normal(local);
             if let Some((g, n0)) = stencil {
                 // No segment to a stencil node (at most `reach` long) can touch a solid
-                // farther away than that.
-                if d <= g.reach {
+                // farther away than that. A sticky body's nodes, inside it too, take its
+                // velocity (ManiSkill2's grid contact): the particles deposit on them and
+                // move with it, where a blocked node would stand in with the particle's own
+                // free update and let it slide off.
+                if d <= g.reach && !self.sticky[sh.body] {
                     mask |= Self::blocked_by_shape(g, s, sh, n0, local);
                 }
             }

@@ -318,10 +318,13 @@ impl Coupling {
     /// are inside) to one of the body's shapes takes the body's velocity at the node after
     /// each grid update, and the body receives the momentum the nodes lose; except where the
     /// surface moves away from the node faster than [`STICKY_RELEASE_SPEED`] (an opening
-    /// gripper releases; a surface cannot pull material by adhesion). A reach of about one
-    /// grid cell makes sure some node lies within it wherever the surface is (nodes inside a
-    /// body receive no mass through it); the pads must then open by more than that to let go. The penalty
-    /// contact still acts on the particles. A gripper's pads made sticky hold a pinched rope
+    /// gripper releases; a surface cannot pull material by adhesion). While sticky, the body
+    /// blocks no stencil node ([`ParticleForces::blocked_nodes`]): the particles near it
+    /// deposit mass on the nodes inside it too, which move with it, as in ManiSkill2's grid
+    /// contact (a blocked node stands in with the particle's own free update, and a rope
+    /// resting on a sticky rod slid off it). A reach of about one grid cell makes sure some
+    /// node lies within it wherever the surface is; the pads must then open by more than
+    /// that to let go. The penalty contact still acts on the particles. A gripper's pads made sticky hold a pinched rope
     /// whose weight the penalty contact alone, acting on the few particles on the pads,
     /// cannot carry. `None` turns it off. An error names a body index out of range or a
     /// reach that is not finite and positive.
@@ -495,8 +498,10 @@ impl Coupling {
             return false;
         }
         let n = particles.positions.len();
+        let sticky: Vec<bool> = self.sticky_reach.iter().map(Option::is_some).collect();
         let kernel = ContactKernel::new(
             &self.shapes,
+            &sticky,
             &self.bodies,
             &self.params,
             dt,

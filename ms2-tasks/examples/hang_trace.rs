@@ -2,7 +2,7 @@
 //! extent, the tracked particles and the success terms.
 //!
 //! ```text
-//! cargo run --release -p ms2-tasks --example hang_trace -- [seed=0] [every=10] [steps=350]
+//! cargo run --release -p ms2-tasks --example hang_trace -- [seed=0] [every=10] [steps=350] [every step from]
 //! ```
 
 use std::time::Instant;
@@ -18,6 +18,8 @@ fn main() -> Result<(), EnvError> {
     let seed = args.first().copied().unwrap_or(0);
     let every = args.get(1).copied().unwrap_or(10).max(1) as u32;
     let steps = args.get(2).copied().unwrap_or(350) as u32;
+    // Print every step from this one on.
+    let dense_from = args.get(3).copied().unwrap_or(u64::MAX) as u32;
     let mut env = make_env(&EnvConfig {
         obs_mode: "state".to_owned(),
         mpm_freq: std::env::var("MPM").ok().and_then(|v| v.parse().ok()),
@@ -28,7 +30,7 @@ fn main() -> Result<(), EnvError> {
     policy.reset(&env);
     let start = Instant::now();
     for step in 0..=steps {
-        if step % every == 0 || step == steps {
+        if step % every == 0 || step == steps || step >= dense_from {
             let (scene, task) = (env.task_scene().unwrap(), env.task().unwrap());
             let hang = task.downcast_ref::<Hang>().unwrap();
             let tcp = scene
@@ -56,8 +58,12 @@ fn main() -> Result<(), EnvError> {
                     .map(|p| soft.distance_to_body(b, *p).unwrap_or(9.0))
                     .fold(f32::MAX, f32::min)
             };
+            let on_rod = x
+                .iter()
+                .filter(|p| soft.distance_to_body(2, **p).unwrap_or(9.0) < 0.005)
+                .count();
             print!(
-                "near {near} d0 {:.4} d1 {:.4} d2 {:.4} ",
+                "near {near} d0 {:.4} d1 {:.4} d2 {:.4} on rod {on_rod} ",
                 dmin(0),
                 dmin(1),
                 dmin(2)

@@ -3,7 +3,7 @@
 use glam::Vec3;
 use ms2_mpm::bent_bar::{BentBar, CurvePiece};
 use ms2_physics::{ActorDesc, ActorKind, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig};
-use ms2_tasks::families::soft::hang::{Hang, ROD_HALF};
+use ms2_tasks::families::soft::hang::{Hang, ROD_HALF, ROD_STICKY_REACH};
 use ms2_tasks::families::soft::hang_scene::{
     hang_terms, rope_solver, HangTerms, RodPose, RopeStart, HANG_MPM_FREQ_HZ, ROPE_HALF_WIDTH,
     ROPE_LENGTH,
@@ -13,9 +13,19 @@ use ms2_tasks::{make_env, EnvConfig};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 
 /// Simulates `bar` (the rope, at rest) next to a kinematic rod at `rod` for `seconds` with
-/// the task's solver (grid, material, 2 kHz, contact constants of that substep), the fingers
+/// the task's solver (grid, material, rate, contact constants of that substep), the fingers
 /// open; returns the success terms at the end.
 fn simulate_rope(bar: BentBar, rod: RodPose, seconds: f32) -> HangTerms {
+    simulate_rope_on(bar, rod, seconds, Some(ROD_STICKY_REACH))
+}
+
+/// As [`simulate_rope`], the rod's grid contact sticky within `sticky_reach` (m) or not.
+fn simulate_rope_on(
+    bar: BentBar,
+    rod: RodPose,
+    seconds: f32,
+    sticky_reach: Option<f32>,
+) -> HangTerms {
     let mut world = World::new(WorldConfig::default()).unwrap();
     let p = rod.position;
     let rod_body = world
@@ -40,6 +50,7 @@ fn simulate_rope(bar: BentBar, rod: RodPose, seconds: f32) -> HangTerms {
     let tracked_ids = start.add_to(&mut solver, rope, 7).unwrap();
     let params = ms2_mpm::CouplingParams::for_substep(dt);
     let mut soft = SoftWorld::with_params(solver, &world, vec![rod_body], params).unwrap();
+    soft.set_sticky(0, sticky_reach).unwrap();
     let steps = (seconds / world.timestep()).round() as usize;
     for _ in 0..steps {
         soft.step(&mut world).unwrap();
@@ -55,6 +66,11 @@ fn simulate_rope(bar: BentBar, rod: RodPose, seconds: f32) -> HangTerms {
 /// A rope draped over `rod`: straight up on the robot's side, half a turn over the rod,
 /// straight down on the far side, in the vertical plane of the rod's normal.
 fn draped(rod: RodPose) -> BentBar {
+    draped_off_centre(rod, 0.0)
+}
+
+/// As [`draped`], the far leg `shift` (m) longer and the near one as much shorter.
+fn draped_off_centre(rod: RodPose, shift: f32) -> BentBar {
     // An arch wider than the rod (the rope is too stiff to wrap a 2 cm rod), its top on it.
     let radius = 0.05;
     let arc = std::f32::consts::PI * radius;
@@ -62,16 +78,20 @@ fn draped(rod: RodPose) -> BentBar {
     let n = rod.normal();
     let arch_centre = rod.position - Vec3::Z * (radius - ROD_HALF[2] - ROPE_HALF_WIDTH - 0.002);
     BentBar {
-        start: arch_centre - n * radius - Vec3::Z * leg,
+        start: arch_centre - n * radius - Vec3::Z * (leg - shift),
         along: n,
         heading: std::f32::consts::FRAC_PI_2,
         pieces: vec![
-            CurvePiece::Straight { length: leg },
+            CurvePiece::Straight {
+                length: leg - shift,
+            },
             CurvePiece::Arc {
                 radius,
                 angle: -std::f32::consts::PI,
             },
-            CurvePiece::Straight { length: leg },
+            CurvePiece::Straight {
+                length: leg + shift,
+            },
         ],
         half_width: ROPE_HALF_WIDTH,
         width_scale: None,
@@ -81,11 +101,31 @@ fn draped(rod: RodPose) -> BentBar {
 #[test]
 fn a_rope_draped_over_a_high_rod_hangs_there_at_rest_and_succeeds() {
     let rod = RodPose::from_unit(0.5, 0.3, 0.9);
-    let t = simulate_rope(draped(rod), rod, 2.0);
+    let t = simulate_rope(draped(rod), rod, 3.0);
     assert!(t.sides && t.over_rod && t.ends_down, "{t:?}");
     assert!(t.off_ground, "{t:?}");
     assert!(t.rest_fraction > 0.99, "{t:?}");
     assert!(t.success, "{t:?}");
+}
+
+#[test]
+fn a_rope_hung_off_centre_stays_on_the_sticky_rod_and_slides_off_a_slippery_one() {
+    // The far leg 8 cm longer than the near one (the rod 40 % along the rope, where the
+    // scripted hand lays it). With the penalty contact's friction alone the rope slid off
+    // towards its heavier side; the rod's sticky grid contact (ManiSkill2's) holds it.
+    let rod = RodPose::from_unit(0.5, 0.3, 0.9);
+    let held = simulate_rope_on(
+        draped_off_centre(rod, 0.04),
+        rod,
+        1.5,
+        Some(ROD_STICKY_REACH),
+    );
+    assert!(
+        held.sides && held.over_rod && held.ends_down && held.off_ground,
+        "{held:?}"
+    );
+    let slid = simulate_rope_on(draped_off_centre(rod, 0.04), rod, 1.5, None);
+    assert!(!(slid.over_rod && slid.off_ground), "{slid:?}");
 }
 
 #[test]

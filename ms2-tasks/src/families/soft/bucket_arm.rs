@@ -234,6 +234,16 @@ impl BucketArm {
         Ok(())
     }
 
+    /// Makes the material stick to coupled body `coupled` (its grid nodes within `reach_m` (m)
+    /// of the surface move with it) for the rest of the episode; an error before the
+    /// coupling exists or for a bad index or reach.
+    pub fn make_sticky(&mut self, coupled: usize, reach_m: f32) -> Result<(), EnvError> {
+        let soft = self.soft.as_mut().ok_or_else(|| {
+            EnvError::InvalidConfig("make_sticky: no soft world coupled yet".to_owned())
+        })?;
+        Ok(soft.set_sticky(coupled, Some(reach_m))?)
+    }
+
     /// The coupled soft world, once an episode started.
     pub fn soft(&self) -> Option<&SoftWorld> {
         self.soft.as_ref()

@@ -7,7 +7,9 @@
 //! floats at a seeded pose in front of it ([`RodPose::from_unit`]). The rope is coupled
 //! two-way to both fingers and the rod (the coupled solver shared with the bucket tasks,
 //! [`BucketArm`], with no bucket on the hand; ManiSkill2 couples every link, ms2 the ones the
-//! rope can reach and the coupling can read: the real Panda's hand is a convex hull).
+//! rope can reach and the coupling can read: the real Panda's hand is a convex hull). As in
+//! ManiSkill2, the rope sticks to the rod ([`ROD_STICKY_REACH`]) and to the fingers while
+//! they are closed.
 //!
 //! - Rates: MPM at 4 kHz by default ([`HANG_MPM_FREQ_HZ`]), physics 500 Hz, control 20 Hz.
 //! - Episode (seeded): the rod's distance, direction and height; where along the rope the
@@ -70,6 +72,10 @@ pub const START_FINGER_QPOS: f32 = 0.004;
 /// Distance (m) from a finger's surface within which the rope's grid nodes move with the
 /// finger: one cell of the rope's grid.
 const FINGER_STICKY_REACH: f32 = 0.005;
+/// Distance (m) from the rod's surface within which the rope's grid nodes stay still, as
+/// ManiSkill2's sticky grid contact on every coupled body holds its noodle on the rod (with
+/// the penalty contact's friction the rope slid off the rod towards its heavier side).
+pub const ROD_STICKY_REACH: f32 = 0.005;
 /// Distance (m) between the finger links above which the fingers let go of the rope: the
 /// start's 8 mm opened by 2 mm per finger.
 const FINGER_RELEASE_DISTANCE: f32 = 0.012;
@@ -331,6 +337,8 @@ impl Task for Hang {
         // let sink into them.
         let params = ms2_mpm::CouplingParams::for_substep(dt);
         self.arm.couple_bodies(solver, world, others, params)?;
+        // Coupled bodies 0 and 1 are the fingers, 2 the rod.
+        self.arm.make_sticky(2, ROD_STICKY_REACH)?;
         // The fingers hold the rope by sticky grid contact while closed, as ManiSkill2's grid
         // contact does: the penalty contact acts on the few particles on the pads, which
         // cannot carry the rope's weight (it tore at the fingertips when the lift began).

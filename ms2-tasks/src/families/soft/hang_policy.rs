@@ -2,9 +2,9 @@
 //!
 //! Holding the rope, the hand turns the rope's direction onto the rod's normal, rises above
 //! the rod on the robot's side (high enough for the short end to pass over it, low enough for
-//! the long end to hang below it), crosses over the rod so that the long end catches on it,
-//! descends on the far side until the rope's middle lies on the rod, opens, and backs away
-//! along the normal.
+//! the long end to hang below it), crosses over the rod so that the long end catches on it
+//! (the rod's sticky contact keeps the rope where it first touches), descends on the far side
+//! to just below the rod, opens slowly, and backs away along the normal.
 
 use glam::Vec3;
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
@@ -19,8 +19,11 @@ use crate::scripted::{tcp_oracle, ScriptedPolicy};
 /// Finger target (m per finger) while holding: where the episode starts
 /// ([`super::hang::START_FINGER_QPOS`]).
 pub const HOLD_FINGER_TARGET: f64 = super::hang::START_FINGER_QPOS as f64;
-/// Height (m) of the crossing above the rod's centre.
-pub const CROSS_HEIGHT: f32 = 0.13;
+/// Height (m) of the crossing above the rod's centre: low enough for the rope hanging below
+/// the hand to touch the rod while crossing (seed 0, 13 cm: it passed 5 mm over the rod,
+/// touched it about 30 % along during the descent, close to the grasp, and the descent then
+/// stretched the rope between grasp and rod).
+pub const CROSS_HEIGHT: f32 = 0.11;
 /// Horizontal offsets (m) from the rod's centre along its normal: where the hand rises (on
 /// the robot's side), where it descends (far side) and where it backs away to.
 pub const NEAR_OFFSET: f32 = -0.08;
@@ -28,8 +31,11 @@ pub const NEAR_OFFSET: f32 = -0.08;
 pub const FAR_OFFSET: f32 = 0.05;
 /// See [`NEAR_OFFSET`].
 pub const AWAY_OFFSET: f32 = 0.12;
-/// Depth (m) of the release point below the rod's centre.
-pub const RELEASE_DEPTH: f32 = 0.06;
+/// Depth (m) of the release point below the rod's centre: the rope between the rod and
+/// the fingers slack (6 cm stretched it once the rod held it).
+pub const RELEASE_DEPTH: f32 = 0.03;
+/// Control steps over which the fingers open (a sudden opening flung the rope off the rod).
+pub const OPEN_STEPS: u32 = 20;
 
 /// A waypoint: control step, TCP position (m, world), yaw added to the start (rad), finger
 /// target (m).
@@ -68,20 +74,20 @@ impl HangPolicy {
             (40, at(NEAR_OFFSET, high), yaw, hold),
             (60, at(FAR_OFFSET, high), yaw, hold),
             (80, at(FAR_OFFSET, low), yaw, hold),
-            (90, at(FAR_OFFSET, low), yaw, GRIPPER_OPEN),
-            (105, at(AWAY_OFFSET, low), yaw, GRIPPER_OPEN),
+            (80 + OPEN_STEPS, at(FAR_OFFSET, low), yaw, GRIPPER_OPEN),
+            (95 + OPEN_STEPS, at(AWAY_OFFSET, low), yaw, GRIPPER_OPEN),
             (u32::MAX, at(AWAY_OFFSET, low), yaw, GRIPPER_OPEN),
         ]
     }
 
-    /// The waypoint at control step `step`, linearly interpolated.
+    /// The waypoint at control step `step`, linearly interpolated (finger target too).
     fn command(&self, step: u32) -> Option<(Vec3, f32, f64)> {
         let s = step + 1;
         for pair in self.waypoints.windows(2) {
             let ((s0, p0, y0, g0), (s1, p1, y1, g1)) = (pair[0], pair[1]);
             if s <= s1 {
                 let t = s.saturating_sub(s0) as f32 / (s1 - s0) as f32;
-                let g = if t >= 1.0 { g1 } else { g0 };
+                let g = g0 + (g1 - g0) * f64::from(t);
                 return Some((p0.lerp(p1, t), y0 + (y1 - y0) * t, g));
             }
         }
