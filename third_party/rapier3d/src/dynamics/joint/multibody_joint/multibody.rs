@@ -15,7 +15,8 @@ use crate::prelude::MultibodyJoint;
 use crate::utils::mat_to_na;
 use crate::utils::{AngularInertiaOps, CrossProduct, CrossProductMatrix, IndexMut2, vect_to_na};
 use na::{
-    self, DMatrix, DVectorView, DVectorViewMut, Dyn, LU, OMatrix, SMatrix, SVector, StorageMut,
+    self, Const, DMatrix, DVectorView, DVectorViewMut, Dyn, LU, OMatrix, SMatrix, SVector,
+    StorageMut,
 };
 
 #[cfg(doc)]
@@ -545,10 +546,15 @@ impl Multibody {
             0
         });
 
+        self.update_jacobian_widths();
+
         // Eqn 42 to 45
         for i in 0..self.links.len() {
             let link = &self.links[i];
             let rb = &bodies[link.rigid_body];
+            // The generalized forces past the Jacobian's width would only receive exact zeros.
+            let width = self.workspace.jacobian_widths[i];
+            let body_jacobian = self.body_jacobians[i].columns(0, width);
 
             let mut acc = RigidBodyVelocity::zero();
 
@@ -599,18 +605,18 @@ impl Multibody {
                 rb.forces.force - rb_mass * acc.linvel,
                 rb.forces.torque - gyroscopic - rb_inertia * acc.angvel,
             );
-            self.accelerations.gemv_tr(
+            self.accelerations.rows_mut(0, width).gemv_tr(
                 1.0,
-                &self.body_jacobians[i],
+                &body_jacobian,
                 external_forces.as_vector(),
                 1.0,
             );
 
             if check_implicit_coriolis_divergence {
                 let applied_forces = Force::new(rb.forces.force, rb.forces.torque);
-                pos_forces.gemv_tr(
+                pos_forces.rows_mut(0, width).gemv_tr(
                     1.0,
-                    &self.body_jacobians[i],
+                    &body_jacobian,
                     applied_forces.as_vector(),
                     1.0,
                 );
@@ -765,9 +771,36 @@ impl Multibody {
         }
     }
 
+    /// Computes, for each link, the number of leading generalized coordinates its body Jacobian
+    /// depends on (`self.workspace.jacobian_widths`).
+    ///
+    /// A link's body Jacobian is its parent's plus terms in its own dofs' columns
+    /// (`assembly_id..assembly_id + ndofs`), so every column at or after
+    /// `max(parent width, assembly_id + ndofs)` is zero. Links normally come parent-first; a link
+    /// whose parent comes after it gets the full width, so that the restricted products below
+    /// compute exactly what the full ones do in every case.
+    fn update_jacobian_widths(&mut self) {
+        let widths = &mut self.workspace.jacobian_widths;
+        widths.clear();
+        for (i, link) in self.links.iter().enumerate() {
+            let own_end = link.assembly_id + link.joint.ndofs();
+            let width = if i == 0 {
+                own_end
+            } else if link.parent_internal_id < i {
+                own_end.max(widths[link.parent_internal_id])
+            } else {
+                self.ndofs
+            };
+            widths.push(width.min(self.ndofs));
+        }
+    }
+
     fn update_body_jacobians(&mut self) {
+        self.update_jacobian_widths();
+
         for i in 0..self.links.len() {
             let link = &self.links[i];
+            let width = self.workspace.jacobian_widths[i];
 
             if self.body_jacobians[i].ncols() != self.ndofs {
                 // TODO: use a resize instead.
@@ -785,8 +818,10 @@ impl Multibody {
                 link_j.copy_from(parent_j);
 
                 {
-                    let mut link_j_v = link_j.fixed_rows_mut::<DIM>(0);
-                    let parent_j_w = parent_j.fixed_rows::<ANG_DIM>(DIM);
+                    // Columns at or after `width` are zero in both Jacobians: skip them.
+                    let mut link_j_v = link_j.generic_view_mut((0, 0), (Const::<DIM>, Dyn(width)));
+                    let parent_j_w =
+                        parent_j.generic_view((DIM, 0), (Const::<ANG_DIM>, Dyn(width)));
 
                     let shift_tr = vect_to_na(link.shift02).gcross_matrix_tr();
                     link_j_v.gemm(1.0, &shift_tr, &parent_j_w, 1.0);
@@ -807,7 +842,7 @@ impl Multibody {
             link_j_part += link_joint_j;
 
             {
-                let link_j = &mut self.body_jacobians[i];
+                let mut link_j = self.body_jacobians[i].columns_mut(0, width);
                 let (mut link_j_v, link_j_w) =
                     link_j.rows_range_pair_mut(0..DIM, DIM..DIM + ANG_DIM);
                 let shift_tr = vect_to_na(link.shift23).gcross_matrix_tr();
@@ -842,13 +877,21 @@ impl Multibody {
         }
 
         let mut curr_assembly_id = 0;
+        self.update_jacobian_widths();
+        // The quadratic forms' `M · J[:, j]` (one 6-vector, reused for every column).
+        let mut quadform_work = SVector::<Real, SPATIAL_DIM>::zeros();
 
         for i in 0..self.links.len() {
             let link = &self.links[i];
             let rb = &bodies[link.rigid_body];
             let rb_mass = rb.mprops.effective_mass();
             let rb_inertia = rb.mprops.effective_angular_inertia().into_matrix();
-            let body_jacobian = &self.body_jacobians[i];
+            // Only the leading `width` columns of this link's body Jacobian (and of its Coriolis
+            // terms, built from its ancestors' Jacobians and its own) can be non-zero: all the
+            // products below are restricted to them. The entries they skip would only have
+            // received exact zeros, so the result is the same, bit for bit.
+            let width = self.workspace.jacobian_widths[i];
+            let body_jacobian = self.body_jacobians[i].columns(0, width);
 
             // NOTE: the mass matrix index reordering operates on the assumption that the assembly
             //       ids are traversed in order. This assert is here to ensure the assumption always
@@ -887,17 +930,34 @@ impl Multibody {
             let rb_mass_matrix_wo_gyro = concat_rb_mass_matrix(rb_mass, rb_inertia.into());
             #[allow(clippy::useless_conversion)] // Needed in 3D, no-op in 2D
             let rb_mass_matrix = concat_rb_mass_matrix(rb_mass, augmented_inertia.into());
-            self.augmented_mass
-                .quadform(1.0, &rb_mass_matrix_wo_gyro, body_jacobian, 1.0);
-            self.acc_augmented_mass
-                .quadform(1.0, &rb_mass_matrix, body_jacobian, 1.0);
+            // (`quadform_with_workspace` reads the first column even when there is none.)
+            if width != 0 {
+                self.augmented_mass
+                    .view_mut((0, 0), (width, width))
+                    .quadform_with_workspace(
+                        &mut quadform_work,
+                        1.0,
+                        &rb_mass_matrix_wo_gyro,
+                        &body_jacobian,
+                        1.0,
+                    );
+                self.acc_augmented_mass
+                    .view_mut((0, 0), (width, width))
+                    .quadform_with_workspace(
+                        &mut quadform_work,
+                        1.0,
+                        &rb_mass_matrix,
+                        &body_jacobian,
+                        1.0,
+                    );
+            }
 
             /*
              *
              * Coriolis matrix.
              *
              */
-            let rb_j = &self.body_jacobians[i];
+            let rb_j = self.body_jacobians[i].columns(0, width);
             let rb_j_w = rb_j.fixed_rows::<ANG_DIM>(DIM);
 
             let ndofs = link.joint.ndofs();
@@ -906,19 +966,25 @@ impl Multibody {
                 let parent_id = link.parent_internal_id;
                 let parent_link = &self.links[parent_id];
                 let parent_rb = &bodies[parent_link.rigid_body];
-                let parent_j = &self.body_jacobians[parent_id];
+                // The parent's Jacobian and Coriolis terms are zero from its own width on, which
+                // is at most this link's `width`.
+                let parent_j = self.body_jacobians[parent_id].columns(0, width);
                 let parent_j_w = parent_j.fixed_rows::<ANG_DIM>(DIM);
                 let parent_w = SimdAngVector::<Real>::from(parent_rb.vels.angvel).gcross_matrix();
 
                 let (coriolis_v, parent_coriolis_v) = self.coriolis_v.index_mut2(i, parent_id);
                 let (coriolis_w, parent_coriolis_w) = self.coriolis_w.index_mut2(i, parent_id);
 
+                // Full copies: the columns at or after `width` stay the zeros the root starts with.
                 coriolis_v.copy_from(parent_coriolis_v);
                 coriolis_w.copy_from(parent_coriolis_w);
+                let mut coriolis_v = coriolis_v.columns_mut(0, width);
+                let mut coriolis_w = coriolis_w.columns_mut(0, width);
+                let parent_coriolis_w = parent_coriolis_w.columns(0, width);
 
                 // [c1 - c0].gcross() * (JDot + JDot/u * qdot)"
                 let shift_cross_tr = vect_to_na(link.shift02).gcross_matrix_tr();
-                coriolis_v.gemm(1.0, &shift_cross_tr, parent_coriolis_w, 1.0);
+                coriolis_v.gemm(1.0, &shift_cross_tr, &parent_coriolis_w, 1.0);
 
                 // JDot (but the 2.0 originates from the sum of two identical terms in JDot and JDot/u * gdot)
                 let dvel_cross = vect_to_na(
@@ -969,13 +1035,13 @@ impl Multibody {
                 self.coriolis_w[i].fill(0.0);
             }
 
-            let coriolis_v = &mut self.coriolis_v[i];
-            let coriolis_w = &mut self.coriolis_w[i];
+            let mut coriolis_v = self.coriolis_v[i].columns_mut(0, width);
+            let coriolis_w = self.coriolis_w[i].columns(0, width);
 
             {
                 // [c3 - c2].gcross() * (JDot + JDot/u * qdot)
                 let shift_cross_tr = vect_to_na(link.shift23).gcross_matrix_tr();
-                coriolis_v.gemm(1.0, &shift_cross_tr, coriolis_w, 1.0);
+                coriolis_v.gemm(1.0, &shift_cross_tr, &coriolis_w, 1.0);
 
                 // JDot
                 let dvel_cross = vect_to_na(rb.vels.angvel.gcross(link.shift23)).gcross_matrix_tr();
@@ -990,15 +1056,17 @@ impl Multibody {
                 );
             }
 
-            let coriolis_v = &mut self.coriolis_v[i];
-            let coriolis_w = &mut self.coriolis_w[i];
+            let coriolis_v = self.coriolis_v[i].columns(0, width);
+            let coriolis_w = self.coriolis_w[i].columns(0, width);
 
             /*
              * Meld with the mass matrix.
              */
             {
-                let mut i_coriolis_dt_v = self.i_coriolis_dt.fixed_rows_mut::<DIM>(0);
-                i_coriolis_dt_v.copy_from(coriolis_v);
+                let mut i_coriolis_dt_v = self
+                    .i_coriolis_dt
+                    .generic_view_mut((0, 0), (Const::<DIM>, Dyn(width)));
+                i_coriolis_dt_v.copy_from(&coriolis_v);
                 let rb_mass_dt = vect_to_na(rb_mass * dt);
                 i_coriolis_dt_v
                     .column_iter_mut()
@@ -1007,18 +1075,23 @@ impl Multibody {
 
             #[cfg(feature = "dim2")]
             {
-                let mut i_coriolis_dt_w = self.i_coriolis_dt.fixed_rows_mut::<ANG_DIM>(DIM);
+                let mut i_coriolis_dt_w = self
+                    .i_coriolis_dt
+                    .generic_view_mut((DIM, 0), (Const::<ANG_DIM>, Dyn(width)));
                 // NOTE: this is just an axpy, but on row columns.
-                i_coriolis_dt_w.zip_apply(coriolis_w, |o, x| *o = x * dt * rb_inertia);
+                i_coriolis_dt_w.zip_apply(&coriolis_w, |o, x| *o = x * dt * rb_inertia);
             }
             #[cfg(feature = "dim3")]
             {
-                let mut i_coriolis_dt_w = self.i_coriolis_dt.fixed_rows_mut::<ANG_DIM>(DIM);
-                i_coriolis_dt_w.gemm(dt, &mat_to_na(rb_inertia), coriolis_w, 0.0);
+                let mut i_coriolis_dt_w = self
+                    .i_coriolis_dt
+                    .generic_view_mut((DIM, 0), (Const::<ANG_DIM>, Dyn(width)));
+                i_coriolis_dt_w.gemm(dt, &mat_to_na(rb_inertia), &coriolis_w, 0.0);
             }
 
             self.acc_augmented_mass
-                .gemm_tr(1.0, rb_j, &self.i_coriolis_dt, 1.0);
+                .view_mut((0, 0), (width, width))
+                .gemm_tr(1.0, &rb_j, &self.i_coriolis_dt.columns(0, width), 1.0);
         }
 
         /*

@@ -8,6 +8,9 @@ use crate::math::{DVector, Real};
 pub(crate) struct MultibodyWorkspace {
     pub accs: Vec<RigidBodyVelocity<Real>>,
     pub ndofs_vec: DVector,
+    /// For each link, the number of leading generalized coordinates its body Jacobian depends
+    /// on: every column at or after this index is zero (see `Multibody::update_jacobian_widths`).
+    pub jacobian_widths: Vec<usize>,
 }
 
 impl MultibodyWorkspace {
@@ -16,6 +19,7 @@ impl MultibodyWorkspace {
         MultibodyWorkspace {
             accs: Vec::new(),
             ndofs_vec: DVector::zeros(0),
+            jacobian_widths: Vec::new(),
         }
     }
 
