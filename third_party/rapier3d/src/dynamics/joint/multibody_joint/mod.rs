@@ -21,6 +21,8 @@ mod multibody;
 mod multibody_joint_handle;
 #[cfg(feature = "alloc")]
 mod multibody_joint_set;
+#[cfg(all(feature = "alloc", feature = "dim3"))]
+mod multibody_kernels;
 #[cfg(feature = "alloc")]
 mod multibody_link;
 #[cfg(feature = "alloc")]

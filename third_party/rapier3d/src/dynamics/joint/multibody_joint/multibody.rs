@@ -48,21 +48,6 @@ fn concat_rb_mass_matrix(mass: Vector, inertia: Real) -> SMatrix<Real, SPATIAL_D
     result
 }
 
-#[cfg(feature = "dim3")]
-fn concat_rb_mass_matrix(
-    mass: Vector,
-    inertia: na::Matrix3<Real>,
-) -> SMatrix<Real, SPATIAL_DIM, SPATIAL_DIM> {
-    let mut result = SMatrix::<Real, SPATIAL_DIM, SPATIAL_DIM>::zeros();
-    result[(0, 0)] = mass.x;
-    result[(1, 1)] = mass.y;
-    result[(2, 2)] = mass.z;
-    result
-        .fixed_view_mut::<ANG_DIM, ANG_DIM>(DIM, DIM)
-        .copy_from(&inertia);
-    result
-}
-
 /// A holonomic coupling between two generalized coordinates of a single
 /// [`Multibody`], `q2 = coeff · q1 + offset`, enforced as a velocity-level
 /// equality constraint. This is how MuJoCo's `<equality><joint>` (a polynomial
@@ -879,6 +864,7 @@ impl Multibody {
         let mut curr_assembly_id = 0;
         self.update_jacobian_widths();
         // The quadratic forms' `M · J[:, j]` (one 6-vector, reused for every column).
+        #[cfg(feature = "dim2")]
         let mut quadform_work = SVector::<Real, SPATIAL_DIM>::zeros();
 
         for i in 0..self.links.len() {
@@ -891,6 +877,7 @@ impl Multibody {
             // products below are restricted to them. The entries they skip would only have
             // received exact zeros, so the result is the same, bit for bit.
             let width = self.workspace.jacobian_widths[i];
+            #[cfg(feature = "dim2")]
             let body_jacobian = self.body_jacobians[i].columns(0, width);
 
             // NOTE: the mass matrix index reordering operates on the assumption that the assembly
@@ -924,13 +911,33 @@ impl Multibody {
                 augmented_inertia += gyroscopic_matrix * dt;
             }
 
-            // TODO: optimize that (knowing the structure of the augmented inertia matrix).
+            // Both quadratic forms `Jᵀ M J` in one pass, knowing the structure of `M` (the same
+            // operations as nalgebra's `quadform`, bit for bit).
+            #[cfg(feature = "dim3")]
+            {
+                let inertia_wo_gyro: na::Matrix3<Real> = rb_inertia.into();
+                let augmented_inertia: na::Matrix3<Real> = augmented_inertia.into();
+                super::multibody_kernels::add_link_mass_quadforms(
+                    self.augmented_mass.as_mut_slice(),
+                    self.acc_augmented_mass.as_mut_slice(),
+                    self.ndofs,
+                    &self.body_jacobians[i].as_slice()[..SPATIAL_DIM * width],
+                    width,
+                    [rb_mass.x, rb_mass.y, rb_mass.z],
+                    &inertia_wo_gyro,
+                    &augmented_inertia,
+                );
+            }
+
             // TODO: this could be better optimized in 2D.
-            #[allow(clippy::useless_conversion)] // Needed in 3D, no-op in 2D
+            #[cfg(feature = "dim2")]
+            #[allow(clippy::useless_conversion)]
             let rb_mass_matrix_wo_gyro = concat_rb_mass_matrix(rb_mass, rb_inertia.into());
-            #[allow(clippy::useless_conversion)] // Needed in 3D, no-op in 2D
+            #[cfg(feature = "dim2")]
+            #[allow(clippy::useless_conversion)]
             let rb_mass_matrix = concat_rb_mass_matrix(rb_mass, augmented_inertia.into());
             // (`quadform_with_workspace` reads the first column even when there is none.)
+            #[cfg(feature = "dim2")]
             if width != 0 {
                 self.augmented_mass
                     .view_mut((0, 0), (width, width))
@@ -1056,13 +1063,30 @@ impl Multibody {
                 );
             }
 
-            let coriolis_v = self.coriolis_v[i].columns(0, width);
-            let coriolis_w = self.coriolis_w[i].columns(0, width);
-
             /*
              * Meld with the mass matrix.
              */
+            #[cfg(feature = "dim3")]
             {
+                let rb_mass_dt = rb_mass * dt;
+                super::multibody_kernels::add_link_coriolis(
+                    self.acc_augmented_mass.as_mut_slice(),
+                    self.ndofs,
+                    &self.body_jacobians[i].as_slice()[..SPATIAL_DIM * width],
+                    width,
+                    &self.coriolis_v[i].as_slice()[..DIM * width],
+                    &self.coriolis_w[i].as_slice()[..ANG_DIM * width],
+                    [rb_mass_dt.x, rb_mass_dt.y, rb_mass_dt.z],
+                    dt,
+                    &mat_to_na(rb_inertia),
+                    self.i_coriolis_dt.as_mut_slice(),
+                );
+            }
+
+            #[cfg(feature = "dim2")]
+            {
+                let coriolis_v = self.coriolis_v[i].columns(0, width);
+                let coriolis_w = self.coriolis_w[i].columns(0, width);
                 let mut i_coriolis_dt_v = self
                     .i_coriolis_dt
                     .generic_view_mut((0, 0), (Const::<DIM>, Dyn(width)));
@@ -1071,27 +1095,17 @@ impl Multibody {
                 i_coriolis_dt_v
                     .column_iter_mut()
                     .for_each(|mut c| c.component_mul_assign(&rb_mass_dt));
-            }
 
-            #[cfg(feature = "dim2")]
-            {
                 let mut i_coriolis_dt_w = self
                     .i_coriolis_dt
                     .generic_view_mut((DIM, 0), (Const::<ANG_DIM>, Dyn(width)));
                 // NOTE: this is just an axpy, but on row columns.
                 i_coriolis_dt_w.zip_apply(&coriolis_w, |o, x| *o = x * dt * rb_inertia);
-            }
-            #[cfg(feature = "dim3")]
-            {
-                let mut i_coriolis_dt_w = self
-                    .i_coriolis_dt
-                    .generic_view_mut((DIM, 0), (Const::<ANG_DIM>, Dyn(width)));
-                i_coriolis_dt_w.gemm(dt, &mat_to_na(rb_inertia), &coriolis_w, 0.0);
-            }
 
-            self.acc_augmented_mass
-                .view_mut((0, 0), (width, width))
-                .gemm_tr(1.0, &rb_j, &self.i_coriolis_dt.columns(0, width), 1.0);
+                self.acc_augmented_mass
+                    .view_mut((0, 0), (width, width))
+                    .gemm_tr(1.0, &rb_j, &self.i_coriolis_dt.columns(0, width), 1.0);
+            }
         }
 
         /*
