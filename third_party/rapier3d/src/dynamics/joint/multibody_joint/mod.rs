@@ -21,7 +21,8 @@ mod multibody;
 mod multibody_joint_handle;
 #[cfg(feature = "alloc")]
 mod multibody_joint_set;
-#[cfg(all(feature = "alloc", feature = "dim3"))]
+#[cfg(feature = "alloc")]
+#[cfg_attr(feature = "dim2", allow(dead_code))]
 mod multibody_kernels;
 #[cfg(feature = "alloc")]
 mod multibody_link;

@@ -1,3 +1,4 @@
+use super::multibody_kernels::gemm_small_acc;
 use super::multibody_link::{MultibodyLink, MultibodyLinkVec};
 use super::multibody_workspace::MultibodyWorkspace;
 use crate::alloc_prelude::*;
@@ -809,7 +810,7 @@ impl Multibody {
                         parent_j.generic_view((DIM, 0), (Const::<ANG_DIM>, Dyn(width)));
 
                     let shift_tr = vect_to_na(link.shift02).gcross_matrix_tr();
-                    link_j_v.gemm(1.0, &shift_tr, &parent_j_w, 1.0);
+                    gemm_small_acc(&mut link_j_v, 1.0, &shift_tr, &parent_j_w);
                 }
             } else {
                 self.body_jacobians[i].fill(0.0);
@@ -831,7 +832,7 @@ impl Multibody {
                 let (mut link_j_v, link_j_w) =
                     link_j.rows_range_pair_mut(0..DIM, DIM..DIM + ANG_DIM);
                 let shift_tr = vect_to_na(link.shift23).gcross_matrix_tr();
-                link_j_v.gemm(1.0, &shift_tr, &link_j_w, 1.0);
+                gemm_small_acc(&mut link_j_v, 1.0, &shift_tr, &link_j_w);
             }
         }
     }
@@ -991,28 +992,33 @@ impl Multibody {
 
                 // [c1 - c0].gcross() * (JDot + JDot/u * qdot)"
                 let shift_cross_tr = vect_to_na(link.shift02).gcross_matrix_tr();
-                coriolis_v.gemm(1.0, &shift_cross_tr, &parent_coriolis_w, 1.0);
+                gemm_small_acc(&mut coriolis_v, 1.0, &shift_cross_tr, &parent_coriolis_w);
 
                 // JDot (but the 2.0 originates from the sum of two identical terms in JDot and JDot/u * gdot)
                 let dvel_cross = vect_to_na(
                     rb.vels.angvel.gcross(link.shift02) + 2.0 * link.joint_velocity.linvel,
                 )
                 .gcross_matrix_tr();
-                coriolis_v.gemm(1.0, &dvel_cross, &parent_j_w, 1.0);
+                gemm_small_acc(&mut coriolis_v, 1.0, &dvel_cross, &parent_j_w);
 
                 // JDot/u * qdot
-                coriolis_v.gemm(
+                gemm_small_acc(
+                    &mut coriolis_v,
                     1.0,
                     &vect_to_na(link.joint_velocity.linvel).gcross_matrix_tr(),
                     &parent_j_w,
-                    1.0,
                 );
-                coriolis_v.gemm(1.0, &(parent_w * shift_cross_tr), &parent_j_w, 1.0);
+                gemm_small_acc(
+                    &mut coriolis_v,
+                    1.0,
+                    &(parent_w * shift_cross_tr),
+                    &parent_j_w,
+                );
 
                 #[cfg(feature = "dim3")]
                 {
                     let vel_wrt_joint_w = vect_to_na(link.joint_velocity.angvel).gcross_matrix();
-                    coriolis_w.gemm(-1.0, &vel_wrt_joint_w, &parent_j_w, 1.0);
+                    gemm_small_acc(&mut coriolis_w, -1.0, &vel_wrt_joint_w, &parent_j_w);
                 }
 
                 // JDot (but the 2.0 originates from the sum of two identical terms in JDot and JDot/u * gdot)
@@ -1028,13 +1034,13 @@ impl Multibody {
                     );
 
                     let rb_joint_j_v = rb_joint_j.fixed_rows::<DIM>(0);
-                    coriolis_v_part.gemm(2.0, &parent_w, &rb_joint_j_v, 1.0);
+                    gemm_small_acc(&mut coriolis_v_part, 2.0, &parent_w, &rb_joint_j_v);
 
                     #[cfg(feature = "dim3")]
                     {
                         let rb_joint_j_w = rb_joint_j.fixed_rows::<ANG_DIM>(DIM);
                         let mut coriolis_w_part = coriolis_w.columns_mut(link.assembly_id, ndofs);
-                        coriolis_w_part.gemm(1.0, &parent_w, &rb_joint_j_w, 1.0);
+                        gemm_small_acc(&mut coriolis_w_part, 1.0, &parent_w, &rb_joint_j_w);
                     }
                 }
             } else {
@@ -1048,18 +1054,18 @@ impl Multibody {
             {
                 // [c3 - c2].gcross() * (JDot + JDot/u * qdot)
                 let shift_cross_tr = vect_to_na(link.shift23).gcross_matrix_tr();
-                coriolis_v.gemm(1.0, &shift_cross_tr, &coriolis_w, 1.0);
+                gemm_small_acc(&mut coriolis_v, 1.0, &shift_cross_tr, &coriolis_w);
 
                 // JDot
                 let dvel_cross = vect_to_na(rb.vels.angvel.gcross(link.shift23)).gcross_matrix_tr();
-                coriolis_v.gemm(1.0, &dvel_cross, &rb_j_w, 1.0);
+                gemm_small_acc(&mut coriolis_v, 1.0, &dvel_cross, &rb_j_w);
 
                 // JDot/u * qdot
-                coriolis_v.gemm(
+                gemm_small_acc(
+                    &mut coriolis_v,
                     1.0,
                     &(SimdAngVector::<Real>::from(rb.vels.angvel).gcross_matrix() * shift_cross_tr),
                     &rb_j_w,
-                    1.0,
                 );
             }
 

@@ -12,7 +12,7 @@
 //! from offset `o` is `m[o + c * s + r]`.
 
 use crate::math::Real;
-use na::Matrix3;
+use na::{Dim, Matrix, Matrix3, SMatrix, Storage, StorageMut};
 
 /// The dot product of two 6-vectors, summed like nalgebra's `dot` (from `+0.0`, in order).
 #[inline(always)]
@@ -79,36 +79,38 @@ pub(super) fn add_link_mass_quadforms(
     }
 }
 
-/// `y[:, j] += alpha · a · b[:, j]` for one column: `y` and `b` are 3-vectors. The same
-/// operations as nalgebra's `gemm` with `beta = 1` (one `axpy` per column of `a`, in order).
-#[inline(always)]
-pub(super) fn gemm3_column(y: &mut [Real], alpha: Real, a: &Matrix3<Real>, b: [Real; 3]) {
-    for c in 0..3 {
-        for r in 0..3 {
-            y[r] = (alpha * a[(r, c)]) * b[c] + y[r];
-        }
-    }
-}
-
-/// `y += alpha · a · b` for the first `width` columns of `y` (3 rows from `y_offset`, column
-/// stride `y_stride`) and of `b` (3 rows from `b_offset`, column stride `b_stride`):
-/// bit-identical to nalgebra's `y.gemm(alpha, a, b, 1.0)` on those columns.
-pub(super) fn gemm3_acc(
-    y: &mut [Real],
-    y_offset: usize,
-    y_stride: usize,
+/// `y += alpha · a · b` for a small fixed-size `a` (`R × C`) and `y`, `b` with any number of
+/// columns and any strides: the same operations, in the same order, as nalgebra's
+/// `y.gemm(alpha, a, b, 1.0)` (one `axpy` per column of `a`), without its generic dispatch.
+pub(super) fn gemm_small_acc<const R: usize, const C: usize, R1, C1, S1, R2, C2, S2>(
+    y: &mut Matrix<Real, R1, C1, S1>,
     alpha: Real,
-    a: &Matrix3<Real>,
-    b: &[Real],
-    b_offset: usize,
-    b_stride: usize,
-    width: usize,
-) {
-    for j in 0..width {
-        let bj = b_offset + j * b_stride;
-        let column = [b[bj], b[bj + 1], b[bj + 2]];
-        let yj = y_offset + j * y_stride;
-        gemm3_column(&mut y[yj..yj + 3], alpha, a, column);
+    a: &SMatrix<Real, R, C>,
+    b: &Matrix<Real, R2, C2, S2>,
+) where
+    R1: Dim,
+    C1: Dim,
+    S1: StorageMut<Real, R1, C1>,
+    R2: Dim,
+    C2: Dim,
+    S2: Storage<Real, R2, C2>,
+{
+    assert!(y.nrows() == R && b.nrows() == C && y.ncols() == b.ncols());
+    let scaled = a * alpha;
+    for j in 0..y.ncols() {
+        let mut column = [0.0; R];
+        for (r, value) in column.iter_mut().enumerate() {
+            *value = y[(r, j)];
+        }
+        for c in 0..C {
+            let bc = b[(c, j)];
+            for (r, value) in column.iter_mut().enumerate() {
+                *value = scaled[(r, c)] * bc + *value;
+            }
+        }
+        for (r, value) in column.iter().enumerate() {
+            y[(r, j)] = *value;
+        }
     }
 }
 
@@ -184,7 +186,13 @@ mod tests {
         let mut seed = 1;
         // From zero (where no rounding of the sum hides a difference in a product) and from
         // arbitrary values.
-        for (dim, from_zero) in [(1usize, true), (3, false), (9, true), (9, false), (12, true)] {
+        for (dim, from_zero) in [
+            (1usize, true),
+            (3, false),
+            (9, true),
+            (9, false),
+            (12, true),
+        ] {
             for width in 0..=dim {
                 let jac = Matrix6xX::<Real>::from_fn(width, |_, _| value(&mut seed));
                 let mass = [value(&mut seed), value(&mut seed), value(&mut seed)];
@@ -228,17 +236,12 @@ mod tests {
                 let mut y = OMatrix::<Real, U3, na::Dyn>::from_fn(dim, |_, _| value(&mut seed));
                 let mut y2 = y.clone();
                 y.columns_mut(0, width)
-                    .gemm(-1.0, &a, &jac.fixed_rows::<3>(3), 1.0);
-                gemm3_acc(
-                    y2.as_mut_slice(),
-                    0,
-                    3,
-                    -1.0,
+                    .gemm(0.37, &a, &jac.fixed_rows::<3>(3), 1.0);
+                gemm_small_acc(
+                    &mut y2.columns_mut(0, width),
+                    0.37,
                     &a,
-                    jac.as_slice(),
-                    3,
-                    6,
-                    width,
+                    &jac.fixed_rows::<3>(3),
                 );
                 assert_eq!(bits(y.as_slice()), bits(y2.as_slice()));
 
