@@ -165,6 +165,7 @@ pub(super) fn add_link_coriolis(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use alloc::{vec, vec::Vec};
     use na::{DMatrix, Matrix6, Matrix6xX, OMatrix, U3};
 
     /// A deterministic pseudo-random value in [-1, 1), with exact zeros now and then (the
