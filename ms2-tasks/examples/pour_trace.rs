@@ -6,7 +6,9 @@
 //! ```
 //! `MPM=<Hz>` sets `mpm_freq`; `MODE=<control mode>` the control mode; `IDLE=1` sends zero
 //! actions instead of the policy's; `FASTEST=1` prints the fastest particle's position and
-//! velocity.
+//! velocity; `BAND=1` where the particles above the band are (distance from the beaker's
+//! axis and height above the band's top, ranges in mm, and how many lie within 5 mm of the
+//! wall).
 
 use std::time::Instant;
 
@@ -74,6 +76,32 @@ fn main() -> Result<(), EnvError> {
                     u.y,
                     u.z,
                     rel.length()
+                );
+            }
+            if std::env::var("BAND").is_ok() {
+                let e = pour.episode();
+                let top = e.line + ms2_tasks::families::soft::pour_scene::LINE_WIDTH;
+                let r_in = ms2_tasks::families::soft::pour_scene::BEAKER_RADIUS;
+                let above: Vec<(f32, f32)> = x
+                    .iter()
+                    .map(|p| ((p.truncate() - e.beaker_xy).length(), p.z - top))
+                    .filter(|&(r, h)| r < r_in && h > 0.0 && h + top < 0.06)
+                    .collect();
+                let fold = |f: fn(&(f32, f32)) -> f32| {
+                    above
+                        .iter()
+                        .map(f)
+                        .fold((f32::MAX, f32::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)))
+                };
+                let (r_lo, r_hi) = fold(|a| a.0);
+                let (h_lo, h_hi) = fold(|a| a.1);
+                let at_wall = above.iter().filter(|a| a.0 > r_in - 0.005).count();
+                print!(
+                    "[band+ r {:.1}-{:.1} mm, h {:.1}-{:.1} mm, {at_wall} at the wall] ",
+                    r_lo * 1e3,
+                    r_hi * 1e3,
+                    h_lo * 1e3,
+                    h_hi * 1e3
                 );
             }
             println!(

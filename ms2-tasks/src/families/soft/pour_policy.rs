@@ -47,15 +47,34 @@ pub const MAX_TILT: f32 = 2.2;
 /// beaker (577 particles spilled).
 pub const MAX_TCP_ERROR: f32 = 0.01;
 /// Outflow (particles per step) the tilt regulates to.
-pub const TARGET_FLOW: f32 = 80.0;
+pub const TARGET_FLOW: f32 = 40.0;
+/// Outflow (particles per step) once the band holds [`NEAR_BAND`] particles: the water
+/// still in the neck and in the air when the bottle turns back lands after the band has
+/// filled, so the pour slows before it (at 40-45 per step the level rose another 0.7 mm
+/// after the return began: ~250 particles above the line's bottom, 23-27 above its top, and
+/// a surface rough by ±4 mm at 5 mm cells; seeds 4 and 6).
+pub const FINAL_FLOW: f32 = 12.0;
+/// Particles in the band at which the pour slows to [`FINAL_FLOW`] (the stream passing
+/// through the band puts 5-15 there).
+pub const NEAR_BAND: usize = 30;
 /// Steps of outflow still to come when the bottle starts turning back.
-pub const LAG_STEPS: f32 = 3.0;
+pub const LAG_STEPS: f32 = 6.0;
 /// The pour aims at this height (m) above the line's bottom (the band is 4 mm).
 pub const AIM_ABOVE_LINE: f32 = 0.002;
 /// Rate (rad per step) of the return upright.
 pub const RETURN_RATE: f32 = 0.15;
 /// Steps the bottle stays upright before the level is checked for a second pour.
 pub const SETTLE_STEPS: u32 = 25;
+/// Range (rad) the last joint needs in the tilt's direction. Turning the hand by +θ about its
+/// approach axis turns the Panda's last joint by +θ; the start leaves it at −1.7 to −2.1 rad,
+/// so turning the other way has only about 1 rad before its limit (−2.8973), the other joints
+/// must make up the rest, and the IK gives up position and tilt: the tilt then stalled near
+/// 100° and the water left at ~20 particles per step (seed 6: 2,400 poured by step 210). With
+/// less range than this the policy turns the other way and pours from the beaker's other
+/// side.
+pub const MIN_WRIST_RANGE: f32 = 2.0;
+/// The Panda's last joint (the one that turns the hand about its approach axis).
+const WRIST_JOINT: &str = "panda_joint7";
 
 /// Where the policy is.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,7 +103,12 @@ pub struct PourPolicy {
 impl PourPolicy {
     /// The policy of `env` (an error when its control mode is not position-based).
     pub fn boxed(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
-        Ok(Box::new(Self {
+        Ok(Box::new(Self::new(env)?))
+    }
+
+    /// The policy of `env`, unboxed (an error when its control mode is not position-based).
+    pub fn new(env: &Env) -> Result<Self, EnvError> {
+        Ok(Self {
             oracle: tcp_oracle(env)?,
             start: None,
             pour_xy: Vec2::ZERO,
@@ -93,7 +117,32 @@ impl PourPolicy {
             phase: Phase::Approach,
             left_last: 0,
             goal: 0,
-        }))
+        })
+    }
+
+    /// The direction (+1 or −1) the bottle tilts in about the hand's approach axis, chosen at
+    /// [`ScriptedPolicy::reset`]: +1 turns the Panda's last joint towards its upper limit.
+    pub fn tilt_sign(&self) -> f32 {
+        self.sign
+    }
+
+    /// Range (rad) the last joint of `env`'s robot has left when it turns in direction `sign`
+    /// (±1): to its upper limit for +1, to its lower one for −1; `None` when the robot has no
+    /// such joint.
+    pub fn wrist_range(env: &Env, sign: f32) -> Option<f32> {
+        let scene = env.task_scene()?;
+        let world = scene.world.as_ref();
+        let art = scene.agent.articulation();
+        let q = world.qpos(art).ok()?;
+        let dof = world.dof_index(art, WRIST_JOINT).ok()?;
+        let info = world
+            .joint_infos(art)
+            .ok()?
+            .into_iter()
+            .find(|j| j.name == WRIST_JOINT)?;
+        let [lo, hi] = info.limits;
+        let q7 = *q.get(dof)?;
+        Some(if sign > 0.0 { hi - q7 } else { q7 - lo })
     }
 
     /// Particles that have left the bottle (outside its body's cylinder, in the bottle frame).
@@ -144,6 +193,16 @@ impl ScriptedPolicy for PourPolicy {
         let u = Vec2::new(y.x, y.y).normalize_or_zero();
         let to_beaker = e.beaker_xy - e.bottle_xy;
         self.sign = if u.dot(to_beaker) >= 0.0 { 1.0 } else { -1.0 };
+        // Turn the other way (pouring from the beaker's other side) when the last joint lacks
+        // range this way and has more the other way.
+        if let (Some(this_way), Some(other_way)) = (
+            Self::wrist_range(env, self.sign),
+            Self::wrist_range(env, -self.sign),
+        ) {
+            if this_way < MIN_WRIST_RANGE && other_way > this_way {
+                self.sign = -self.sign;
+            }
+        }
         // Lying flat, the mouth is (mouth height − grasp height) along the tilt direction.
         let reach = BOTTLE_HEIGHT - e.tcp_height;
         self.pour_xy = e.beaker_xy - self.sign * u * reach;
@@ -202,15 +261,20 @@ impl ScriptedPolicy for PourPolicy {
                     // The band already holds 100 particles (ManiSkill2's reward's `done`):
                     // at seed 0 it did with 4,100 particles in the beaker, half the count of
                     // the aimed level, when the outflow had fallen to 8 per step.
-                    let band_full =
-                        counts.above_line.saturating_sub(counts.above_band) >= MIN_ABOVE_LINE;
-                    if band_full || out as f32 + LAG_STEPS * flow >= self.goal as f32 {
+                    let band = counts.above_line.saturating_sub(counts.above_band);
+                    let target_flow = if band >= NEAR_BAND {
+                        FINAL_FLOW
+                    } else {
+                        TARGET_FLOW
+                    };
+                    let too_fast = flow > 2.0 * target_flow;
+                    if band >= MIN_ABOVE_LINE || out as f32 + LAG_STEPS * flow >= self.goal as f32 {
                         self.phase = Phase::Return(u32::MAX);
-                    } else if off_target && self.tilt > QUICK_TILT {
+                    } else if (off_target || too_fast) && self.tilt > QUICK_TILT {
                         self.tilt -= SLOW_RATE;
                     } else if self.tilt < QUICK_TILT {
                         self.tilt += QUICK_RATE;
-                    } else if flow < TARGET_FLOW && self.tilt < MAX_TILT {
+                    } else if flow < target_flow && self.tilt < MAX_TILT {
                         self.tilt += SLOW_RATE;
                     }
                 }
