@@ -234,10 +234,11 @@ fn state_round_trip_is_bit_exact_and_seeds_repeat() {
     let mut a = hang_env("state");
     a.reset(Some(2), false).unwrap();
     let hold = {
-        // Arm still, fingers at their start opening.
+        // Arm still, fingers at their start opening (0.01 m each: the gripper's −0.01..0.04 m
+        // target range mapped to −1..1).
         let mut act = vec![0.0; a.action_space().size()];
         if let Some(g) = act.last_mut() {
-            *g = -0.44;
+            *g = -0.2;
         }
         act
     };
