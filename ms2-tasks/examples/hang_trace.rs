@@ -58,10 +58,18 @@ fn main() -> Result<(), EnvError> {
                     .map(|p| soft.distance_to_body(b, *p).unwrap_or(9.0))
                     .fold(f32::MAX, f32::min)
             };
-            let on_rod = x
+            let ids = soft.solver().particle_ids();
+            let first = ids.iter().copied().min().unwrap_or(0);
+            let touching: Vec<f32> = x
                 .iter()
-                .filter(|p| soft.distance_to_body(2, **p).unwrap_or(9.0) < 0.005)
-                .count();
+                .zip(ids)
+                .filter(|(p, _)| soft.distance_to_body(2, **p).unwrap_or(9.0) < 0.008)
+                .map(|(_, &id)| (id - first) as f32 / x.len() as f32)
+                .collect();
+            let on_rod = touching.len();
+            // Mean fraction along the rope (from the short end) of the particles on the rod.
+            let arc = touching.iter().sum::<f32>() / on_rod as f32;
+            print!("arc {arc:.2} ");
             print!(
                 "near {near} d0 {:.4} d1 {:.4} d2 {:.4} on rod {on_rod} ",
                 dmin(0),

@@ -160,14 +160,15 @@ fn space_size(space: &ms2_tasks::Space, path: &str) -> usize {
 }
 
 #[test]
-fn episodes_start_with_the_rope_on_the_fingertips_and_a_seeded_rod() {
+fn episodes_start_with_the_rope_pinched_between_the_fingertips_and_a_seeded_rod() {
     let mut env = hang_env("particles");
     assert_eq!(env.max_episode_steps(), 350);
     let mut heights = Vec::new();
     for seed in 0..4 {
         let (obs, _) = env.reset(Some(seed), false).unwrap();
         let x = obs.get("particles/x").unwrap().as_f32().unwrap();
-        assert!(x.len() / 3 > 9000, "seed {seed}: {} particles", x.len() / 3);
+        // The whole rope: 160 rows of 8 × 8 particles, none cut away by the fingers.
+        assert_eq!(x.len() / 3, 10_240, "seed {seed}");
         // The observation space fixes the count: every seed has the same particles.
         assert_eq!(
             x.len(),
@@ -187,18 +188,29 @@ fn episodes_start_with_the_rope_on_the_fingertips_and_a_seeded_rod() {
         heights.push(z);
         let hang = env.task().unwrap().downcast_ref::<Hang>().unwrap();
         let soft = hang.arm().soft().unwrap();
-        // Both fingertips (coupled bodies 0 and 1) touch the rope; the rod does not.
+        // The rope is pinched: a face of it lies along each fingertip pad (coupled bodies 0
+        // and 1), no particle inside a finger; the rod is away from it.
         for body in 0..3 {
-            let d = soft
+            let d: Vec<f32> = soft
                 .solver()
                 .positions()
                 .iter()
                 .map(|p| soft.distance_to_body(body, *p).unwrap())
-                .fold(f32::MAX, f32::min);
+                .collect();
+            let nearest = d.iter().copied().fold(f32::MAX, f32::min);
             if body < 2 {
-                assert!(d < 0.004, "seed {seed}: finger {body} at {d} m");
+                assert!(
+                    nearest > 0.0,
+                    "seed {seed}: a particle inside finger {body}"
+                );
+                // A face of the rope on a 20 × 20 mm pad: about 8 × 8 particles.
+                let on_pad = d.iter().filter(|&&d| d < 0.002).count();
+                assert!(
+                    on_pad >= 40,
+                    "seed {seed}: {on_pad} particles on pad {body}"
+                );
             } else {
-                assert!(d > 0.05, "seed {seed}: rod at {d} m");
+                assert!(nearest > 0.05, "seed {seed}: rod at {nearest} m");
             }
         }
         let e = hang
@@ -222,10 +234,11 @@ fn state_round_trip_is_bit_exact_and_seeds_repeat() {
     let mut a = hang_env("state");
     a.reset(Some(2), false).unwrap();
     let hold = {
-        // Arm still, fingers at their start opening.
+        // Arm still, fingers at their start opening (0.01 m each: the gripper's −0.01..0.04 m
+        // target range mapped to −1..1).
         let mut act = vec![0.0; a.action_space().size()];
         if let Some(g) = act.last_mut() {
-            *g = -0.44;
+            *g = -0.2;
         }
         act
     };

@@ -2,8 +2,8 @@
 //! Hang.
 //!
 //! The Panda (ManiSkill2's, base at (−0.46, 0, 0) m, arm at ManiSkill2's Hang start
-//! configuration) starts with the rope on its fingertips (in slots of the rope) about a fifth
-//! of the rope's length from one end ([`RopeStart`]); a red kinematic rod (60 cm long, 2 cm square)
+//! configuration) starts with the rope pinched between its fingertip pads about a fifth of
+//! the rope's length from one end ([`RopeStart`]); a red kinematic rod (60 cm long, 2 cm square)
 //! floats at a seeded pose in front of it ([`RodPose::from_unit`]). The rope is coupled
 //! two-way to both fingers and the rod (the coupled solver shared with the bucket tasks,
 //! [`BucketArm`], with no bucket on the hand; ManiSkill2 couples every link, ms2 the ones the
@@ -66,9 +66,10 @@ pub const ARM_START: [f32; 7] = [
     std::f32::consts::PI - 0.2,
     std::f32::consts::FRAC_PI_4,
 ];
-/// Finger position (m per finger) at the start: the fingertips 8 mm apart (ManiSkill2's
-/// recorded starts: 2 mm, the rope pinched between them).
-pub const START_FINGER_QPOS: f32 = 0.004;
+/// Finger position (m per finger) at the start: the fingertip pads 20 mm apart, the width of
+/// the rope's particles (eight of 2.5 mm across), which lie between them (ManiSkill2's
+/// recorded starts pinch the rope between fingertips 2 mm apart).
+pub const START_FINGER_QPOS: f32 = 0.01;
 /// Distance (m) from a finger's surface within which the rope's grid nodes move with the
 /// finger: one cell of the rope's grid.
 const FINGER_STICKY_REACH: f32 = 0.005;
@@ -77,8 +78,8 @@ const FINGER_STICKY_REACH: f32 = 0.005;
 /// the penalty contact's friction the rope slid off the rod towards its heavier side).
 pub const ROD_STICKY_REACH: f32 = 0.005;
 /// Distance (m) between the finger links above which the fingers let go of the rope: the
-/// start's 8 mm opened by 2 mm per finger.
-const FINGER_RELEASE_DISTANCE: f32 = 0.012;
+/// start's 20 mm opened by 2 mm per finger.
+const FINGER_RELEASE_DISTANCE: f32 = 0.024;
 /// Floats of task state before the particles.
 const STATE_HEADER: usize = 10;
 
@@ -302,7 +303,8 @@ impl Task for Hang {
         Ok(())
     }
 
-    /// ManiSkill2's Hang start: base at (−0.46, 0, 0), [`ARM_START`], fingertips 8 mm apart.
+    /// ManiSkill2's Hang start: base at (−0.46, 0, 0), [`ARM_START`], fingertip pads 20 mm
+    /// apart ([`START_FINGER_QPOS`]).
     fn initialize_agent(
         &mut self,
         scene: &mut TaskScene,
@@ -317,8 +319,8 @@ impl Task for Hang {
 
     fn initialize_task(&mut self, scene: &TaskScene, rng: &mut EpisodeRng) -> Result<(), EnvError> {
         let world = scene.world.as_ref();
-        // Whole lattice spacings along the rope, so that the fingertips' slots cut the same
-        // particles whatever the draw (the observation space fixes the particle count).
+        // Whole lattice spacings along the rope, so that every draw samples the same particles
+        // (the observation space fixes the particle count).
         let steps = ((GRASP_ARC.1 - GRASP_ARC.0) / ROPE_SPACING).round() as u32;
         self.grasp_arc = GRASP_ARC.0 + ROPE_SPACING * rng.random_range(0..=steps) as f32;
         let start = RopeStart::new(&self.pinch(world)?, self.grasp_arc);

@@ -8,10 +8,11 @@
 //! fifth of its length from one end; ms2 builds that start instead ([`RopeStart`]): the rope's
 //! straight rest shape bent ([`ms2_mpm::bent_bar`]) so that its grasp point lies on the
 //! fingertips, its short end hanging towards −x and its long end curving down to the ground and
-//! lying on it towards +x. The fingertips sit in slots of the rope (no particles inside the
-//! fingers), the rope's upper part resting on them: ms2's coupling is a penalty contact with
-//! friction applied to the particles that touch a body, which holds a load by normal forces,
-//! not by squeezing (ManiSkill2's sticky grid contact holds a pinched rope).
+//! lying on it towards +x. The rope is pinched as in ManiSkill2's recorded starts: its
+//! cross-section lies between the two fingertip pads, one pad along each side face, and the
+//! fingers' sticky grid contact holds it while the gripper is closed; opening the gripper moves
+//! both pads away from it. (Until 2026-11-28 the fingertips sat in slots cut through the rope,
+//! which then wrapped around an open fingertip and stayed hooked on it.)
 
 use glam::{Mat3, Vec3};
 use ms2_mpm::bent_bar::{BentBar, CurvePiece};
@@ -167,10 +168,10 @@ impl Pinch {
         })
     }
 
-    /// Where the rope's centreline crosses the pinch: its top part above the fingertips (where
-    /// the fingers widen), resting on them, its bottom part between them.
+    /// Where the rope's centreline crosses the pinch: midway between the fingertip pads, so
+    /// that the rope's cross-section lies between them, one pad on either side of it.
     pub fn rope_centre(&self) -> Vec3 {
-        self.centre + Vec3::Z * (self.pad_half_height + 0.002)
+        self.centre
     }
 }
 
@@ -182,7 +183,7 @@ pub struct RopeStart {
     /// Arc length (m) of the grasp point from the short end.
     pub grasp_arc: f32,
     /// The fingers' boxes: particles inside them (or within a third of a spacing) are left
-    /// out, so the fingertips sit in slots of the rope.
+    /// out (none at `Hang-v0`'s start opening, where the pads frame the rope).
     pub fingers: Vec<WorldBox>,
 }
 
@@ -248,8 +249,8 @@ impl RopeStart {
         jitter_seed: u64,
     ) -> Result<[ParticleId; 5], SoftSceneError> {
         let mut p = self.bar.sample(ROPE_SPACING);
-        // The slots are cut from the lattice before the jitter, so that every seed keeps the
-        // same particles (the observation space fixes the count).
+        // Particles inside a finger are cut from the lattice before the jitter, so that every
+        // seed keeps the same particles (the observation space fixes the count).
         let keep: Vec<bool> = p
             .positions
             .iter()
