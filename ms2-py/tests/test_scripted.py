@@ -13,7 +13,7 @@ EPISODES = 10
 SOFT_EPISODES = 5
 #: Fewer still where an episode takes minutes: Write-v0 (17,640 particles, about a minute to
 #: its success; 50/50 on seeds 0-49 with the Rust example) and Pour-v0 (10,548 water particles,
-#: 3/3 on seeds 0-2; docs/tasks.md).
+#: 3-6 minutes an episode; its rate over more seeds with the Rust example, docs/tasks.md).
 EPISODES_OF = {"Write-v0": 2, "Pour-v0": 2}
 MIN_SUCCESS_RATE = 0.8
 #: Tasks whose scripted policy is measured in another mode than the preferred one: the
@@ -22,8 +22,8 @@ SCRIPTED_MODE = {"PandaAvoidObstacles-v0": "pd_joint_delta_pos"}
 #: Known failures, documented in docs/tasks.md: PickSingleYCB-v0 (6/10 on seeds 0-9 since
 #: every reset rebuilds the scene: wide bowls, long tools; issue #16), PickClutterYCB-v0
 #: (20/30 on seeds 0-29 in pd_ee_delta_pose: neighbours in the way of its top-down grasp;
-#: issue #16), Hang-v0 (not solved yet: the rope stays on the sticky rod after the release,
-#: but its short end stays hooked on an open fingertip; issue #20; an episode takes minutes,
+#: issue #16), Hang-v0 (not solved yet: the pinched rope is laid on the sticky rod only ~40 %
+#: along its length and slides off after the release; issue #20; an episode takes minutes,
 #: so it is not run).
 KNOWN_FAILING = {"PickSingleYCB-v0", "PickClutterYCB-v0", "Hang-v0"}
 #: Solved but too slow for this suite, measured with the Rust examples instead (docs/tasks.md).
