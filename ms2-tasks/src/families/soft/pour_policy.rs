@@ -1,16 +1,18 @@
 //! `Pour-v0`'s scripted (oracle) policy: grasp the bottle, carry it over the beaker, tilt it
 //! closed loop on the water that left it, turn it upright, hold still.
 //!
-//! The hand tilts the bottle about its approach axis (the Panda's last joint turns it), so
-//! the mouth swings sideways towards the beaker; the TCP is placed so that the mouth is over
+//! The hand tilts the bottle about its approach axis (the Panda's last joint turns it, in the
+//! direction that leaves that joint [`MIN_WRIST_RANGE`]), so the mouth swings sideways towards
+//! the beaker; the TCP is placed so that the mouth is over
 //! the beaker's centre when the bottle lies flat. The tilt grows while the outflow is below
-//! [`TARGET_FLOW`] particles per step and holds while it is above (it backs off while the TCP
+//! [`TARGET_FLOW`] particles per step ([`FINAL_FLOW`] once the band holds [`NEAR_BAND`]) and
+//! holds while it is above (it backs off while the outflow is twice the target or the TCP
 //! is more than [`MAX_TCP_ERROR`] from its target); the bottle turns back
 //! upright once the band above the line holds [`MIN_ABOVE_LINE`] particles, or once the water
 //! that left it, plus [`LAG_STEPS`] steps of the current outflow, reaches the particle count
 //! of the level [`AIM_ABOVE_LINE`] above the line (the beaker's area times that height over a
 //! particle's volume). If the settled level is still below
-//! the line, it pours again.
+//! the line, it pours again, and that top-up returns at [`TOP_UP_MARGIN`] more in the band.
 
 use glam::{Vec2, Vec3};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
