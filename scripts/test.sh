@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up a fresh machine (scripts/setup.sh) and runs every test: Rust (the workspace, release
 # profile, sharing target/ with the maturin build setup.sh made) and Python (ruff + pytest), after
-# the style gates CI enforces: rustfmt and clippy with warnings as errors. It starts with the
+# the style gates CI enforces: rustfmt, clippy and rustdoc with warnings as errors. It starts with the
 # repository hygiene check (no tracked build artefacts) and ends with `cargo package` of every
 # library crate (scripts/check_packages.sh).
 set -euo pipefail
@@ -37,6 +37,8 @@ fi
 echo "[test] cargo fmt --check and clippy (workspace, all targets, warnings are errors)"
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
+echo "[test] cargo doc (workspace crates, broken intra-doc links are errors)"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --workspace --exclude ms2-py
 echo "[test] ms2-physics without its rapier engine (--no-default-features: the engine-neutral vocabulary)"
 cargo clippy -p ms2-physics --no-default-features --all-targets -- -D warnings
 echo "[test] cargo test (workspace, release profile)"

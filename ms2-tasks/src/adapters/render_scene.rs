@@ -1,4 +1,4 @@
-//! [`WorldRenderScene`]: an ms2-physics [`World`] seen as an [`ms2_render::Scene`].
+//! [`WorldRenderScene`]: an ms2-physics [`World`](ms2_physics::World) seen as an [`ms2_render::Scene`].
 //!
 //! Every visual shape of every actor and articulation link becomes one render instance; per
 //! frame only poses are copied ([`WorldRenderScene::sync_poses`]). Particle sets (a soft body's
@@ -307,7 +307,7 @@ pub struct SegmentedObject {
     pub articulation: Option<ArticulationId>,
 }
 
-/// A render [`Scene`] mirroring a physics [`World`]'s visual shapes.
+/// A render [`Scene`] mirroring a physics [`World`](ms2_physics::World)'s visual shapes.
 #[derive(Debug)]
 pub struct WorldRenderScene {
     scene: Scene,

@@ -3,7 +3,7 @@
 //!
 //! A holonomic base on dummy joints fixed to the world (x, y, yaw), a lift, and one or two
 //! Pandas ([`ms2_assets::mobile_panda`]); the Panda links carry the real Panda's meshes when
-//! [`super::panda_model`] is the real one. Controllers: ManiSkill2's `base_pd_joint_vel`
+//! [`super::panda_model()`] is the real one. Controllers: ManiSkill2's `base_pd_joint_vel`
 //! (ego-centric base velocities) combined with each arm's mode and a mimic gripper per arm
 //! ([`ms2_control::RobotConfig::mobile_panda`]); modes are named `base_pd_joint_vel_arm_<mode>`.
 //! Cameras: three `overhead_camera_<i>` on `mobile_base`, 1.5 m up, 400×160, fov π/3, looking

@@ -75,7 +75,7 @@ pub struct ReplayedEpisode {
 ///   states); a conversion re-simulates the source episode in a second env to read the source
 ///   robot's joint positions at every step, so it costs about twice the simulation.
 /// * Another control mode: closed-loop conversion. At each source step `t` the source action's
-///   desired joint targets `q̄_src(t)` are computed (see [`SourceJointTargets`]); the target
+///   desired joint targets `q̄_src(t)` are computed (see `SourceJointTargets`); the target
 ///   controller then gets the action that makes its drive targets reproduce `q̄_src(t)` *from
 ///   the target env's current state* (`CombinedController::action_for_joint_targets`, e.g.
 ///   `T_a = T⁻¹ · FK(q̄_src)` for `pd_ee_delta_pose`). When the action saturates or IK fails,

@@ -1,7 +1,7 @@
 //! The task families, one folder each. A family folder holds its tasks' [`crate::Task`] impls,
 //! their [`crate::spec::TaskSpec`]s, scripted policies and motion-planning solutions, and one
 //! `register` function; this module calls each family's `register` once. Adding a family is a
-//! folder plus its line in [`register_builtin`] (and its `mod` line); nothing else in the crate
+//! folder plus its line in `register_builtin` (and its `mod` line); nothing else in the crate
 //! names an env id. See docs/architecture.md, "How to add a task".
 //!
 //! | family | tasks | feature |

@@ -4,8 +4,8 @@
 //! - `rgbd`: `{"agent", "extra", "camera_param": {cam: {"extrinsic_cv" [3,4],
 //!   "cam2world_gl" [4,4], "intrinsic_cv" [3,3]}}, "image": {cam: {"rgb" u8 [H,W,3],
 //!   "depth" f32 [H,W,1] (metres, 0 = nothing seen)}}}`; `rgbd_robot_seg` adds
-//!   `image[cam]["robot_seg"]` bool [H,W,1]; a camera with `add_segmentation` adds
-//!   `image[cam]["Segmentation"]` u32 [H,W,4].
+//!   `image[cam]["robot_seg"]` bool `[H,W,1]`; a camera with `add_segmentation` adds
+//!   `image[cam]["Segmentation"]` u32 `[H,W,4]`.
 //! - `image` (ManiSkill2's raw textures, from which its `rgbd` and `pointcloud` are derived):
 //!   as `rgbd` but `image[cam]` = `{"Color" f32 [H,W,4] (RGBA in [0, 1], alpha 1),
 //!   "Position" f32 [H,W,4] (x, y, z in the camera's OpenGL frame: x right, y up, looking
@@ -15,7 +15,7 @@
 //! - `pointcloud`: `{"agent", "extra", "pointcloud": {"xyzw" f32 [N,4] (world frame; w = 1 for
 //!   points on a surface, all zeros for background), "rgb" u8 [N,3], "Segmentation" u32 [N,4]}}`,
 //!   N = the sum of H·W over cameras (camera order, then row-major); `pointcloud_robot_seg`
-//!   adds `pointcloud["robot_seg"]` bool [N,1].
+//!   adds `pointcloud["robot_seg"]` bool `[N,1]`.
 //! - `Segmentation` channels: 0 = visual-shape id, 1 = actor/link id (see
 //!   [`crate::adapters::render_scene`]), 2 and 3 = 0 (as in ManiSkill2).
 //! - [`VisualLayout`] is plain data (every build); [`CameraFrame`] and [`assemble`] need the

@@ -4,9 +4,9 @@
 //! angle. Privileged: it reads the task's handle (surface samples), joint axis and link pose.
 //!
 //! Placement: in the plane normal to the joint axis, the closed fingers (2.2 cm × 5.2 cm seen
-//! from above, tips 9.5 mm past the TCP) fit in a circle of [`FINGER_RADIUS`]; the search takes
+//! from above, tips 9.5 mm past the TCP) fit in a circle of `FINGER_RADIUS`; the search takes
 //! the smallest push radius (most overlap with the arm) at which that circle, a little behind
-//! the arm, keeps [`CLEARANCE`] from every handle point at or above the fingertips' height. The
+//! the arm, keeps `CLEARANCE` from every handle point at or above the fingertips' height. The
 //! fingertips go to 30 % of the arm's height band.
 
 use nalgebra::{Point3, Unit, UnitQuaternion, Vector3};

@@ -9,14 +9,14 @@
 //!
 //! 1. `Prepare`: the lift to [`GRASP_LIFT`], the arms to the pre-grasp posture (the IK
 //!    solution for the hands [`PREGRASP_HEIGHT`] above the rim points, seen from the staging
-//!    pose), the base to [`PREPARE_DISTANCE`] from the bucket, facing it at the chosen yaw.
-//! 2. `Align`: the base to the staging pose, [`STAGING_DISTANCE`] from the bucket.
-//! 3. `Descend`: the hands down onto the rim (IK over the arms, the base held).
-//! 4. `Close`: the grippers close.
-//! 5. `Lift`: the arms keep their joints; the lift rises by [`LIFT_RAISE`].
-//! 6. `Carry`: the base drives (same yaw, speeding up gently) so that the bucket's root stops
+//!    pose), the base to the staging pose, [`STAGING_DISTANCE`] from the bucket, facing it at
+//!    the chosen yaw.
+//! 2. `Descend`: the hands down onto the rim (IK over the arms, the base held).
+//! 3. `Close`: the grippers close.
+//! 4. `Lift`: the arms keep their joints; the lift rises by [`LIFT_RAISE`].
+//! 5. `Carry`: the base drives (same yaw, speeding up gently) so that the bucket's root stops
 //!    [`CARRY_SHORT`] before the goal.
-//! 7. `Lower`: the lift goes down until the bucket stands on the platform; then `Hold`.
+//! 6. `Lower`: the lift goes down until the bucket stands on the platform; then `Hold`.
 //!
 //! A grasp that slips while lifting or carrying (the bucket lags the lift by over
 //! [`DROP_MARGIN`] or tips past 0.35 rad) is let go (`Release`: gripper open, hands up) and

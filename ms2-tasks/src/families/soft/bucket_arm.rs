@@ -4,7 +4,7 @@
 //!
 //! [`BucketArm`] holds what `Excavate-v0` and `Fill-v0` share: the coupled [`SoftWorld`],
 //! the bucket's pose, the soft substeps after each physics step, the `particles` observation,
-//! the clay as the cameras draw it ([`BucketArm::clay_visual`]) and the particle part of the
+//! the clay as the cameras draw it ([`BucketArm::drawn_as`] sets their name and colour) and the particle part of the
 //! task state. A task is then its episode data plus hooks.
 
 use glam::{Mat3, Vec2, Vec3};

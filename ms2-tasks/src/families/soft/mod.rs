@@ -8,7 +8,7 @@
 //! scene); [`excavate`] and [`fill`] the tasks' hooks; [`scripted`] their oracle policies.
 //! [`hang_scene`] is Hang's rope, rod and success terms, [`hang`] its hooks (on the same
 //! base, coupled to the fingers and the rod), [`hang_policy`] its oracle. [`write_targets`] is
-//! Write's characters, goals and IoU, [`write`] its hooks (on the same base, the clay coupled
+//! Write's characters, goals and IoU, [`mod@write`] its hooks (on the same base, the clay coupled
 //! to the stick), [`write_policy`] its oracle. [`pinch`] is Pinch's hooks (the plasticine
 //! coupled to the fingers), [`pinch_scene`] the block and the level generator, [`pinch_plan`]
 //! the pinch sequences, [`pinch_level`] the levels and their cache, [`chamfer`] the shape

@@ -102,12 +102,12 @@ impl BucketPlan for ScriptedScoop {
 
 /// Bucket waypoints of the scripted pour: lift, turn the open front sideways (towards the
 /// robot's centre line) while carrying the lip over the beaker, lower it, tilt the opening
-/// down about the lip, hold. The lip stops [`POUR_LIP_BACK`] short of the pour point and
-/// [`POUR_LIP_DROP`] below it: poured from the pour point itself at 2 kHz, a quarter of the
+/// down about the lip, hold. The lip stops `POUR_LIP_BACK` short of the pour point and
+/// `POUR_LIP_DROP` below it: poured from the pour point itself at 2 kHz, a quarter of the
 /// clay (flung along the open front) landed beyond the beaker's far wall.
 ///
 /// The turn keeps the pour within the Panda's reach: the bucket hangs 20 cm below the hand,
-/// so tilting it by [`POUR_PITCH`] swings the hand 19 cm along the open front. Tilted
+/// so tilting it by `POUR_PITCH` swings the hand 19 cm along the open front. Tilted
 /// forward (along world +x, the bucket's heading at rest) that put the hand beyond the
 /// Panda's reach over the beaker; IK then failed and the bucket drifted back towards the
 /// robot in `pd_ee_delta_pose`. Sideways the hand stays about 70 cm from the robot's base.
