@@ -13,7 +13,10 @@
 //!   env step timed. A vector step lasts as long as its slowest env's (every env must finish
 //!   before the batch of observations returns), so with one env per core the best possible
 //!   ratio is `num_envs · mean(step) / mean(max over the envs of step)`, whatever the threading.
-//!   The spread of single-step costs (contacts come and go under random actions) sets it.
+//!   The spread of single-step costs (contacts come and go under random actions) sets it;
+//! - the threaded loop's breakdown: per vector step, its wall time, its slowest env's own step
+//!   (against the lockstep's: the envs slowing each other down), when the last env started
+//!   (waking a worker) and how long the return took after the last env ended.
 //!
 //! Run it on an idle machine: the threaded row needs the cores to itself.
 
@@ -22,6 +25,7 @@ use std::time::Instant;
 use ms2_tasks::seeding::episode_rng;
 use ms2_tasks::{make_env, EnvCommand, EnvConfig, EnvError, EpisodeRng, VecEnv};
 use rand::Rng;
+use rayon::prelude::*;
 
 fn random_action(rng: &mut EpisodeRng, dim: usize) -> Vec<f32> {
     (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect()
@@ -110,6 +114,44 @@ fn main() -> Result<(), EnvError> {
         }
     }
     let vector = (rounds * num_envs) as f64 / t.elapsed().as_secs_f64();
+    drop(vec_env);
+
+    // The same threaded loop (rayon, one env per task, as `VecEnv` runs them), each env's
+    // step timed inside its task: where a vector step's time goes beyond its slowest env.
+    let mut envs = (0..num_envs)
+        .map(|_| make_env(&cfg))
+        .collect::<Result<Vec<_>, _>>()?;
+    for (i, env) in envs.iter_mut().enumerate() {
+        env.reset(Some(i as u64), false)?;
+    }
+    let mut rng = episode_rng(2);
+    let (mut sum_vector, mut sum_slowest, mut sum_skew, mut sum_tail) = (0.0, 0.0, 0.0, 0.0);
+    for _ in 0..rounds {
+        let actions: Vec<Vec<f32>> = (0..num_envs)
+            .map(|_| random_action(&mut rng, dim))
+            .collect();
+        let start = Instant::now();
+        // Per env: (start of its step, end of its step), seconds after `start`.
+        let spans = envs
+            .par_iter_mut()
+            .zip(actions.par_iter())
+            .map(|(env, action)| {
+                let begin = start.elapsed().as_secs_f64();
+                let out = env.step(action)?;
+                if out.terminated || out.truncated {
+                    env.reset(None, false)?;
+                }
+                Ok((begin, start.elapsed().as_secs_f64()))
+            })
+            .collect::<Result<Vec<(f64, f64)>, EnvError>>()?;
+        let total = start.elapsed().as_secs_f64();
+        let last_end = spans.iter().map(|s| s.1).fold(0.0, f64::max);
+        sum_vector += total;
+        sum_slowest += spans.iter().map(|s| s.1 - s.0).fold(0.0, f64::max);
+        sum_skew += spans.iter().map(|s| s.0).fold(0.0, f64::max);
+        sum_tail += total - last_end;
+    }
+    let per_round = |sum: f64| 1e6 * sum / rounds as f64;
 
     println!(
         "{env_id} {mode}, {} threads: single {single:.0} env steps/s; VecEnv({num_envs}) \
@@ -119,6 +161,15 @@ fn main() -> Result<(), EnvError> {
         vector / single,
         1e6 * sum_mean / rounds as f64,
         1e6 * sum_max / rounds as f64,
+    );
+    println!(
+        "  threaded breakdown (mean per vector step): {:.0} µs in all; slowest env's own step {:.0} µs (lockstep: {:.0}); last env \
+         started {:.0} µs after the call; {:.0} µs from the last env's end to the return",
+        per_round(sum_vector),
+        per_round(sum_slowest),
+        1e6 * sum_max / rounds as f64,
+        per_round(sum_skew),
+        per_round(sum_tail),
     );
     Ok(())
 }
