@@ -1310,6 +1310,7 @@ impl Multibody {
                 solver_vel2: self.solver_id,
                 ndofs2: ndofs,
                 j_id2: j_id,
+                unit_jacobian2: u32::MAX,
                 joint_id: usize::MAX, // internal: no impulse writeback.
                 impulse: 0.0,
                 impulse_bounds: [-Real::MAX, Real::MAX],

@@ -85,6 +85,7 @@ pub(crate) fn unit_joint_limit_constraint_impl(
         solver_vel2: multibody.solver_id,
         ndofs2: ndofs,
         j_id2: *j_id,
+        unit_jacobian2: (link.assembly_id + dof_id) as u32,
         joint_id: usize::MAX, // TODO: we don’t support impulse writeback for internal constraints yet.
         impulse: 0.0,
         impulse_bounds,
@@ -170,6 +171,7 @@ pub(crate) fn unit_joint_friction_constraint_impl(
         solver_vel2: multibody.solver_id,
         ndofs2: ndofs,
         j_id2: *j_id,
+        unit_jacobian2: (link.assembly_id + dof_id) as u32,
         joint_id: usize::MAX, // TODO: we don’t support impulse writeback for internal constraints yet.
         impulse: 0.0,
         impulse_bounds: [-max_impulse, max_impulse],
@@ -271,6 +273,7 @@ pub(crate) fn unit_joint_motor_constraint_impl(
         solver_vel2: multibody.solver_id,
         ndofs2: ndofs,
         j_id2: *j_id,
+        unit_jacobian2: (link.assembly_id + dof_id) as u32,
         joint_id: usize::MAX, // TODO: we don’t support impulse writeback for internal constraints yet.
         impulse: 0.0,
         impulse_bounds,

@@ -17,6 +17,10 @@ pub struct GenericJointConstraint {
     pub j_id1: usize,
     pub ndofs2: usize,
     pub j_id2: usize,
+    /// `u32::MAX`, or the index `i` if the side-2 Jacobian (at `j_id2`) is the unit vector
+    /// `e_i` and there is no side 1 (`ndofs1 == 0`): a motor, limit or friction constraint
+    /// on one generalized coordinate of a multibody. Its `J · v` is then read as `v[i]`.
+    pub unit_jacobian2: u32,
 
     pub joint_id: JointIndex,
 
@@ -48,6 +52,7 @@ impl GenericJointConstraint {
             j_id1: usize::MAX,
             ndofs2: usize::MAX,
             j_id2: usize::MAX,
+            unit_jacobian2: u32::MAX,
             joint_id: usize::MAX,
             impulse: 0.0,
             impulse_bounds: [-Real::MAX, Real::MAX],
@@ -278,7 +283,15 @@ impl GenericJointConstraint {
         let (j2, wj2) = jacobians[self.j_id2..self.j_id2 + 2 * self.ndofs2].split_at(self.ndofs2);
 
         let vel1 = dot_in_nalgebra_order(j1, self.solver_vel1(solver_vels, generic_solver_vels));
-        let vel2 = dot_in_nalgebra_order(j2, self.solver_vel2(solver_vels, generic_solver_vels));
+        let solver_vel2 = self.solver_vel2(solver_vels, generic_solver_vels);
+        let vel2 = if self.unit_jacobian2 == u32::MAX {
+            dot_in_nalgebra_order(j2, solver_vel2)
+        } else {
+            // `e_i · v` in nalgebra's order sums `+0.0`, `1 · v[i]` and products `0 · v[k]`
+            // (`±0` for a finite `v[k]`): `v[i]`, except that `-0` comes out as `+0`, as
+            // here. (An infinite or NaN velocity would make nalgebra's sum NaN.)
+            solver_vel2[self.unit_jacobian2 as usize] + 0.0
+        };
 
         let dvel = self.rhs + (vel2 - vel1);
         let total_impulse = na::clamp(
