@@ -278,29 +278,30 @@ impl GenericJointConstraint {
         generic_solver_vels: &mut DVector,
     ) {
         let jacobians = jacobians.as_slice();
+
+        if self.unit_jacobian2 != u32::MAX && self.ndofs1 == 0 && !self.is_rigid_body2 {
+            // A constraint on one coordinate of a multibody (the common case): no side 1,
+            // whose empty dot product would be `+0.0` and whose axpy would do nothing.
+            let start = self.solver_vel2 as usize;
+            let solver_vel2 = &mut generic_solver_vels.as_mut_slice()[start..start + self.ndofs2];
+            let wj2 = &jacobians[self.j_id2 + self.ndofs2..self.j_id2 + 2 * self.ndofs2];
+            let vel1: Real = 0.0;
+            // `e_i · v` in nalgebra's order sums `+0.0`, `1 · v[i]` and products `0 · v[k]`
+            // (`±0` for a finite `v[k]`): `v[i]`, except that `-0` comes out as `+0`, as
+            // here. (An infinite or NaN velocity would make nalgebra's sum NaN.)
+            let vel2 = solver_vel2[self.unit_jacobian2 as usize] + 0.0;
+            let delta_impulse = self.update_impulse(vel2 - vel1);
+            axpy_in_nalgebra_order(solver_vel2, -delta_impulse, wj2);
+            return;
+        }
+
         // Each side's Jacobian (`ndofs` values at `j_id`) is followed by its weighted Jacobian.
         let (j1, wj1) = jacobians[self.j_id1..self.j_id1 + 2 * self.ndofs1].split_at(self.ndofs1);
         let (j2, wj2) = jacobians[self.j_id2..self.j_id2 + 2 * self.ndofs2].split_at(self.ndofs2);
 
         let vel1 = dot_in_nalgebra_order(j1, self.solver_vel1(solver_vels, generic_solver_vels));
-        let solver_vel2 = self.solver_vel2(solver_vels, generic_solver_vels);
-        let vel2 = if self.unit_jacobian2 == u32::MAX {
-            dot_in_nalgebra_order(j2, solver_vel2)
-        } else {
-            // `e_i · v` in nalgebra's order sums `+0.0`, `1 · v[i]` and products `0 · v[k]`
-            // (`±0` for a finite `v[k]`): `v[i]`, except that `-0` comes out as `+0`, as
-            // here. (An infinite or NaN velocity would make nalgebra's sum NaN.)
-            solver_vel2[self.unit_jacobian2 as usize] + 0.0
-        };
-
-        let dvel = self.rhs + (vel2 - vel1);
-        let total_impulse = na::clamp(
-            self.impulse + self.inv_lhs * (dvel - self.cfm_gain * self.impulse),
-            self.impulse_bounds[0],
-            self.impulse_bounds[1],
-        );
-        let delta_impulse = total_impulse - self.impulse;
-        self.impulse = total_impulse;
+        let vel2 = dot_in_nalgebra_order(j2, self.solver_vel2(solver_vels, generic_solver_vels));
+        let delta_impulse = self.update_impulse(vel2 - vel1);
 
         axpy_in_nalgebra_order(
             self.solver_vel1_mut(solver_vels, generic_solver_vels),
@@ -312,6 +313,21 @@ impl GenericJointConstraint {
             -delta_impulse,
             wj2,
         );
+    }
+
+    /// The projected Gauss-Seidel update of the impulse, given the constraint velocity
+    /// `J₂ v₂ − J₁ v₁`; returns the impulse change.
+    #[inline(always)]
+    fn update_impulse(&mut self, relative_vel: Real) -> Real {
+        let dvel = self.rhs + relative_vel;
+        let total_impulse = na::clamp(
+            self.impulse + self.inv_lhs * (dvel - self.cfm_gain * self.impulse),
+            self.impulse_bounds[0],
+            self.impulse_bounds[1],
+        );
+        let delta_impulse = total_impulse - self.impulse;
+        self.impulse = total_impulse;
+        delta_impulse
     }
 
     pub fn writeback_impulses(&self, joints_all: &mut [JointGraphEdge]) {
@@ -408,5 +424,85 @@ pub(crate) fn axpy_in_nalgebra_order(y: &mut [Real], alpha: Real, x: &[Real]) {
     assert_eq!(y.len(), x.len(), "axpy on vectors of different lengths");
     for (y, x) in y.iter_mut().zip(x) {
         *y += alpha * *x;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::vec::Vec;
+    use na::{DVectorView, DVectorViewMut};
+
+    /// A deterministic pseudo-random value in [-1, 1), with exact zeros of both signs now and
+    /// then.
+    fn value(seed: &mut u64) -> Real {
+        *seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let v = ((*seed >> 40) as Real / (1u64 << 24) as Real) * 2.0 - 1.0;
+        match (*seed >> 20) % 11 {
+            0 => 0.0,
+            1 => -0.0,
+            _ => v,
+        }
+    }
+
+    fn values(seed: &mut u64, n: usize) -> Vec<Real> {
+        (0..n).map(|_| value(seed)).collect()
+    }
+
+    #[test]
+    fn generic_joint_constraint_kernels_match_nalgebra_bit_for_bit() {
+        let mut seed = 7;
+        for n in 0..=20 {
+            for _ in 0..50 {
+                let a = values(&mut seed, n);
+                let b = values(&mut seed, n);
+                let expected = DVectorView::from_slice(&a, n).dot(&DVectorView::from_slice(&b, n));
+                assert_eq!(
+                    dot_in_nalgebra_order(&a, &b).to_bits(),
+                    expected.to_bits(),
+                    "dot, n = {n}"
+                );
+
+                let alpha = value(&mut seed);
+                let mut y = values(&mut seed, n);
+                let mut expected = y.clone();
+                DVectorViewMut::from_slice(&mut expected, n).axpy(
+                    alpha,
+                    &DVectorView::from_slice(&a, n),
+                    1.0,
+                );
+                axpy_in_nalgebra_order(&mut y, alpha, &a);
+                let bits = |v: &[Real]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&y), bits(&expected), "axpy, n = {n}");
+            }
+        }
+    }
+
+    /// What `solve` relies on for a unit-vector Jacobian `e_i`: nalgebra's `e_i · v` is
+    /// `v[i] + 0.0` for finite `v`, zeros of either sign included.
+    #[test]
+    fn unit_jacobian_dot_is_the_coordinate_plus_zero() {
+        let mut seed = 11;
+        for n in 1..=20 {
+            for i in 0..n {
+                for _ in 0..20 {
+                    let mut v = values(&mut seed, n);
+                    if seed % 3 == 0 {
+                        v[i] = if seed % 2 == 0 { -0.0 } else { 0.0 };
+                    }
+                    let mut e = alloc::vec![0.0; n];
+                    e[i] = 1.0;
+                    let expected =
+                        DVectorView::from_slice(&e, n).dot(&DVectorView::from_slice(&v, n));
+                    assert_eq!(
+                        (v[i] + 0.0).to_bits(),
+                        expected.to_bits(),
+                        "n = {n}, i = {i}"
+                    );
+                }
+            }
+        }
     }
 }
