@@ -262,6 +262,8 @@ impl Multibody {
     }
 
     pub(crate) fn append(&mut self, mut rhs: Multibody, parent: usize, joint: MultibodyJoint) {
+        // A new structure: its kinematics must be recomputed.
+        self.workspace.forward_kinematics_inputs.clear();
         let joint_ndofs = joint.ndofs();
         let rhs_root_ndofs = rhs.links[0].joint.ndofs();
         let ndofs_before_append = self.velocities.len();
@@ -446,6 +448,8 @@ impl Multibody {
         dof: MultibodyJoint,
         body: RigidBodyHandle,
     ) -> &mut MultibodyLink {
+        // A new structure: its kinematics must be recomputed.
+        self.workspace.forward_kinematics_inputs.clear();
         assert!(
             parent.is_none() || !self.links.is_empty(),
             "Multibody::build_body: invalid parent id."
@@ -1559,6 +1563,67 @@ impl Multibody {
          * Compute body jacobians.
          */
         self.update_body_jacobians();
+
+        let mut inputs = core::mem::take(&mut self.workspace.forward_kinematics_inputs);
+        self.forward_kinematics_inputs(bodies, &mut inputs);
+        self.workspace.forward_kinematics_inputs = inputs;
+    }
+
+    /// [`Self::forward_kinematics`] reading the root pose from its rigid-body, skipped when
+    /// none of its inputs changed since the last forward kinematics of this multibody: then
+    /// it would recompute, bit for bit, the link poses, shifts and body Jacobians it already
+    /// holds (only forward kinematics writes them). The physics pipeline calls this at the
+    /// start of every step, right after the previous step ended with forward kinematics.
+    pub(crate) fn forward_kinematics_if_changed(&mut self, bodies: &RigidBodySet) {
+        // The root pose (and type) is an input: take it first, as forward kinematics does.
+        self.update_root_type(bodies, true);
+        let mut inputs = core::mem::take(&mut self.workspace.forward_kinematics_scratch);
+        self.forward_kinematics_inputs(bodies, &mut inputs);
+        let unchanged = !inputs.is_empty() && inputs == self.workspace.forward_kinematics_inputs;
+        self.workspace.forward_kinematics_scratch = inputs;
+        if !unchanged {
+            self.forward_kinematics(bodies, true);
+        }
+    }
+
+    /// Everything [`Self::forward_kinematics`] reads, as bits, into `out`: the structure
+    /// (links, parents, dofs, rigid-bodies and their types), each joint's frames, locked axes,
+    /// coordinates and rotation, and each link body's center of mass. Empty in 2D (never
+    /// equal: forward kinematics always runs there).
+    fn forward_kinematics_inputs(&self, bodies: &RigidBodySet, out: &mut Vec<u64>) {
+        out.clear();
+        #[cfg(feature = "dim3")]
+        {
+            fn push(out: &mut Vec<u64>, values: &[Real]) {
+                out.extend(values.iter().map(|v| u64::from(v.to_bits())));
+            }
+            out.extend([self.ndofs as u64, self.links.len() as u64]);
+            for link in self.links.iter() {
+                let (index, generation) = link.rigid_body.into_raw_parts();
+                let joint = &link.joint;
+                out.extend([
+                    u64::from(index),
+                    u64::from(generation),
+                    link.parent_internal_id as u64,
+                    link.assembly_id as u64,
+                    u64::from(joint.data.locked_axes.bits()),
+                ]);
+                let (frame1, frame2) = (&joint.data.local_frame1, &joint.data.local_frame2);
+                push(out, &frame1.rotation.to_array());
+                push(out, &frame1.translation.to_array());
+                push(out, &frame2.rotation.to_array());
+                push(out, &frame2.translation.to_array());
+                push(out, joint.coords.as_slice());
+                push(out, &joint.joint_rot.to_array());
+                match bodies.get(link.rigid_body) {
+                    Some(rb) => {
+                        push(out, &rb.mprops.local_mprops.local_com.to_array());
+                        out.push(rb.body_type as u64);
+                    }
+                    None => out.push(u64::MAX),
+                }
+            }
+        }
     }
 
     /// Computes the ids of all the links between the root and the link identified by `link_id`.
