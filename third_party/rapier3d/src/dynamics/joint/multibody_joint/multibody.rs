@@ -23,6 +23,26 @@ use na::{
 #[cfg(doc)]
 use crate::prelude::{GenericJoint, RigidBody};
 
+/// A copy of the leading `dim × dim` block of `m`, column slice by column slice (what
+/// `m.view((0, 0), (dim, dim)).into_owned()` returns, without its element-by-element
+/// iteration over the view).
+fn leading_square_block(m: &DMatrix<Real>, dim: usize) -> DMatrix<Real> {
+    let nrows = m.nrows();
+    assert!(dim <= nrows && dim <= m.ncols());
+    if dim == nrows && dim == m.ncols() {
+        return m.clone();
+    }
+    let mut block = DMatrix::zeros(dim, dim);
+    for (j, column) in block
+        .as_mut_slice()
+        .chunks_exact_mut(dim.max(1))
+        .enumerate()
+    {
+        column.copy_from_slice(&m.as_slice()[j * nrows..j * nrows + dim]);
+    }
+    block
+}
+
 #[repr(C)]
 #[derive(Copy, Clone, Debug, Default)]
 struct Force {
@@ -1169,16 +1189,12 @@ impl Multibody {
             .rearrange_rows(&mut self.augmented_mass, true);
 
         // TODO: avoid allocation inside LU at each timestep.
-        self.acc_inv_augmented_mass = LU::new(
-            self.acc_augmented_mass
-                .view((0, 0), (effective_dim, effective_dim))
-                .into_owned(),
-        );
-        self.inv_augmented_mass = LU::new(
-            self.augmented_mass
-                .view((0, 0), (effective_dim, effective_dim))
-                .into_owned(),
-        );
+        self.acc_inv_augmented_mass = LU::new(leading_square_block(
+            &self.acc_augmented_mass,
+            effective_dim,
+        ));
+        self.inv_augmented_mass =
+            LU::new(leading_square_block(&self.augmented_mass, effective_dim));
     }
 
     /// Per-DoF inverse joint-space inertia `diag(M⁻¹)` at the current configuration, where `M`
