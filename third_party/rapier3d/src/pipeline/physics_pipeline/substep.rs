@@ -433,10 +433,11 @@ impl PhysicsPipeline {
         soft_bodies.island_events = sb_events;
         self.counters.stages.user_changes.pause();
 
-        // TODO: do this only on user-change.
+        // Forward kinematics only where the user changed an input (coordinates, frames,
+        // root pose, ...) since the previous step ended with it.
         // TODO: do we want some kind of automatic inverse kinematics?
         for multibody in &mut multibody_joints.multibodies {
-            multibody.1.forward_kinematics(bodies, true);
+            multibody.1.forward_kinematics_if_changed(bodies);
             multibody
                 .1
                 .update_rigid_bodies_internal(bodies, true, false, false);

@@ -23,6 +23,26 @@ use na::{
 #[cfg(doc)]
 use crate::prelude::{GenericJoint, RigidBody};
 
+/// A copy of the leading `dim × dim` block of `m`, column slice by column slice (what
+/// `m.view((0, 0), (dim, dim)).into_owned()` returns, without its element-by-element
+/// iteration over the view).
+fn leading_square_block(m: &DMatrix<Real>, dim: usize) -> DMatrix<Real> {
+    let nrows = m.nrows();
+    assert!(dim <= nrows && dim <= m.ncols());
+    if dim == nrows && dim == m.ncols() {
+        return m.clone();
+    }
+    let mut block = DMatrix::zeros(dim, dim);
+    for (j, column) in block
+        .as_mut_slice()
+        .chunks_exact_mut(dim.max(1))
+        .enumerate()
+    {
+        column.copy_from_slice(&m.as_slice()[j * nrows..j * nrows + dim]);
+    }
+    block
+}
+
 #[repr(C)]
 #[derive(Copy, Clone, Debug, Default)]
 struct Force {
@@ -262,6 +282,8 @@ impl Multibody {
     }
 
     pub(crate) fn append(&mut self, mut rhs: Multibody, parent: usize, joint: MultibodyJoint) {
+        // A new structure: its kinematics must be recomputed.
+        self.workspace.forward_kinematics_inputs.clear();
         let joint_ndofs = joint.ndofs();
         let rhs_root_ndofs = rhs.links[0].joint.ndofs();
         let ndofs_before_append = self.velocities.len();
@@ -446,6 +468,8 @@ impl Multibody {
         dof: MultibodyJoint,
         body: RigidBodyHandle,
     ) -> &mut MultibodyLink {
+        // A new structure: its kinematics must be recomputed.
+        self.workspace.forward_kinematics_inputs.clear();
         assert!(
             parent.is_none() || !self.links.is_empty(),
             "Multibody::build_body: invalid parent id."
@@ -1165,16 +1189,12 @@ impl Multibody {
             .rearrange_rows(&mut self.augmented_mass, true);
 
         // TODO: avoid allocation inside LU at each timestep.
-        self.acc_inv_augmented_mass = LU::new(
-            self.acc_augmented_mass
-                .view((0, 0), (effective_dim, effective_dim))
-                .into_owned(),
-        );
-        self.inv_augmented_mass = LU::new(
-            self.augmented_mass
-                .view((0, 0), (effective_dim, effective_dim))
-                .into_owned(),
-        );
+        self.acc_inv_augmented_mass = LU::new(leading_square_block(
+            &self.acc_augmented_mass,
+            effective_dim,
+        ));
+        self.inv_augmented_mass =
+            LU::new(leading_square_block(&self.augmented_mass, effective_dim));
     }
 
     /// Per-DoF inverse joint-space inertia `diag(M⁻¹)` at the current configuration, where `M`
@@ -1310,6 +1330,7 @@ impl Multibody {
                 solver_vel2: self.solver_id,
                 ndofs2: ndofs,
                 j_id2: j_id,
+                unit_jacobian2: u32::MAX,
                 joint_id: usize::MAX, // internal: no impulse writeback.
                 impulse: 0.0,
                 impulse_bounds: [-Real::MAX, Real::MAX],
@@ -1558,6 +1579,67 @@ impl Multibody {
          * Compute body jacobians.
          */
         self.update_body_jacobians();
+
+        let mut inputs = core::mem::take(&mut self.workspace.forward_kinematics_inputs);
+        self.forward_kinematics_inputs(bodies, &mut inputs);
+        self.workspace.forward_kinematics_inputs = inputs;
+    }
+
+    /// [`Self::forward_kinematics`] reading the root pose from its rigid-body, skipped when
+    /// none of its inputs changed since the last forward kinematics of this multibody: then
+    /// it would recompute, bit for bit, the link poses, shifts and body Jacobians it already
+    /// holds (only forward kinematics writes them). The physics pipeline calls this at the
+    /// start of every step, right after the previous step ended with forward kinematics.
+    pub(crate) fn forward_kinematics_if_changed(&mut self, bodies: &RigidBodySet) {
+        // The root pose (and type) is an input: take it first, as forward kinematics does.
+        self.update_root_type(bodies, true);
+        let mut inputs = core::mem::take(&mut self.workspace.forward_kinematics_scratch);
+        self.forward_kinematics_inputs(bodies, &mut inputs);
+        let unchanged = !inputs.is_empty() && inputs == self.workspace.forward_kinematics_inputs;
+        self.workspace.forward_kinematics_scratch = inputs;
+        if !unchanged {
+            self.forward_kinematics(bodies, true);
+        }
+    }
+
+    /// Everything [`Self::forward_kinematics`] reads, as bits, into `out`: the structure
+    /// (links, parents, dofs, rigid-bodies and their types), each joint's frames, locked axes,
+    /// coordinates and rotation, and each link body's center of mass. Empty in 2D (never
+    /// equal: forward kinematics always runs there).
+    fn forward_kinematics_inputs(&self, bodies: &RigidBodySet, out: &mut Vec<u64>) {
+        out.clear();
+        #[cfg(feature = "dim3")]
+        {
+            fn push(out: &mut Vec<u64>, values: &[Real]) {
+                out.extend(values.iter().map(|v| u64::from(v.to_bits())));
+            }
+            out.extend([self.ndofs as u64, self.links.len() as u64]);
+            for link in self.links.iter() {
+                let (index, generation) = link.rigid_body.into_raw_parts();
+                let joint = &link.joint;
+                out.extend([
+                    u64::from(index),
+                    u64::from(generation),
+                    link.parent_internal_id as u64,
+                    link.assembly_id as u64,
+                    u64::from(joint.data.locked_axes.bits()),
+                ]);
+                let (frame1, frame2) = (&joint.data.local_frame1, &joint.data.local_frame2);
+                push(out, &frame1.rotation.to_array());
+                push(out, &frame1.translation.to_array());
+                push(out, &frame2.rotation.to_array());
+                push(out, &frame2.translation.to_array());
+                push(out, joint.coords.as_slice());
+                push(out, &joint.joint_rot.to_array());
+                match bodies.get(link.rigid_body) {
+                    Some(rb) => {
+                        push(out, &rb.mprops.local_mprops.local_com.to_array());
+                        out.push(rb.body_type as u64);
+                    }
+                    None => out.push(u64::MAX),
+                }
+            }
+        }
     }
 
     /// Computes the ids of all the links between the root and the link identified by `link_id`.

@@ -1,7 +1,7 @@
 use crate::dynamics::solver::GenericJointConstraint;
 use crate::dynamics::{
     FixedJointBuilder, GenericJoint, IntegrationParameters, Multibody, MultibodyLink,
-    RigidBodyVelocity, joint,
+    RigidBodyVelocity,
 };
 use crate::math::{
     ANG_DIM, DIM, DVector, JacobianViewMut, Pose, Real, Rotation, SPATIAL_DIM, SpatialVector,
@@ -324,6 +324,8 @@ impl MultibodyJoint {
 
         for i in 0..DIM {
             if (locked_bits & (1 << i)) == 0 {
+                // Where this coordinate's unit Jacobian block was written, once it is.
+                let mut dof_block = None;
                 let limits = if (limit_bits & (1 << i)) != 0 {
                     Some([self.data.limits[i].min, self.data.limits[i].max])
                 } else {
@@ -331,7 +333,7 @@ impl MultibodyJoint {
                 };
 
                 if (motor_bits & (1 << i)) != 0 {
-                    joint::unit_joint_motor_constraint(
+                    super::unit_multibody_joint::unit_joint_motor_constraint_impl(
                         params,
                         multibody,
                         link,
@@ -343,11 +345,12 @@ impl MultibodyJoint {
                         jacobians,
                         constraints,
                         &mut num_constraints,
+                        &mut dof_block,
                     );
                 }
 
                 if (limit_bits & (1 << i)) != 0 {
-                    joint::unit_joint_limit_constraint(
+                    super::unit_multibody_joint::unit_joint_limit_constraint_impl(
                         params,
                         multibody,
                         link,
@@ -359,6 +362,7 @@ impl MultibodyJoint {
                         constraints,
                         &mut num_constraints,
                         self.data.softness,
+                        &mut dof_block,
                     );
                 }
                 // Dry joint friction (MuJoCo `frictionloss`), keyed per-DoF on
@@ -366,7 +370,7 @@ impl MultibodyJoint {
                 // default) emits nothing.
                 let friction = multibody.frictions()[link.assembly_id + curr_free_dof];
                 if friction > 0.0 {
-                    joint::unit_joint_friction_constraint(
+                    super::unit_multibody_joint::unit_joint_friction_constraint_impl(
                         params,
                         multibody,
                         link,
@@ -377,6 +381,7 @@ impl MultibodyJoint {
                         constraints,
                         &mut num_constraints,
                         self.data.softness,
+                        &mut dof_block,
                     );
                 }
                 curr_free_dof += 1;
@@ -399,9 +404,11 @@ impl MultibodyJoint {
         // TODO: we should make special cases for multi-angular-dofs limits/motors
         for i in DIM..SPATIAL_DIM {
             if (locked_bits & (1 << i)) == 0 {
+                // Where this coordinate's unit Jacobian block was written, once it is.
+                let mut dof_block = None;
                 let limits = if (limit_bits & (1 << i)) != 0 {
                     let limits = [self.data.limits[i].min, self.data.limits[i].max];
-                    joint::unit_joint_limit_constraint(
+                    super::unit_multibody_joint::unit_joint_limit_constraint_impl(
                         params,
                         multibody,
                         link,
@@ -413,6 +420,7 @@ impl MultibodyJoint {
                         constraints,
                         &mut num_constraints,
                         self.data.softness,
+                        &mut dof_block,
                     );
                     Some(limits)
                 } else {
@@ -420,7 +428,7 @@ impl MultibodyJoint {
                 };
 
                 if (motor_bits & (1 << i)) != 0 {
-                    joint::unit_joint_motor_constraint(
+                    super::unit_multibody_joint::unit_joint_motor_constraint_impl(
                         params,
                         multibody,
                         link,
@@ -432,6 +440,7 @@ impl MultibodyJoint {
                         jacobians,
                         constraints,
                         &mut num_constraints,
+                        &mut dof_block,
                     );
                 }
 
@@ -440,7 +449,7 @@ impl MultibodyJoint {
                 // default) emits nothing.
                 let friction = multibody.frictions()[link.assembly_id + curr_free_dof];
                 if friction > 0.0 {
-                    joint::unit_joint_friction_constraint(
+                    super::unit_multibody_joint::unit_joint_friction_constraint_impl(
                         params,
                         multibody,
                         link,
@@ -451,6 +460,7 @@ impl MultibodyJoint {
                         constraints,
                         &mut num_constraints,
                         self.data.softness,
+                        &mut dof_block,
                     );
                 }
                 curr_free_dof += 1;

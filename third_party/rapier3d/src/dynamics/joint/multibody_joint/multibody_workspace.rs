@@ -11,6 +11,14 @@ pub(crate) struct MultibodyWorkspace {
     /// For each link, the number of leading generalized coordinates its body Jacobian depends
     /// on: every column at or after this index is zero (see `Multibody::update_jacobian_widths`).
     pub jacobian_widths: Vec<usize>,
+    /// The inputs of the last `Multibody::forward_kinematics` (see
+    /// `Multibody::forward_kinematics_inputs`); empty when unknown (never serialized, so a
+    /// deserialized multibody recomputes its kinematics).
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
+    pub forward_kinematics_inputs: Vec<u64>,
+    /// Scratch buffer for `Multibody::forward_kinematics_if_changed`.
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
+    pub forward_kinematics_scratch: Vec<u64>,
 }
 
 impl MultibodyWorkspace {
@@ -20,6 +28,8 @@ impl MultibodyWorkspace {
             accs: Vec::new(),
             ndofs_vec: DVector::zeros(0),
             jacobian_widths: Vec::new(),
+            forward_kinematics_inputs: Vec::new(),
+            forward_kinematics_scratch: Vec::new(),
         }
     }
 

@@ -21,6 +21,39 @@ pub fn unit_joint_limit_constraint(
     insert_at: &mut usize,
     softness: SpringCoefficients<Real>,
 ) {
+    unit_joint_limit_constraint_impl(
+        params,
+        multibody,
+        link,
+        limits,
+        curr_pos,
+        dof_id,
+        j_id,
+        jacobians,
+        constraints,
+        insert_at,
+        softness,
+        &mut None,
+    )
+}
+
+/// As [`unit_joint_limit_constraint`], reusing the unit Jacobian block of `dof_block` (see
+/// [`write_unit_dof_jacobians`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn unit_joint_limit_constraint_impl(
+    params: &IntegrationParameters,
+    multibody: &Multibody,
+    link: &MultibodyLink,
+    limits: [Real; 2],
+    curr_pos: Real,
+    dof_id: usize,
+    j_id: &mut usize,
+    jacobians: &mut DVector,
+    constraints: &mut [GenericJointConstraint],
+    insert_at: &mut usize,
+    softness: SpringCoefficients<Real>,
+    dof_block: &mut Option<usize>,
+) {
     let ndofs = multibody.ndofs();
     let min_enabled = curr_pos < limits[0];
     let max_enabled = limits[1] < curr_pos;
@@ -33,12 +66,7 @@ pub fn unit_joint_limit_constraint(
     let rhs_wo_bias = 0.0;
 
     let dof_j_id = *j_id + dof_id + link.assembly_id;
-    jacobians.rows_mut(*j_id, ndofs * 2).fill(0.0);
-    jacobians[dof_j_id] = 1.0;
-    jacobians[dof_j_id + ndofs] = 1.0;
-    multibody
-        .inv_augmented_mass()
-        .solve_mut(&mut jacobians.rows_mut(*j_id + ndofs, ndofs));
+    write_unit_dof_jacobians(multibody, link, dof_id, *j_id, jacobians, dof_block);
 
     let lhs = jacobians[dof_j_id + ndofs]; // = J^t * M^-1 J
     let impulse_bounds = [
@@ -57,6 +85,7 @@ pub fn unit_joint_limit_constraint(
         solver_vel2: multibody.solver_id,
         ndofs2: ndofs,
         j_id2: *j_id,
+        unit_jacobian2: (link.assembly_id + dof_id) as u32,
         joint_id: usize::MAX, // TODO: we don’t support impulse writeback for internal constraints yet.
         impulse: 0.0,
         impulse_bounds,
@@ -92,16 +121,42 @@ pub fn unit_joint_friction_constraint(
     insert_at: &mut usize,
     softness: SpringCoefficients<Real>,
 ) {
+    unit_joint_friction_constraint_impl(
+        params,
+        multibody,
+        link,
+        friction,
+        dof_id,
+        j_id,
+        jacobians,
+        constraints,
+        insert_at,
+        softness,
+        &mut None,
+    )
+}
+
+/// As [`unit_joint_friction_constraint`], reusing the unit Jacobian block of `dof_block` (see
+/// [`write_unit_dof_jacobians`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn unit_joint_friction_constraint_impl(
+    params: &IntegrationParameters,
+    multibody: &Multibody,
+    link: &MultibodyLink,
+    friction: Real,
+    dof_id: usize,
+    j_id: &mut usize,
+    jacobians: &mut DVector,
+    constraints: &mut [GenericJointConstraint],
+    insert_at: &mut usize,
+    softness: SpringCoefficients<Real>,
+    dof_block: &mut Option<usize>,
+) {
     let ndofs = multibody.ndofs();
     let cfm_coeff = softness.cfm_coeff(params.dt);
 
     let dof_j_id = *j_id + dof_id + link.assembly_id;
-    jacobians.rows_mut(*j_id, ndofs * 2).fill(0.0);
-    jacobians[dof_j_id] = 1.0;
-    jacobians[dof_j_id + ndofs] = 1.0;
-    multibody
-        .inv_augmented_mass()
-        .solve_mut(&mut jacobians.rows_mut(*j_id + ndofs, ndofs));
+    write_unit_dof_jacobians(multibody, link, dof_id, *j_id, jacobians, dof_block);
 
     let lhs = jacobians[dof_j_id + ndofs]; // = J^t * M^-1 J
     let max_impulse = friction * params.dt;
@@ -116,6 +171,7 @@ pub fn unit_joint_friction_constraint(
         solver_vel2: multibody.solver_id,
         ndofs2: ndofs,
         j_id2: *j_id,
+        unit_jacobian2: (link.assembly_id + dof_id) as u32,
         joint_id: usize::MAX, // TODO: we don’t support impulse writeback for internal constraints yet.
         impulse: 0.0,
         impulse_bounds: [-max_impulse, max_impulse],
@@ -148,17 +204,45 @@ pub fn unit_joint_motor_constraint(
     constraints: &mut [GenericJointConstraint],
     insert_at: &mut usize,
 ) {
+    unit_joint_motor_constraint_impl(
+        params,
+        multibody,
+        link,
+        motor,
+        curr_pos,
+        limits,
+        dof_id,
+        j_id,
+        jacobians,
+        constraints,
+        insert_at,
+        &mut None,
+    )
+}
+
+/// As [`unit_joint_motor_constraint`], reusing the unit Jacobian block of `dof_block` (see
+/// [`write_unit_dof_jacobians`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn unit_joint_motor_constraint_impl(
+    params: &IntegrationParameters,
+    multibody: &Multibody,
+    link: &MultibodyLink,
+    motor: &JointMotor,
+    curr_pos: Real,
+    limits: Option<[Real; 2]>,
+    dof_id: usize,
+    j_id: &mut usize,
+    jacobians: &mut DVector,
+    constraints: &mut [GenericJointConstraint],
+    insert_at: &mut usize,
+    dof_block: &mut Option<usize>,
+) {
     let inv_dt = params.inv_dt();
     let ndofs = multibody.ndofs();
     let motor_params = motor.motor_params(params.dt);
 
     let dof_j_id = *j_id + dof_id + link.assembly_id;
-    jacobians.rows_mut(*j_id, ndofs * 2).fill(0.0);
-    jacobians[dof_j_id] = 1.0;
-    jacobians[dof_j_id + ndofs] = 1.0;
-    multibody
-        .inv_augmented_mass()
-        .solve_mut(&mut jacobians.rows_mut(*j_id + ndofs, ndofs));
+    write_unit_dof_jacobians(multibody, link, dof_id, *j_id, jacobians, dof_block);
 
     let lhs = jacobians[dof_j_id + ndofs]; // = J^t * M^-1 J
     let impulse_bounds = [-motor_params.max_impulse, motor_params.max_impulse];
@@ -189,6 +273,7 @@ pub fn unit_joint_motor_constraint(
         solver_vel2: multibody.solver_id,
         ndofs2: ndofs,
         j_id2: *j_id,
+        unit_jacobian2: (link.assembly_id + dof_id) as u32,
         joint_id: usize::MAX, // TODO: we don’t support impulse writeback for internal constraints yet.
         impulse: 0.0,
         impulse_bounds,
@@ -204,4 +289,41 @@ pub fn unit_joint_motor_constraint(
     *insert_at += 1;
 
     *j_id += 2 * ndofs;
+}
+
+/// Writes at `j_id` the Jacobian block of a constraint on generalized coordinate
+/// `link.assembly_id + dof_id` alone: the unit vector `e` (`ndofs` values) followed by
+/// `M⁻¹ e` (`ndofs` values, through the multibody's factorized augmented mass matrix).
+///
+/// `dof_block` is where such a block for the same coordinate was already written during the
+/// same constraint generation (`None` if none was): then the block is copied from there
+/// instead of being solved for again (the same solve of the same right-hand side, so the
+/// values are identical), which halves the LU solves of a coordinate with both a motor and a
+/// limit. Afterwards `dof_block` is `Some(j_id)`.
+pub(crate) fn write_unit_dof_jacobians(
+    multibody: &Multibody,
+    link: &MultibodyLink,
+    dof_id: usize,
+    j_id: usize,
+    jacobians: &mut DVector,
+    dof_block: &mut Option<usize>,
+) {
+    let ndofs = multibody.ndofs();
+    match *dof_block {
+        Some(src) if src != j_id => {
+            jacobians
+                .as_mut_slice()
+                .copy_within(src..src + 2 * ndofs, j_id);
+        }
+        _ => {
+            let dof_j_id = j_id + dof_id + link.assembly_id;
+            jacobians.rows_mut(j_id, ndofs * 2).fill(0.0);
+            jacobians[dof_j_id] = 1.0;
+            jacobians[dof_j_id + ndofs] = 1.0;
+            multibody
+                .inv_augmented_mass()
+                .solve_mut(&mut jacobians.rows_mut(j_id + ndofs, ndofs));
+        }
+    }
+    *dof_block = Some(j_id);
 }
