@@ -70,6 +70,23 @@ fn main() -> Result<(), EnvError> {
             // Mean fraction along the rope (from the short end) of the particles on the rod.
             let arc = touching.iter().sum::<f32>() / on_rod as f32;
             print!("arc {arc:.2} ");
+            // The legs' inner faces at the rod's height: the particles 1-5 cm above the rod's
+            // top nearest the TCP on either side along the rod's normal (m).
+            let n = rod.normal();
+            let tcp_v = glam::Vec3::new(tcp.x, tcp.y, tcp.z);
+            let band = x
+                .iter()
+                .filter(|p| p.z > rod.position.z + 0.02 && p.z < rod.position.z + 0.06);
+            let (mut lo_s, mut hi_s) = (-9.0f32, 9.0f32);
+            for p in band {
+                let s = (*p - tcp_v).dot(n);
+                if s < 0.0 {
+                    lo_s = lo_s.max(s);
+                } else {
+                    hi_s = hi_s.min(s);
+                }
+            }
+            print!("legs {lo_s:.3} {hi_s:.3} ");
             print!(
                 "near {near} d0 {:.4} d1 {:.4} d2 {:.4} on rod {on_rod} ",
                 dmin(0),

@@ -3,7 +3,7 @@
 use glam::Vec3;
 use ms2_mpm::bent_bar::{BentBar, CurvePiece};
 use ms2_physics::{ActorDesc, ActorKind, Pose3, ShapeDesc, ShapeSpec, World, WorldConfig};
-use ms2_tasks::families::soft::hang::{Hang, ROD_HALF, ROD_STICKY_REACH};
+use ms2_tasks::families::soft::hang::{Hang, ROD_HALF, ROD_STICKY_REACH, START_FINGER_QPOS};
 use ms2_tasks::families::soft::hang_scene::{
     hang_terms, rope_solver, HangTerms, RodPose, RopeStart, HANG_MPM_FREQ_HZ, ROPE_HALF_WIDTH,
     ROPE_LENGTH,
@@ -282,31 +282,38 @@ fn state_round_trip_is_bit_exact_and_seeds_repeat() {
     assert_eq!(c.get_state(), d.get_state(), "two restored runs diverged");
 }
 
+/// Heights (m) of the tracked particles (10 %, 30 %, 50 %, 70 %, 90 % along the rope).
+fn tracked_z(env: &ms2_tasks::Env) -> [f32; 5] {
+    let (scene, task) = (env.task_scene().unwrap(), env.task().unwrap());
+    let hang = task.downcast_ref::<Hang>().unwrap();
+    hang.hang_eval(scene.world.as_ref())
+        .unwrap()
+        .tracked
+        .map(|p| p.z)
+}
+
 #[test]
 fn the_fingers_lift_the_rope_they_hold() {
-    // The scripted policy's first 20 control steps raise the closed hand about 23 cm. The
-    // fingers' sticky grid contact carries the rope: its grasped part rises with the hand
-    // and the rest hangs below it (with the penalty contact alone it tore at the fingertips
-    // and fell as the lift began).
+    // The closed hand rises 23 cm over 20 control steps from the start's pinch. The fingers'
+    // sticky grid contact carries the rope: its grasped part rises with the hand and the
+    // rest hangs below it (with the penalty contact alone it tore at the fingertips and fell
+    // as the lift began).
     let mut env = hang_env("state");
-    let mut policy = ms2_tasks::make_scripted_policy(&env).unwrap();
+    let oracle = ms2_tasks::scripted::tcp_oracle(&env).unwrap();
     env.reset(Some(0), false).unwrap();
-    policy.reset(&env);
-    let tracked_z = |env: &ms2_tasks::Env| {
-        let (scene, task) = (env.task_scene().unwrap(), env.task().unwrap());
-        let hang = task.downcast_ref::<Hang>().unwrap();
-        hang.hang_eval(scene.world.as_ref())
-            .unwrap()
-            .tracked
-            .map(|p| p.z)
+    let start = {
+        let scene = env.task_scene().unwrap();
+        scene.agent.tcp_pose(scene.world.as_ref())
     };
     let before = tracked_z(&env);
-    for _ in 0..20 {
-        let action = policy.act(&env);
+    for step in 1..=20 {
+        let mut target = start;
+        target.translation.vector.z += 0.0115 * step as f32;
+        let action = oracle.action(&env, &target, f64::from(START_FINGER_QPOS));
         env.step(&action).unwrap();
     }
     let after = tracked_z(&env);
-    // Tracked particles at 10 %, 30 %, … along the rope; the fingers hold it 20-24 % along.
+    // The fingers hold the rope 20-24 % along.
     for k in 0..2 {
         assert!(
             after[k] - before[k] > 0.15,
@@ -320,5 +327,38 @@ fn the_fingers_lift_the_rope_they_hold() {
         after[2] > before[2] + 0.1,
         "the rope's middle stayed at z {}",
         after[2]
+    );
+}
+
+#[test]
+fn the_scripted_policy_first_lays_the_rope_down_and_lets_go_of_it() {
+    // The plan's first step: open at the start and rise, the rope falls to the ground whole
+    // and the fingers leave it (the re-grasp needs the rope lying free).
+    let mut env = hang_env("state");
+    let mut policy = ms2_tasks::make_scripted_policy(&env).unwrap();
+    env.reset(Some(1), false).unwrap();
+    policy.reset(&env);
+    for _ in 0..ms2_tasks::families::soft::hang_policy::PLAN_STEP {
+        let action = policy.act(&env);
+        env.step(&action).unwrap();
+    }
+    let (scene, task) = (env.task_scene().unwrap(), env.task().unwrap());
+    let hang = task.downcast_ref::<Hang>().unwrap();
+    let soft = hang.arm().soft().unwrap();
+    let x = soft.solver().positions();
+    let top = x.iter().map(|p| p.z).fold(f32::MIN, f32::max);
+    assert!(top < 0.03, "the rope's top is {top} m up");
+    for finger in 0..2 {
+        let d = x
+            .iter()
+            .map(|p| soft.distance_to_body(finger, *p).unwrap_or(9.0))
+            .fold(f32::MAX, f32::min);
+        assert!(d > 0.02, "finger {finger} is {d} m from the rope");
+    }
+    let e = hang.hang_eval(scene.world.as_ref()).unwrap();
+    assert!(
+        e.finger_opening > 0.07,
+        "fingers {} m open",
+        e.finger_opening
     );
 }

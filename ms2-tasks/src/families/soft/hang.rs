@@ -71,8 +71,9 @@ pub const ARM_START: [f32; 7] = [
 /// recorded starts pinch the rope between fingertips 2 mm apart).
 pub const START_FINGER_QPOS: f32 = 0.01;
 /// Distance (m) from a finger's surface within which the rope's grid nodes move with the
-/// finger: one cell of the rope's grid.
-const FINGER_STICKY_REACH: f32 = 0.005;
+/// finger: two cells of the rope's grid (with one, 5 mm, the rope's end slipped out of the
+/// scripted policy's re-grasp as soon as the carry began).
+const FINGER_STICKY_REACH: f32 = 0.01;
 /// Distance (m) from the rod's surface within which the rope's grid nodes stay still, as
 /// ManiSkill2's sticky grid contact on every coupled body holds its noodle on the rod (with
 /// the penalty contact's friction the rope slid off the rod towards its heavier side).

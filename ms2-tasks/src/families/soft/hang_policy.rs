@@ -1,12 +1,23 @@
-//! `Hang-v0`'s scripted (oracle) policy: TCP waypoints planned at reset from the rod's pose.
+//! `Hang-v0`'s scripted (oracle) policy: lay the rope down, re-grasp it near its short end,
+//! hang it over the rod. It does not solve the task yet (see docs/tasks.md, Hang-v0).
 //!
-//! Holding the rope, the hand turns the rope's direction onto the rod's normal, rises above
-//! the rod on the robot's side (high enough for the short end to pass over it, low enough for
-//! the long end to hang below it), crosses over the rod so that the long end catches on it
-//! (the rod's sticky contact keeps the rope where it first touches), descends on the far side
-//! to just below the rod, opens slowly, and backs away along the normal.
+//! The episode starts with the rope pinched about a fifth along its length, which leaves
+//! the rope unbalanced over the rod (it slid off towards its heavier side at the release).
+//! So the hand first opens and lets the rope fall to the ground (it lets go cleanly). When
+//! the rope has settled ([`PLAN_STEP`]) the policy reads the particles (the tracked particle
+//! 10 % along the rope, the grasp point, and the rope's direction there) and plans the rest:
+//! hover above the grasp point with the fingers' closing axis across the rope, descend
+//! around it, close (the fingers' sticky grip holds it), lift it straight up so that it
+//! hangs from the hand, turn the closing axis onto the rod's normal, carry it across the
+//! rod so that the hanging rope first touches the rod (which holds it: the rod is sticky)
+//! beyond its middle, descend a little on the far side, open slowly and rise.
+//!
+//! Measured (seed 0): the rope, re-grasped at its middle, hangs as a closed hairpin (both
+//! legs together below the hand), which cannot straddle the rod; re-grasped near an end, it
+//! lifts, hangs and (with the fingers' 1 cm sticky reach) is carried over the rod, which it
+//! straddles after the release, but off-centre (see [`CROSS_HEIGHT`]).
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 
 use super::hang::Hang;
@@ -16,25 +27,37 @@ use crate::geometry::Pose3;
 use crate::scripted::oracle::{TcpOracle, GRIPPER_OPEN};
 use crate::scripted::{tcp_oracle, ScriptedPolicy};
 
-/// Finger target (m per finger) while holding: where the episode starts
+/// Finger target (m per finger) while holding: the start's pinch width
 /// ([`super::hang::START_FINGER_QPOS`]).
 pub const HOLD_FINGER_TARGET: f64 = super::hang::START_FINGER_QPOS as f64;
-/// Height (m) of the crossing above the rod's centre: low enough for the rope hanging below
-/// the hand to touch the rod while crossing (seed 0, 13 cm: it passed 5 mm over the rod,
-/// touched it about 30 % along during the descent, close to the grasp, and the descent then
-/// stretched the rope between grasp and rod).
-pub const CROSS_HEIGHT: f32 = 0.11;
-/// Horizontal offsets (m) from the rod's centre along its normal: where the hand rises (on
-/// the robot's side), where it descends (far side) and where it backs away to.
-pub const NEAR_OFFSET: f32 = -0.08;
+/// Finger target (m per finger) of the re-grasp: the pads 14 mm apart, squeezing the rope's
+/// 20 mm (the start's 20 mm let the rope's end slip out when the hand turned or moved).
+pub const GRIP_FINGER_TARGET: f64 = 0.007;
+/// Control step at which the dropped rope has settled and the re-grasp is planned.
+pub const PLAN_STEP: u32 = 20;
+/// Height (m) above the rope from which the open hand descends around it.
+pub const HOVER_HEIGHT: f32 = 0.06;
+/// Lowest TCP height (m) of the grasp: the fingertip pads (1 cm below and above the TCP)
+/// clear of the ground.
+pub const GRASP_HEIGHT: f32 = 0.015;
+/// Height (m) of the crossing above the rod's centre. The rope hanging from the hand first
+/// touches the rod (seed 0) 35 % along at 14 cm, 50 % at 20 cm, 65 % at 26 cm (where the hand
+/// sagged 4 cm below its target); the release then shifts the rope over the rod towards the
+/// robot, to 25-32 % along in every case measured.
+pub const CROSS_HEIGHT: f32 = 0.2;
+/// Horizontal offsets (m) from the rod's centre along its normal: where the hand starts the
+/// crossing (robot's side) and where it releases (far side, 3 cm below the crossing height:
+/// descending farther let the heavier near side pull the rope back over the rod).
+pub const NEAR_OFFSET: f32 = -0.1;
 /// See [`NEAR_OFFSET`].
 pub const FAR_OFFSET: f32 = 0.05;
-/// See [`NEAR_OFFSET`].
-pub const AWAY_OFFSET: f32 = 0.12;
-/// Depth (m) of the release point below the rod's centre: the rope between the rod and
-/// the fingers slack (6 cm stretched it once the rod held it).
-pub const RELEASE_DEPTH: f32 = 0.03;
-/// Control steps over which the fingers open (a sudden opening flung the rope off the rod).
+/// Radius (m) around the grasp point of the particles whose principal direction is the
+/// rope's direction there.
+const TANGENT_RADIUS: f32 = 0.04;
+/// Control steps the hand waits above the rod for the legs' swing to die down.
+pub const SETTLE_STEPS: u32 = 10;
+/// Control steps over which the fingers open at the release (a sudden opening flung the
+/// rope off the rod).
 pub const OPEN_STEPS: u32 = 20;
 
 /// A waypoint: control step, TCP position (m, world), yaw added to the start (rad), finger
@@ -46,6 +69,7 @@ pub struct HangPolicy {
     oracle: TcpOracle,
     start: Option<Pose3>,
     waypoints: Vec<Waypoint>,
+    planned: bool,
 }
 
 impl HangPolicy {
@@ -55,32 +79,114 @@ impl HangPolicy {
             oracle: tcp_oracle(env)?,
             start: None,
             waypoints: Vec::new(),
+            planned: false,
         }))
     }
 
-    /// The waypoints from the TCP's start position `p0` (m) for `hang`'s rod.
-    pub fn plan(p0: Vec3, hang: &Hang) -> Vec<Waypoint> {
-        let rod = hang.rod_pose();
-        let (c, n) = (rod.position, rod.normal());
-        let yaw = n.y.atan2(n.x);
-        let hold = HOLD_FINGER_TARGET;
-        let at = |offset: f32, z: f32| (c + n * offset).truncate().extend(z);
-        let high = c.z + CROSS_HEIGHT;
-        let low = c.z - RELEASE_DEPTH;
+    /// The drop: from the TCP's start position `p0` (m), open the fingers and rise 3 cm
+    /// while the rope falls and settles.
+    pub fn drop_plan(p0: Vec3) -> Vec<Waypoint> {
+        let up = p0 + Vec3::Z * 0.03;
         vec![
-            (0, p0, 0.0, hold),
-            (4, p0, 0.0, hold),
-            (24, p0.truncate().extend(high), yaw, hold),
-            (40, at(NEAR_OFFSET, high), yaw, hold),
-            (60, at(FAR_OFFSET, high), yaw, hold),
-            (80, at(FAR_OFFSET, low), yaw, hold),
-            (80 + OPEN_STEPS, at(FAR_OFFSET, low), yaw, GRIPPER_OPEN),
-            (95 + OPEN_STEPS, at(AWAY_OFFSET, low), yaw, GRIPPER_OPEN),
-            (u32::MAX, at(AWAY_OFFSET, low), yaw, GRIPPER_OPEN),
+            (0, p0, 0.0, HOLD_FINGER_TARGET),
+            (4, p0, 0.0, GRIPPER_OPEN),
+            (12, up, 0.0, GRIPPER_OPEN),
+            (u32::MAX, up, 0.0, GRIPPER_OPEN),
         ]
     }
 
-    /// The waypoint at control step `step`, linearly interpolated (finger target too).
+    /// The re-grasp and hang from the TCP at `p` (m) at control step `s0`, the grasp point
+    /// at `grasp` (m), the rope running along horizontal unit vector `along` there (towards
+    /// its nearer end), for `hang`'s rod.
+    pub fn hang_plan(s0: u32, p: Vec3, grasp: Vec3, along: Vec2, hang: &Hang) -> Vec<Waypoint> {
+        let rod = hang.rod_pose();
+        let (c, n) = (rod.position, rod.normal());
+        let pi = std::f32::consts::PI;
+        // The hand's "along" (across the closing axis) is +x at yaw 0; a pinch is symmetric,
+        // so the grasp's yaw is taken modulo π, in (−π/2, π/2].
+        let half_turn = |a: f32| {
+            let a = a.rem_euclid(pi);
+            if a > 0.5 * pi {
+                a - pi
+            } else {
+                a
+            }
+        };
+        let heading = along.y.atan2(along.x);
+        let grasp_yaw = half_turn(heading);
+        // The carry turns the closing axis onto the rod's normal, the direction of the carry:
+        // the pads push the hanging rope along (with the rope leaving the pinch along the
+        // carry, the carry dragged it out between the pads). The rope hangs straight down 2-3
+        // cm from the pinch; a quarter or half turn at most.
+        let carry_yaw = grasp_yaw + half_turn(n.y.atan2(n.x) + 0.5 * pi - heading);
+        let at = |offset: f32, z: f32| (c + n * offset).truncate().extend(c.z + z);
+        // The pads 5 mm off the ground (ground contact stalled their closing).
+        let grasp = grasp.truncate().extend(grasp.z.max(GRASP_HEIGHT));
+        let hover = grasp + Vec3::Z * HOVER_HEIGHT;
+        let near = at(NEAR_OFFSET, CROSS_HEIGHT);
+        let (open, hold) = (GRIPPER_OPEN, GRIP_FINGER_TARGET);
+        let mut w = vec![
+            (s0, p, 0.0, open),
+            (s0 + 15, hover, grasp_yaw, open),
+            (s0 + 27, grasp, grasp_yaw, open),
+            (s0 + 30, grasp, grasp_yaw, open),
+            (s0 + 36, grasp, grasp_yaw, hold),
+            (s0 + 44, grasp, grasp_yaw, hold),
+        ];
+        let s = s0 + 44;
+        let up = grasp.truncate().extend(near.z);
+        let over = at(FAR_OFFSET, CROSS_HEIGHT - 0.03);
+        let high = over + Vec3::Z * 0.05;
+        // Lift straight up, then turn, then carry: the pinch of the rope's end let go when
+        // the hand lifted, turned and moved at once.
+        w.extend([
+            (s + 50, up, grasp_yaw, hold),
+            (s + 80, up, carry_yaw, hold),
+            (s + 110, near, carry_yaw, hold),
+            (s + 115, near, carry_yaw, hold),
+            (s + 135, at(0.0, CROSS_HEIGHT), carry_yaw, hold),
+            (s + 150, over, carry_yaw, hold),
+            (s + 150 + SETTLE_STEPS, over, carry_yaw, hold),
+            (s + 150 + SETTLE_STEPS + OPEN_STEPS, over, carry_yaw, open),
+            (s + 165 + SETTLE_STEPS + OPEN_STEPS, high, carry_yaw, open),
+            (u32::MAX, high, carry_yaw, open),
+        ]);
+        w
+    }
+
+    /// The grasp point (m: the tracked particle 10 % along the rope, 4 cm from its short
+    /// end, within the arm's reach on the ground) and the rope's horizontal direction there
+    /// (unit, towards that end) in `env`.
+    pub fn grasp_point(env: &Env) -> Option<(Vec3, Vec2)> {
+        let (scene, task) = (env.task_scene()?, env.task()?);
+        let hang = task.downcast_ref::<Hang>()?;
+        let tracked = hang.hang_eval(scene.world.as_ref())?.tracked;
+        let grasp = tracked[0];
+        let x = hang.arm().soft()?.solver().positions();
+        let near: Vec<Vec2> = x
+            .iter()
+            .map(|p| p.truncate())
+            .filter(|p| p.distance(grasp.truncate()) < TANGENT_RADIUS)
+            .collect();
+        let mean = near.iter().copied().sum::<Vec2>() / near.len().max(1) as f32;
+        let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+        for p in &near {
+            let d = *p - mean;
+            sxx += d.x * d.x;
+            sxy += d.x * d.y;
+            syy += d.y * d.y;
+        }
+        // Principal axis of the 2×2 covariance, pointed away from the particle at 30 %.
+        let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+        let mut along = Vec2::new(angle.cos(), angle.sin());
+        if along.dot((grasp - tracked[1]).truncate()) < 0.0 {
+            along = -along;
+        }
+        Some((grasp, along))
+    }
+
+    /// The waypoint at control step `step`: position and yaw eased in and out (smoothstep:
+    /// no jerk to set the hanging legs swinging), the finger target linearly interpolated.
     fn command(&self, step: u32) -> Option<(Vec3, f32, f64)> {
         let s = step + 1;
         for pair in self.waypoints.windows(2) {
@@ -88,10 +194,27 @@ impl HangPolicy {
             if s <= s1 {
                 let t = s.saturating_sub(s0) as f32 / (s1 - s0) as f32;
                 let g = g0 + (g1 - g0) * f64::from(t);
-                return Some((p0.lerp(p1, t), y0 + (y1 - y0) * t, g));
+                let e = t * t * (3.0 - 2.0 * t);
+                return Some((p0.lerp(p1, e), y0 + (y1 - y0) * e, g));
             }
         }
         self.waypoints.last().map(|w| (w.1, w.2, w.3))
+    }
+
+    /// Plans the re-grasp at control step `step` (once), from the current command.
+    fn plan_regrasp(&mut self, env: &Env, step: u32) {
+        self.planned = true;
+        let (Some((p, _, _)), Some((grasp, along))) =
+            (self.command(step.saturating_sub(1)), Self::grasp_point(env))
+        else {
+            return;
+        };
+        let Some(hang) = env.task().and_then(|t| t.downcast_ref::<Hang>()) else {
+            return;
+        };
+        self.waypoints.retain(|w| w.0 < step);
+        self.waypoints
+            .extend(Self::hang_plan(step, p, grasp, along, hang));
     }
 }
 
@@ -99,22 +222,22 @@ impl ScriptedPolicy for HangPolicy {
     fn reset(&mut self, env: &Env) {
         self.start = None;
         self.waypoints.clear();
-        let (Some(scene), Some(task)) = (env.task_scene(), env.task()) else {
-            return;
-        };
-        let Some(hang) = task.downcast_ref::<Hang>() else {
+        self.planned = false;
+        let Some(scene) = env.task_scene() else {
             return;
         };
         let tcp = scene.agent.tcp_pose(scene.world.as_ref());
         let p = tcp.translation.vector;
-        self.waypoints = Self::plan(Vec3::new(p.x, p.y, p.z), hang);
+        self.waypoints = Self::drop_plan(Vec3::new(p.x, p.y, p.z));
         self.start = Some(tcp);
     }
 
     fn act(&mut self, env: &Env) -> Vec<f32> {
-        let (Some(start), Some((p, yaw, fingers))) =
-            (self.start, self.command(env.elapsed_steps()))
-        else {
+        let step = env.elapsed_steps();
+        if step >= PLAN_STEP && !self.planned {
+            self.plan_regrasp(env, step);
+        }
+        let (Some(start), Some((p, yaw, fingers))) = (self.start, self.command(step)) else {
             return vec![0.0; env.action_space().size()];
         };
         let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw);
