@@ -88,9 +88,36 @@ pub fn wrap_angle(a: f32) -> f32 {
     }
 }
 
+/// Wraps an angle to `(-π/2, π/2]`: the yaw of something symmetric under half turns (a
+/// two-finger pinch across a rope).
+pub fn wrap_half_turn(a: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let w = a.rem_euclid(PI);
+    if w > FRAC_PI_2 {
+        w - PI
+    } else {
+        w
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wrap_half_turn_keeps_the_direction_modulo_a_half_turn() {
+        use std::f32::consts::{FRAC_PI_2, PI};
+        for k in -40..=40 {
+            let a = k as f32 * 0.1;
+            let w = wrap_half_turn(a);
+            assert!(w > -FRAC_PI_2 - 1e-6 && w <= FRAC_PI_2 + 1e-6, "{a} -> {w}");
+            // Same line: a and w differ by a whole number of half turns.
+            let turns = (a - w) / PI;
+            assert!((turns - turns.round()).abs() < 1e-4, "{a} -> {w}");
+        }
+        assert_eq!(wrap_half_turn(0.3), 0.3);
+        assert!((wrap_half_turn(PI - 0.2) + 0.2).abs() < 1e-6);
+    }
     use approx::assert_relative_eq;
 
     #[test]

@@ -104,14 +104,7 @@ impl HangPolicy {
         let pi = std::f32::consts::PI;
         // The hand's "along" (across the closing axis) is +x at yaw 0; a pinch is symmetric,
         // so the grasp's yaw is taken modulo π, in (−π/2, π/2].
-        let half_turn = |a: f32| {
-            let a = a.rem_euclid(pi);
-            if a > 0.5 * pi {
-                a - pi
-            } else {
-                a
-            }
-        };
+        let half_turn = crate::geometry::wrap_half_turn;
         let heading = along.y.atan2(along.x);
         let grasp_yaw = half_turn(heading);
         // The carry turns the closing axis onto the rod's normal, the direction of the carry:
