@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Sets up a fresh machine (scripts/setup.sh) and runs every test: Rust (the workspace, release
 # profile, sharing target/ with the maturin build setup.sh made) and Python (ruff + pytest), after
-# the style gates CI enforces: rustfmt, clippy and rustdoc with warnings as errors. It starts with the
-# repository hygiene check (no tracked build artefacts) and ends with `cargo package` of every
-# library crate (scripts/check_packages.sh).
+# the style gates CI enforces: rustfmt, clippy and rustdoc with warnings as errors. It starts
+# with the repository hygiene check (no tracked build artefacts) and ends with `cargo package` of
+# every library crate (scripts/check_packages.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 started=$(date +%s)
