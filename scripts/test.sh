@@ -4,8 +4,22 @@
 # the style gates CI enforces: rustfmt, clippy and rustdoc with warnings as errors. It starts
 # with the repository hygiene check (no tracked build artefacts) and ends with `cargo package` of
 # every library crate (scripts/check_packages.sh).
+#
+# `scripts/test.sh --heavy` (or MS2_HEAVY_TESTS=1) also runs the long pytest sweeps CI leaves
+# out to stay within its ~30 min on 2 cores (ms2-py/tests/conftest.py `HEAVY`): more scripted
+# soft-task episodes, every mode of the slowest soft tasks, longer restores, hypothesis's
+# "heavy" profile.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+for arg in "$@"; do
+  case "$arg" in
+    --heavy) export MS2_HEAVY_TESTS=1 ;;
+    *) echo "usage: scripts/test.sh [--heavy] (got '$arg')" >&2; exit 2 ;;
+  esac
+done
+if [ "${MS2_HEAVY_TESTS:-0}" != "0" ] && [ -n "${MS2_HEAVY_TESTS:-}" ]; then
+  echo "[test] heavy: the long pytest sweeps too (MS2_HEAVY_TESTS=$MS2_HEAVY_TESTS)"
+fi
 started=$(date +%s)
 # A build from scratch needs several GB of disk (less without the release profile's line tables,
 # which CI drops: CARGO_PROFILE_RELEASE_DEBUG=0); say so up front rather than failing mid-link.

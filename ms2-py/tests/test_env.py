@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 from conftest import (
     ENV_IDS,
+    HEAVY,
     MAIN_ID,
+    SLOWEST_SOFT,
     SOFT_TASKS,
     assert_obs_equal,
     leaves,
@@ -109,6 +111,12 @@ def test_every_obs_control_and_reward_mode_steps(env_id):
             for r in base.supported_reward_modes
             if (o, r) != ("state", "normalized_dense")
         ]
+        if env_id in SLOWEST_SOFT and not HEAVY:
+            # Seconds per step: the other obs and reward modes once each, not their product.
+            combinations = combinations[: len(base.supported_control_modes)] + [
+                ("state_dict", default_control, "dense"),
+                ("none", default_control, "sparse"),
+            ]
     for obs_mode, control_mode, reward_mode in combinations:
         env = ms2.Ms2Env(
             env_id, obs_mode=obs_mode, control_mode=control_mode, reward_mode=reward_mode
@@ -174,13 +182,15 @@ def test_get_set_state_round_trip(env_id):
     env = make(env_id, obs_mode="state", control_mode=preferred_control_mode(env_id))
     env.reset(seed=11)
     rng = np.random.default_rng(2)
-    for action in random_actions(env.action_space, rng, 5):
+    quick = env_id in SLOWEST_SOFT and not HEAVY
+    for action in random_actions(env.action_space, rng, 2 if quick else 5):
         env.step(action)
     state = env.unwrapped.get_state()
     assert state.dtype == np.float32 and state.ndim == 1
-    # 50 steps after the restore; 8 for the soft tasks (seconds per step; their Rust tests
-    # step restores further).
-    actions = random_actions(env.action_space, rng, 8 if env_id in SOFT_TASKS else 50)
+    # 50 steps after the restore; 8 for the soft tasks, 3 for the slowest without
+    # MS2_HEAVY_TESTS (seconds per step; their Rust tests step restores further).
+    after = 3 if quick else 8 if env_id in SOFT_TASKS else 50
+    actions = random_actions(env.action_space, rng, after)
     first = [env.step(a)[0] for a in actions]
     assert obs_differs(first[0], first[-1])
     env.unwrapped.set_state(state)
