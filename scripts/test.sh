@@ -85,9 +85,10 @@ ruff check ms2-py
 echo "[test] pytest (ms2-py/tests)"
 # One worker process per core (pytest-xdist; PYTEST_WORKERS overrides): most tests simulate on
 # one thread, so two workers use both cores; conftest.py starts the minutes-long tests first so
-# that the short ones fill in around them. The full suite, loaded machine (load 8-10), two
-# workers: 3,782 s (2026-11-28), where one process took 5,472 s before the slow tasks' sweeps
-# were trimmed.
+# that the short ones fill in around them. Two workers, niced under two other engineers' work
+# (load 6-7), without --heavy: 1,093 s (2026-11-28 18:14-18:32 UTC; the longest test, Pour-v0's
+# scripted episode, 539 s), where the suite with the soft tasks' full sweeps took 3,782 s at
+# load 8-10 the same morning.
 python -m pytest -q -n "${PYTEST_WORKERS:-auto}" --dist load ms2-py/tests
 echo "[test] cargo package (every library crate packaged and built from its .crate alone)"
 bash scripts/check_packages.sh
