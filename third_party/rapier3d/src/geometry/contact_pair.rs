@@ -218,6 +218,13 @@ pub struct ContactPair {
     /// The pair's contacts, in the form the two colliders call for: contact manifolds, or
     /// the contact candidates of two soft surfaces.
     pub contacts: PairContacts,
+    /// The contact-pair filter hook's verdict for this pair with the epoch it was computed in
+    /// (see [`PhysicsHooks::contact_pair_filter_epoch`]); `None`: not computed, or the hook
+    /// does not allow caching. Not serialized: a deserialized pair asks the hook again.
+    ///
+    /// [`PhysicsHooks::contact_pair_filter_epoch`]: crate::pipeline::PhysicsHooks::contact_pair_filter_epoch
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
+    pub(crate) filter_verdict: Option<(u64, Option<SolverFlags>)>,
 }
 
 /// The contacts of a [`ContactPair`], with a fixed layout: the solver addresses a pair's manifolds
@@ -424,6 +431,7 @@ impl ContactPair {
             collider2,
             event_status: PairEventStatus::empty(),
             contacts: PairContacts::Rigid(RigidPairContacts::new()),
+            filter_verdict: None,
         }
     }
 
@@ -434,6 +442,7 @@ impl ContactPair {
         self.collider1 = collider1;
         self.collider2 = collider2;
         self.event_status = PairEventStatus::empty();
+        self.filter_verdict = None;
         match &mut self.contacts {
             PairContacts::Rigid(rigid) => {
                 rigid.clear();
