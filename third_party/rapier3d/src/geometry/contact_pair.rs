@@ -343,6 +343,17 @@ impl RigidPairContacts {
         self.soft = None;
     }
 
+    /// Whether [`Self::clear`] would leave this unchanged: no manifolds, clusters, workspace,
+    /// recycling state or soft contacts.
+    pub(crate) fn is_cleared(&self) -> bool {
+        self.manifolds.is_empty()
+            && self.solver_clusters.is_empty()
+            && self.solver_clusters_prev.is_empty()
+            && self.workspace.is_none()
+            && self.recycle_state.is_none()
+            && self.soft.is_none()
+    }
+
     /// Is there any active contact among this side's solver manifolds?
     pub fn has_any_active_contact(&self) -> bool {
         self.solver_manifolds()

@@ -109,6 +109,31 @@ pub(super) fn process_pair(
         return OUTCOME_SKIPPED;
     }
 
+    // A pair that its cached filter verdict rejects (see `contact_pair_filter_epoch`) and that
+    // holds nothing since its last rejection: rejecting it again below would leave it as it is
+    // (no contacts, no transition, outcome `OUTCOME_SKIPPED`) and only rewrite its solver hint
+    // (no qualified manifold; whether a side is an awake dynamic body), so do just that.
+    if let (Some((epoch, None)), Some(rigid)) = (pair.filter_verdict, pair.rigid()) {
+        if rigid.is_cleared()
+            && (co1.flags.active_hooks | co2.flags.active_hooks)
+                .contains(ActiveHooks::FILTER_CONTACT_PAIRS)
+            && hooks.contact_pair_filter_epoch() == Some(epoch)
+        {
+            let dyn_awake = |co: &crate::geometry::Collider| {
+                co.parent.is_some_and(|p| {
+                    let rb = &bodies[p.handle];
+                    rb.body_type.is_dynamic() && !rb.activation.sleeping
+                })
+            };
+            let is_dyn = dyn_awake(co1) || dyn_awake(co2);
+            // SAFETY: each pair is processed at most once per update (disjoint slots).
+            unsafe {
+                *hints_ptr.0.add(edge_id as usize) = (is_dyn as u16) * PAIR_HINT_DYN_BIT;
+            }
+            return OUTCOME_SKIPPED;
+        }
+    }
+
     // Contact recycling: if the relative pose barely moved since the
     // last full update, skip contact determination entirely. Must run before the
     // `has_any_active_contact` walk below (whose result recycling cannot change).
