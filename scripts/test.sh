@@ -61,10 +61,10 @@ echo "[test] cargo test (workspace, release profile)"
 # and lints every one of them, and no test runs an example binary (about 50 release links).
 cargo test --release --workspace --exclude ms2-py --lib --bins --tests
 cargo test --release --workspace --exclude ms2-py --doc
-echo "[test] the vendored rapier3d's kernels match nalgebra bit for bit (third_party/rapier3d/PATCHES.md)"
+echo "[test] the vendored rapier3d's patches: kernels bit for bit, cached filter verdicts (third_party/rapier3d/PATCHES.md)"
 # Not a workspace member (its own lock file and lints), so its patch tests run here.
 cargo test --release --manifest-path third_party/rapier3d/Cargo.toml --lib -- \
-    multibody_kernels generic_joint_constraint::tests
+    multibody_kernels generic_joint_constraint::tests filter_verdicts_are_cached_per_epoch
 echo "[test] ms2-tasks feature combinations (clippy --all-targets each; state-only tests)"
 # Every feature combination of ms2-tasks must build (lints only, not builds), and the
 # state-only runtime (`rapier` alone: no wgpu, no MPM, no planner) must pass its tests.

@@ -26,7 +26,7 @@ pub use crate::ids::ArticulationId;
 use crate::ids::{BodyId, BodyKind};
 use crate::math::{pose_from_na, vec_from_na, Pose3};
 use crate::shape::{MassSpec, ShapeSpec, VisualShape};
-use crate::world::{BodyEntry, ExcludedPairs, World};
+use crate::world::{BodyEntry, World};
 
 /// One link of a built articulation.
 #[derive(Clone, Debug)]
@@ -429,7 +429,7 @@ impl World {
                     }
                 }
                 if touching {
-                    self.hooks.pairs.insert(ExcludedPairs::key(a, b));
+                    self.hooks.exclude(a, b);
                     for id in [a, b] {
                         for &c in &self.table[id.index()].colliders {
                             let co = &mut self.sim.colliders[c];

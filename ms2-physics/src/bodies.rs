@@ -8,7 +8,7 @@ use crate::articulation::{Articulation, ArticulationId};
 use crate::error::{check_finite, check_pose_finite, PhysicsError, Result};
 use crate::math::{pose_from_na, pose_to_na, vec_from_na, vec_to_na, Pose3};
 use crate::shape::{ShapeSpec, VisualShape};
-use crate::world::{BodyEntry, BodyId, BodyKind, ExcludedPairs, World};
+use crate::world::{BodyEntry, BodyId, BodyKind, World};
 
 impl World {
     pub(crate) fn entry(&self, body: BodyId) -> Result<&BodyEntry> {
@@ -243,11 +243,10 @@ impl World {
     pub fn set_collision_between(&mut self, a: BodyId, b: BodyId, enabled: bool) -> Result<()> {
         self.entry(a)?;
         self.entry(b)?;
-        let key = ExcludedPairs::key(a, b);
         if enabled {
-            self.hooks.pairs.remove(&key);
+            self.hooks.include(a, b);
         } else {
-            self.hooks.pairs.insert(key);
+            self.hooks.exclude(a, b);
             for id in [a, b] {
                 let colliders = self.table[id.index()].colliders.clone();
                 for c in colliders {

@@ -1,5 +1,6 @@
 //! The rigid world: rapier's sets, the body table, actors, stepping and body queries.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
 use rustc_hash::FxHashSet;
@@ -35,14 +36,47 @@ pub(crate) struct BodyEntry {
 }
 
 /// Body pairs whose contacts are ignored (robot links that touch at rest), as a rapier hook.
-#[derive(Clone, Debug, Default)]
+///
+/// Its verdicts depend only on the set and on the colliders' `user_data` (their body ids, set
+/// once when a collider is created), so it lets rapier's narrow phase cache them per contact
+/// pair (`contact_pair_filter_epoch`): `epoch` changes with every change of the set and is
+/// unique in the process, so a pair's cached verdict from another set (a restored clone of the
+/// simulation, another world) never matches it.
+#[derive(Clone, Debug)]
 pub(crate) struct ExcludedPairs {
-    pub(crate) pairs: FxHashSet<(u32, u32)>,
+    pairs: FxHashSet<(u32, u32)>,
+    epoch: u64,
+}
+
+/// The source of [`ExcludedPairs`] epochs: one value per set content, never reused.
+static NEXT_EXCLUSION_EPOCH: AtomicU64 = AtomicU64::new(0);
+
+impl Default for ExcludedPairs {
+    fn default() -> Self {
+        ExcludedPairs {
+            pairs: FxHashSet::default(),
+            epoch: NEXT_EXCLUSION_EPOCH.fetch_add(1, Ordering::Relaxed),
+        }
+    }
 }
 
 impl ExcludedPairs {
     pub(crate) fn key(a: BodyId, b: BodyId) -> (u32, u32) {
         (a.0.min(b.0), a.0.max(b.0))
+    }
+
+    /// Ignores contacts between `a` and `b` from now on.
+    pub(crate) fn exclude(&mut self, a: BodyId, b: BodyId) {
+        if self.pairs.insert(ExcludedPairs::key(a, b)) {
+            self.epoch = NEXT_EXCLUSION_EPOCH.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    /// Restores contacts between `a` and `b`.
+    pub(crate) fn include(&mut self, a: BodyId, b: BodyId) {
+        if self.pairs.remove(&ExcludedPairs::key(a, b)) {
+            self.epoch = NEXT_EXCLUSION_EPOCH.fetch_add(1, Ordering::Relaxed);
+        }
     }
 }
 
@@ -58,6 +92,10 @@ impl PhysicsHooks for ExcludedPairs {
         } else {
             Some(SolverFlags::default())
         }
+    }
+
+    fn contact_pair_filter_epoch(&self) -> Option<u64> {
+        Some(self.epoch)
     }
 }
 

@@ -218,6 +218,13 @@ pub struct ContactPair {
     /// The pair's contacts, in the form the two colliders call for: contact manifolds, or
     /// the contact candidates of two soft surfaces.
     pub contacts: PairContacts,
+    /// The contact-pair filter hook's verdict for this pair with the epoch it was computed in
+    /// (see [`PhysicsHooks::contact_pair_filter_epoch`]); `None`: not computed, or the hook
+    /// does not allow caching. Not serialized: a deserialized pair asks the hook again.
+    ///
+    /// [`PhysicsHooks::contact_pair_filter_epoch`]: crate::pipeline::PhysicsHooks::contact_pair_filter_epoch
+    #[cfg_attr(feature = "serde-serialize", serde(skip))]
+    pub(crate) filter_verdict: Option<(u64, Option<SolverFlags>)>,
 }
 
 /// The contacts of a [`ContactPair`], with a fixed layout: the solver addresses a pair's manifolds
@@ -336,6 +343,17 @@ impl RigidPairContacts {
         self.soft = None;
     }
 
+    /// Whether [`Self::clear`] would leave this unchanged: no manifolds, clusters, workspace,
+    /// recycling state or soft contacts.
+    pub(crate) fn is_cleared(&self) -> bool {
+        self.manifolds.is_empty()
+            && self.solver_clusters.is_empty()
+            && self.solver_clusters_prev.is_empty()
+            && self.workspace.is_none()
+            && self.recycle_state.is_none()
+            && self.soft.is_none()
+    }
+
     /// Is there any active contact among this side's solver manifolds?
     pub fn has_any_active_contact(&self) -> bool {
         self.solver_manifolds()
@@ -424,6 +442,7 @@ impl ContactPair {
             collider2,
             event_status: PairEventStatus::empty(),
             contacts: PairContacts::Rigid(RigidPairContacts::new()),
+            filter_verdict: None,
         }
     }
 
@@ -434,6 +453,7 @@ impl ContactPair {
         self.collider1 = collider1;
         self.collider2 = collider2;
         self.event_status = PairEventStatus::empty();
+        self.filter_verdict = None;
         match &mut self.contacts {
             PairContacts::Rigid(rigid) => {
                 rigid.clear();

@@ -262,6 +262,30 @@ pub trait PhysicsHooks: crate::utils::MaybeSync {
         Some(SolverFlags::COMPUTE_RIGID_IMPULSES)
     }
 
+    /// The epoch of [`Self::filter_contact_pair`]'s verdicts, if the narrow phase may cache them.
+    ///
+    /// `None` (the default): the filter is called for every update of every pair that reaches
+    /// it, as described there.
+    ///
+    /// `Some(epoch)` promises that, as long as this method returns the same `epoch`, the
+    /// filter's verdict for a pair of colliders depends on nothing but the two collider
+    /// handles (not on poses, velocities, or the order of the calls). The narrow phase then
+    /// keeps each contact pair's verdict with the epoch it was computed in, and calls the
+    /// filter again only when the epoch differs (or the pair is new). Such a filter may also be
+    /// called, once per epoch, for pairs that the built-in rules (same body, joints, collision
+    /// groups, body types) reject, so that the pairs it rejects skip those rules afterwards.
+    /// Return a different epoch whenever a verdict may change, e.g. a counter bumped by every
+    /// change of the filter's data; an epoch value must never be reused for different
+    /// verdicts, also not across clones of the physics state.
+    ///
+    /// The cache is per contact pair and not serialized: a deserialized, new or re-added pair
+    /// calls the filter again. The active-hook flags of the colliders are read at every update
+    /// (a pair whose colliders no longer ask for [`ActiveHooks::FILTER_CONTACT_PAIRS`] ignores
+    /// its cached verdict). CCD calls the filter without the cache.
+    fn contact_pair_filter_epoch(&self) -> Option<u64> {
+        None
+    }
+
     /// Applies the intersection pair filter.
     ///
     /// Note that this method will only be called if at least one of the colliders

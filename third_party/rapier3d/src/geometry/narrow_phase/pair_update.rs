@@ -109,6 +109,31 @@ pub(super) fn process_pair(
         return OUTCOME_SKIPPED;
     }
 
+    // A pair that its cached filter verdict rejects (see `contact_pair_filter_epoch`) and that
+    // holds nothing since its last rejection: rejecting it again below would leave it as it is
+    // (no contacts, no transition, outcome `OUTCOME_SKIPPED`) and only rewrite its solver hint
+    // (no qualified manifold; whether a side is an awake dynamic body), so do just that.
+    if let (Some((epoch, None)), Some(rigid)) = (pair.filter_verdict, pair.rigid()) {
+        if rigid.is_cleared()
+            && (co1.flags.active_hooks | co2.flags.active_hooks)
+                .contains(ActiveHooks::FILTER_CONTACT_PAIRS)
+            && hooks.contact_pair_filter_epoch() == Some(epoch)
+        {
+            let dyn_awake = |co: &crate::geometry::Collider| {
+                co.parent.is_some_and(|p| {
+                    let rb = &bodies[p.handle];
+                    rb.body_type.is_dynamic() && !rb.activation.sleeping
+                })
+            };
+            let is_dyn = dyn_awake(co1) || dyn_awake(co2);
+            // SAFETY: each pair is processed at most once per update (disjoint slots).
+            unsafe {
+                *hints_ptr.0.add(edge_id as usize) = (is_dyn as u16) * PAIR_HINT_DYN_BIT;
+            }
+            return OUTCOME_SKIPPED;
+        }
+    }
+
     // Contact recycling: if the relative pose barely moved since the
     // last full update, skip contact determination entirely. Must run before the
     // `has_any_active_contact` walk below (whose result recycling cannot change).
@@ -180,6 +205,40 @@ pub(super) fn process_pair(
     let mut outcome = OUTCOME_SKIPPED;
 
     'emit_events: {
+        let active_hooks = co1.flags.active_hooks | co2.flags.active_hooks;
+
+        // A filter hook that allows caching (`contact_pair_filter_epoch`) is asked once per
+        // epoch, before the built-in rules: every rejection below has the same effect, so a
+        // pair the hook rejects is rejected here without the rules (`Some(None)`).
+        let cached_verdict = if active_hooks.contains(ActiveHooks::FILTER_CONTACT_PAIRS) {
+            hooks
+                .contact_pair_filter_epoch()
+                .map(|epoch| match pair.filter_verdict {
+                    Some((cached_epoch, verdict)) if cached_epoch == epoch => verdict,
+                    _ => {
+                        let context = PairFilterContext {
+                            bodies,
+                            colliders,
+                            rigid_body1: rb_handle1,
+                            rigid_body2: rb_handle2,
+                            collider1: pair.collider1,
+                            collider2: pair.collider2,
+                        };
+                        let verdict = hooks.filter_contact_pair(&context);
+                        pair.filter_verdict = Some((epoch, verdict));
+                        verdict
+                    }
+                })
+        } else {
+            None
+        };
+        if matches!(cached_verdict, Some(None)) {
+            if clear_filtered_pair(pair) {
+                outcome = OUTCOME_CLEARED_IN_GRAPH;
+            }
+            break 'emit_events;
+        }
+
         if rb_handle1 == rb_handle2 && co1.parent.is_some() {
             // Same parents. Ignore collisions.
             if clear_filtered_pair(pair) {
@@ -279,19 +338,23 @@ pub(super) fn process_pair(
             break 'emit_events;
         }
 
-        let active_hooks = co1.flags.active_hooks | co2.flags.active_hooks;
-
         let mut solver_flags = if active_hooks.contains(ActiveHooks::FILTER_CONTACT_PAIRS) {
-            let context = PairFilterContext {
-                bodies,
-                colliders,
-                rigid_body1: rb_handle1,
-                rigid_body2: rb_handle2,
-                collider1: pair.collider1,
-                collider2: pair.collider2,
+            let verdict = match cached_verdict {
+                Some(verdict) => verdict,
+                None => {
+                    let context = PairFilterContext {
+                        bodies,
+                        colliders,
+                        rigid_body1: rb_handle1,
+                        rigid_body2: rb_handle2,
+                        collider1: pair.collider1,
+                        collider2: pair.collider2,
+                    };
+                    hooks.filter_contact_pair(&context)
+                }
             };
 
-            if let Some(solver_flags) = hooks.filter_contact_pair(&context) {
+            if let Some(solver_flags) = verdict {
                 solver_flags
             } else {
                 // No contact allowed.

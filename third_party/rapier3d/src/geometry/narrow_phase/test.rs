@@ -290,3 +290,135 @@ pub fn collider_set_parent_no_self_intersection() {
         "There should be a contact manifold."
     );
 }
+
+/// A contact-pair filter that counts its calls and reports an epoch set by the test.
+struct CountingFilter {
+    calls: core::sync::atomic::AtomicUsize,
+    /// `0`: no epoch (`None`, upstream behaviour); else the epoch reported.
+    epoch: core::sync::atomic::AtomicU64,
+    reject: core::sync::atomic::AtomicBool,
+}
+
+impl crate::pipeline::PhysicsHooks for CountingFilter {
+    fn filter_contact_pair(
+        &self,
+        _context: &crate::pipeline::PairFilterContext,
+    ) -> Option<SolverFlags> {
+        use core::sync::atomic::Ordering;
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        if self.reject.load(Ordering::Relaxed) {
+            None
+        } else {
+            Some(SolverFlags::default())
+        }
+    }
+
+    fn contact_pair_filter_epoch(&self) -> Option<u64> {
+        match self.epoch.load(core::sync::atomic::Ordering::Relaxed) {
+            0 => None,
+            e => Some(e),
+        }
+    }
+}
+
+/// The filter verdict cache (`PhysicsHooks::contact_pair_filter_epoch`): a hook without an
+/// epoch is asked at every update, one with an epoch once per epoch, and a cached verdict is
+/// applied (rejection: no contacts; acceptance: contacts) until the epoch changes.
+#[test]
+pub fn filter_verdicts_are_cached_per_epoch() {
+    use crate::pipeline::ActiveHooks;
+    use core::sync::atomic::Ordering;
+
+    let mut bodies = RigidBodySet::new();
+    let mut colliders = ColliderSet::new();
+    let ground = bodies.insert(RigidBodyBuilder::fixed());
+    colliders.insert_with_parent(
+        ColliderBuilder::cuboid(1.0, 1.0, 0.1)
+            .active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS)
+            .build(),
+        ground,
+        &mut bodies,
+    );
+    // A ball resting on the box (slightly inside it), awake: its pair is updated every step.
+    let ball = bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(0.0, 0.0, 0.599))
+            .can_sleep(false),
+    );
+    colliders.insert_with_parent(ColliderBuilder::ball(0.5).build(), ball, &mut bodies);
+
+    let params = IntegrationParameters::default();
+    let mut pipeline = PhysicsPipeline::new();
+    let mut islands = IslandManager::new();
+    let mut broad_phase = DefaultBroadPhase::new();
+    let mut narrow_phase = NarrowPhase::new();
+    let mut impulse_joints = ImpulseJointSet::new();
+    let mut multibody_joints = MultibodyJointSet::new();
+    let mut soft_bodies = SoftBodySet::new();
+    let mut ccd = CCDSolver::new();
+    let hooks = CountingFilter {
+        calls: 0.into(),
+        epoch: 0.into(),
+        reject: false.into(),
+    };
+    let mut step = |narrow_phase: &mut NarrowPhase, bodies: &mut RigidBodySet| {
+        pipeline.step(
+            Vector::new(0.0, 0.0, -9.81),
+            &params,
+            &mut islands,
+            &mut broad_phase,
+            narrow_phase,
+            bodies,
+            &mut colliders,
+            &mut impulse_joints,
+            &mut multibody_joints,
+            &mut soft_bodies,
+            &mut ccd,
+            &hooks,
+            &(),
+        );
+    };
+    let touching = |narrow_phase: &NarrowPhase| {
+        narrow_phase
+            .contact_pairs()
+            .any(|pair| pair.has_any_active_contact())
+    };
+
+    // No epoch: asked at every update.
+    for _ in 0..5 {
+        step(&mut narrow_phase, &mut bodies);
+    }
+    assert_eq!(hooks.calls.load(Ordering::Relaxed), 5);
+    assert!(touching(&narrow_phase));
+
+    // An epoch and a rejection: asked once, the pair stays without contacts.
+    hooks.epoch.store(1, Ordering::Relaxed);
+    hooks.reject.store(true, Ordering::Relaxed);
+    for _ in 0..5 {
+        step(&mut narrow_phase, &mut bodies);
+        assert!(!touching(&narrow_phase));
+    }
+    assert_eq!(hooks.calls.load(Ordering::Relaxed), 6);
+
+    // Same epoch, the hook would now accept: the cached rejection holds.
+    hooks.reject.store(false, Ordering::Relaxed);
+    step(&mut narrow_phase, &mut bodies);
+    assert!(!touching(&narrow_phase));
+    assert_eq!(hooks.calls.load(Ordering::Relaxed), 6);
+
+    // A new epoch: asked again, contacts come back, and the acceptance is cached.
+    hooks.epoch.store(2, Ordering::Relaxed);
+    for _ in 0..5 {
+        step(&mut narrow_phase, &mut bodies);
+    }
+    assert!(touching(&narrow_phase));
+    assert_eq!(hooks.calls.load(Ordering::Relaxed), 7);
+
+    // A clone of the narrow phase keeps the cache; a new epoch invalidates it there too.
+    let mut cloned = narrow_phase.clone();
+    hooks.epoch.store(3, Ordering::Relaxed);
+    hooks.reject.store(true, Ordering::Relaxed);
+    step(&mut cloned, &mut bodies);
+    assert!(!touching(&cloned));
+    assert_eq!(hooks.calls.load(Ordering::Relaxed), 8);
+}
