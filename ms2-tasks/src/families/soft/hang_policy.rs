@@ -136,24 +136,24 @@ impl HangPolicy {
         ];
         let s = s0 + 44;
         let up = grasp.truncate().extend(near.z);
-        let far = at(FAR_OFFSET, CROSS_HEIGHT);
         let over = at(FAR_OFFSET, RELEASE_HEIGHT);
         let high = over + Vec3::Z * 0.05;
         // Lift straight up, then turn, then carry (the pinch of the rope's end let go when
-        // the hand lifted, turned and moved at once): across the rod, where the long leg
-        // catches, beyond it, then down on the far side (the rope slides back over the rod
-        // towards the robot as the hand lowers it).
+        // the hand lifted, turned and moved at once): over the rod, where the long leg
+        // catches, then beyond and down on the far side at once (the rope slides back over
+        // the rod towards the robot as the hand lowers it). Moved 6 cm beyond the rod at the
+        // crossing height first, the hand was at the arm's reach and dipped 6-10 cm (seeds 0
+        // and 1): the rope slid off the rod on seed 1.
         w.extend([
             (s + 50, up, grasp_yaw, hold),
             (s + 80, up, carry_yaw, hold),
             (s + 110, near, carry_yaw, hold),
             (s + 115, near, carry_yaw, hold),
             (s + 135, at(0.0, CROSS_HEIGHT), carry_yaw, hold),
-            (s + 145, far, carry_yaw, hold),
-            (s + 165, over, carry_yaw, hold),
-            (s + 165 + SETTLE_STEPS, over, carry_yaw, hold),
-            (s + 165 + SETTLE_STEPS + OPEN_STEPS, over, carry_yaw, open),
-            (s + 180 + SETTLE_STEPS + OPEN_STEPS, high, carry_yaw, open),
+            (s + 160, over, carry_yaw, hold),
+            (s + 160 + SETTLE_STEPS, over, carry_yaw, hold),
+            (s + 160 + SETTLE_STEPS + OPEN_STEPS, over, carry_yaw, open),
+            (s + 175 + SETTLE_STEPS + OPEN_STEPS, high, carry_yaw, open),
             (u32::MAX, high, carry_yaw, open),
         ]);
         w
