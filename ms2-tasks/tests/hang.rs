@@ -110,8 +110,7 @@ fn a_rope_draped_over_a_high_rod_hangs_there_at_rest_and_succeeds() {
 
 #[test]
 fn a_rope_hung_off_centre_stays_on_the_sticky_rod_and_slides_off_a_slippery_one() {
-    // The far leg 8 cm longer than the near one (the rod 40 % along the rope, where the
-    // scripted hand lays it). With the penalty contact's friction alone the rope slid off
+    // The far leg 8 cm longer than the near one (the rod 40 % along the rope). With the penalty contact's friction alone the rope slid off
     // towards its heavier side; the rod's sticky grid contact (ManiSkill2's) holds it.
     let rod = RodPose::from_unit(0.5, 0.3, 0.9);
     let held = simulate_rope_on(
