@@ -50,16 +50,17 @@ pub const GRASP_HEIGHT: f32 = 0.015;
 pub const CROSS_HEIGHT: f32 = 0.17;
 /// Height (m) of the hand above the rod's centre at the release: lowered from the crossing
 /// while it moves beyond the rod ([`FAR_OFFSET`]), the hand lets the rope slide back over the
-/// rod towards the robot, to about 55 % along (seed 8). The piece between hand and rod then
-/// runs nearly level, and at the release it swings down about the rod, taut, instead of
-/// falling slack (released 7 or 10 cm above the rod and 6 cm beyond it, the rope slid further
-/// towards the robot: 42-46 % along on seeds 0 and 1, its lowest particle 3.1 cm up on seed 8).
-pub const RELEASE_HEIGHT: f32 = 0.02;
+/// rod towards the robot, to about 52 % along, and the release to 42-47 % (seeds 0-2). Released
+/// 10 cm above the rod, the rope hung 48 % along on seed 8 (rod 0.212 m high), its lowest
+/// particle 3.1 cm up; released 2 cm above the rod's centre and 11 cm beyond it, the piece
+/// between hand and rod swung down taut (seed 8: 51 % along, 4.1 cm up) but tore off at the
+/// release on seed 2.
+pub const RELEASE_HEIGHT: f32 = 0.07;
 /// Horizontal offsets (m) from the rod's centre along its normal: where the hand starts the
 /// crossing (robot's side) and where it lowers the rope and releases it (far side).
 pub const NEAR_OFFSET: f32 = -0.1;
 /// See [`NEAR_OFFSET`].
-pub const FAR_OFFSET: f32 = 0.11;
+pub const FAR_OFFSET: f32 = 0.06;
 /// Index of the grasped tracked particle ([`super::hang_scene::TRACKED_FRACTIONS`]): the one
 /// a quarter along the rope from its short end.
 const GRASP_TRACKED: usize = 1;
