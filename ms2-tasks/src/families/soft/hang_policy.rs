@@ -53,8 +53,8 @@ pub const CROSS_HEIGHT: f32 = 0.17;
 /// rod towards the robot, to about 52 % along, and the release to 42-47 % (seeds 0-2). Released
 /// 10 cm above the rod, the rope hung 48 % along on seed 8 (rod 0.212 m high), its lowest
 /// particle 3.1 cm up; released 2 cm above the rod's centre and 11 cm beyond it, the piece
-/// between hand and rod swung down taut (seed 8: 51 % along, 4.1 cm up) but tore off at the
-/// release on seed 2.
+/// between hand and rod swung down taut (seed 8: 51 % along, 4.1 cm up), but on seed 2 the
+/// rope's short piece, stretched between hand and rod, tore off at the release.
 pub const RELEASE_HEIGHT: f32 = 0.07;
 /// Horizontal offsets (m) from the rod's centre along its normal: where the hand starts the
 /// crossing (robot's side) and where it lowers the rope and releases it (far side).
