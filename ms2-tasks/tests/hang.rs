@@ -110,8 +110,7 @@ fn a_rope_draped_over_a_high_rod_hangs_there_at_rest_and_succeeds() {
 
 #[test]
 fn a_rope_hung_off_centre_stays_on_the_sticky_rod_and_slides_off_a_slippery_one() {
-    // The far leg 8 cm longer than the near one (the rod 40 % along the rope, where the
-    // scripted hand lays it). With the penalty contact's friction alone the rope slid off
+    // The far leg 8 cm longer than the near one (the rod 40 % along the rope). With the penalty contact's friction alone the rope slid off
     // towards its heavier side; the rod's sticky grid contact (ManiSkill2's) holds it.
     let rod = RodPose::from_unit(0.5, 0.3, 0.9);
     let held = simulate_rope_on(
@@ -136,6 +135,45 @@ fn a_rope_beside_the_rod_falls_to_the_ground_and_fails() {
     bar.start += rod.normal() * 0.1;
     let t = simulate_rope(bar, rod, 1.5);
     assert!(!t.off_ground && !t.over_rod && !t.success, "{t:?}");
+}
+
+#[test]
+fn the_tracked_particles_lie_where_maniskill2_selects_them() {
+    // ManiSkill2's `selected_indices`: the first particle past the start of the bands 5-15 %,
+    // 25-35 %, 48-52 %, 65-75 % and 85-95 % along its straight rope, counted from the short
+    // end. On a straight rope along +x from the origin, each tracked particle's x is its arc
+    // length; it lies on the rope's axis.
+    let bar = BentBar {
+        start: Vec3::new(0.0, 0.0, 0.1),
+        along: Vec3::X,
+        heading: 0.0,
+        pieces: vec![CurvePiece::Straight {
+            length: ROPE_LENGTH,
+        }],
+        half_width: ROPE_HALF_WIDTH,
+        width_scale: None,
+    };
+    let start = RopeStart {
+        bar,
+        grasp_arc: 0.0,
+        fingers: Vec::new(),
+    };
+    let (mut solver, rope) = rope_solver((1.0 / HANG_MPM_FREQ_HZ) as f32).unwrap();
+    let ids = start.add_to(&mut solver, rope, 3).unwrap();
+    for (k, fraction) in [0.05f32, 0.25, 0.48, 0.65, 0.85].into_iter().enumerate() {
+        let i = solver
+            .particle_ids()
+            .iter()
+            .position(|&p| p == ids[k])
+            .unwrap();
+        let p = solver.positions()[i];
+        assert!(
+            (p.x - fraction * ROPE_LENGTH).abs() < 0.003,
+            "tracked particle {k} at x {} m, not {fraction} of the rope",
+            p.x
+        );
+        assert!(p.y.abs() < 0.002 && (p.z - 0.1).abs() < 0.002, "{p:?}");
+    }
 }
 
 fn hang_env(obs_mode: &str) -> ms2_tasks::Env {
@@ -282,7 +320,7 @@ fn state_round_trip_is_bit_exact_and_seeds_repeat() {
     assert_eq!(c.get_state(), d.get_state(), "two restored runs diverged");
 }
 
-/// Heights (m) of the tracked particles (10 %, 30 %, 50 %, 70 %, 90 % along the rope).
+/// Heights (m) of the tracked particles (5 %, 25 %, 48 %, 65 %, 85 % along the rope).
 fn tracked_z(env: &ms2_tasks::Env) -> [f32; 5] {
     let (scene, task) = (env.task_scene().unwrap(), env.task().unwrap());
     let hang = task.downcast_ref::<Hang>().unwrap();
@@ -313,7 +351,7 @@ fn the_fingers_lift_the_rope_they_hold() {
         env.step(&action).unwrap();
     }
     let after = tracked_z(&env);
-    // The fingers hold the rope 20-24 % along.
+    // The fingers hold the rope 20-24 % along (the tracked particles 5 % and 25 % along).
     for k in 0..2 {
         assert!(
             after[k] - before[k] > 0.15,

@@ -1,21 +1,25 @@
-//! `Hang-v0`'s scripted (oracle) policy: lay the rope down, re-grasp it near its short end,
-//! hang it over the rod. It does not solve the task yet (see docs/tasks.md, Hang-v0).
+//! `Hang-v0`'s scripted (oracle) policy: lay the rope down, re-grasp it a quarter along,
+//! hang it over the rod with its middle on the rod (see docs/tasks.md, Hang-v0).
 //!
 //! The episode starts with the rope pinched about a fifth along its length, which leaves
 //! the rope unbalanced over the rod (it slid off towards its heavier side at the release).
 //! So the hand first opens and lets the rope fall to the ground (it lets go cleanly). When
 //! the rope has settled ([`PLAN_STEP`]) the policy reads the particles (the tracked particle
-//! 10 % along the rope, the grasp point, and the rope's direction there) and plans the rest:
-//! hover above the grasp point with the fingers' closing axis across the rope, descend
+//! a quarter along the rope, the grasp point, and the rope's direction there) and plans the
+//! rest: hover above the grasp point with the fingers' closing axis across the rope, descend
 //! around it, close (the fingers' sticky grip holds it), lift it straight up so that it
-//! hangs from the hand, turn the closing axis onto the rod's normal, carry it across the
-//! rod so that the hanging rope first touches the rod (which holds it: the rod is sticky)
-//! beyond its middle, descend a little on the far side, open slowly and rise.
+//! hangs from the hand in two legs (10 and 30 cm), turn the closing axis onto the rod's
+//! normal, carry it across the rod high enough for the short leg to pass over the rod while
+//! the long one catches on it (the rod is sticky), then lower the hand on the far side
+//! until the rope between the hand and the rod plus the short leg weigh about as much as
+//! the long leg on the robot's side, wait, open slowly and rise.
 //!
-//! Measured (seed 0): the rope, re-grasped at its middle, hangs as a closed hairpin (both
-//! legs together below the hand), which cannot straddle the rod; re-grasped near an end, it
-//! lifts, hangs and (with the fingers' 1 cm sticky reach) is carried over the rod, which it
-//! straddles after the release, but off-centre (see [`CROSS_HEIGHT`]).
+//! Why a quarter along: the rope slides over the rod towards the heavier side when the
+//! fingers let go of a piece that is not hanging yet (held 10 % along, the piece between
+//! hand and rod fell and the rope slid to 25-32 % along, its long side on the ground). Held
+//! a quarter along, the short leg already hangs below the hand and only about 9 cm of rope
+//! lies between hand and rod, so the release moves little; held at the middle, the two
+//! 20 cm legs hang together and cannot straddle the rod.
 
 use glam::{Vec2, Vec3};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
@@ -40,17 +44,26 @@ pub const HOVER_HEIGHT: f32 = 0.06;
 /// Lowest TCP height (m) of the grasp: the fingertip pads (1 cm below and above the TCP)
 /// clear of the ground.
 pub const GRASP_HEIGHT: f32 = 0.015;
-/// Height (m) of the crossing above the rod's centre. The rope hanging from the hand first
-/// touches the rod (seed 0) 35 % along at 14 cm, 50 % at 20 cm, 65 % at 26 cm (where the hand
-/// sagged 4 cm below its target); the release then shifts the rope over the rod towards the
-/// robot, to 25-32 % along in every case measured.
-pub const CROSS_HEIGHT: f32 = 0.2;
+/// Height (m) of the hand above the rod's centre while it crosses the rod: the short leg
+/// (10 cm, 7 cm below the hand) passes over the rod, the long one catches on it about 60 %
+/// along the rope (seed 0).
+pub const CROSS_HEIGHT: f32 = 0.17;
+/// Height (m) of the hand above the rod's centre at the release: lowered from the crossing
+/// while it moves beyond the rod ([`FAR_OFFSET`]), the hand lets the rope slide back over the
+/// rod towards the robot, to about 52 % along, and the release to 42-47 % (seeds 0-2). Released
+/// 10 cm above the rod, the rope hung 48 % along on seed 8 (rod 0.212 m high), its lowest
+/// particle 3.1 cm up; released 2 cm above the rod's centre and 11 cm beyond it, the piece
+/// between hand and rod swung down taut (seed 8: 51 % along, 4.1 cm up), but on seed 2 the
+/// rope's short piece, stretched between hand and rod, tore off at the release.
+pub const RELEASE_HEIGHT: f32 = 0.07;
 /// Horizontal offsets (m) from the rod's centre along its normal: where the hand starts the
-/// crossing (robot's side) and where it releases (far side, 3 cm below the crossing height:
-/// descending farther let the heavier near side pull the rope back over the rod).
+/// crossing (robot's side) and where it lowers the rope and releases it (far side).
 pub const NEAR_OFFSET: f32 = -0.1;
 /// See [`NEAR_OFFSET`].
-pub const FAR_OFFSET: f32 = 0.05;
+pub const FAR_OFFSET: f32 = 0.06;
+/// Index of the grasped tracked particle ([`super::hang_scene::TRACKED_FRACTIONS`]): the one
+/// a quarter along the rope from its short end.
+const GRASP_TRACKED: usize = 1;
 /// Radius (m) around the grasp point of the particles whose principal direction is the
 /// rope's direction there.
 const TANGENT_RADIUS: f32 = 0.04;
@@ -128,33 +141,37 @@ impl HangPolicy {
         ];
         let s = s0 + 44;
         let up = grasp.truncate().extend(near.z);
-        let over = at(FAR_OFFSET, CROSS_HEIGHT - 0.03);
+        let over = at(FAR_OFFSET, RELEASE_HEIGHT);
         let high = over + Vec3::Z * 0.05;
-        // Lift straight up, then turn, then carry: the pinch of the rope's end let go when
-        // the hand lifted, turned and moved at once.
+        // Lift straight up, then turn, then carry (the pinch of the rope's end let go when
+        // the hand lifted, turned and moved at once): over the rod, where the long leg
+        // catches, then beyond and down on the far side at once (the rope slides back over
+        // the rod towards the robot as the hand lowers it). Moved 6 cm beyond the rod at the
+        // crossing height first, the hand was at the arm's reach and dipped 6-10 cm (seeds 0
+        // and 1): the rope slid off the rod on seed 1.
         w.extend([
             (s + 50, up, grasp_yaw, hold),
             (s + 80, up, carry_yaw, hold),
             (s + 110, near, carry_yaw, hold),
             (s + 115, near, carry_yaw, hold),
             (s + 135, at(0.0, CROSS_HEIGHT), carry_yaw, hold),
-            (s + 150, over, carry_yaw, hold),
-            (s + 150 + SETTLE_STEPS, over, carry_yaw, hold),
-            (s + 150 + SETTLE_STEPS + OPEN_STEPS, over, carry_yaw, open),
-            (s + 165 + SETTLE_STEPS + OPEN_STEPS, high, carry_yaw, open),
+            (s + 160, over, carry_yaw, hold),
+            (s + 160 + SETTLE_STEPS, over, carry_yaw, hold),
+            (s + 160 + SETTLE_STEPS + OPEN_STEPS, over, carry_yaw, open),
+            (s + 175 + SETTLE_STEPS + OPEN_STEPS, high, carry_yaw, open),
             (u32::MAX, high, carry_yaw, open),
         ]);
         w
     }
 
-    /// The grasp point (m: the tracked particle 10 % along the rope, 4 cm from its short
-    /// end, within the arm's reach on the ground) and the rope's horizontal direction there
+    /// The grasp point (m: the tracked particle a quarter along the rope, 10 cm from its
+    /// short end) and the rope's horizontal direction there
     /// (unit, towards that end) in `env`.
     pub fn grasp_point(env: &Env) -> Option<(Vec3, Vec2)> {
         let (scene, task) = (env.task_scene()?, env.task()?);
         let hang = task.downcast_ref::<Hang>()?;
         let tracked = hang.hang_eval(scene.world.as_ref())?.tracked;
-        let grasp = tracked[0];
+        let grasp = tracked[GRASP_TRACKED];
         let x = hang.arm().soft()?.solver().positions();
         let near: Vec<Vec2> = x
             .iter()
@@ -169,10 +186,10 @@ impl HangPolicy {
             sxy += d.x * d.y;
             syy += d.y * d.y;
         }
-        // Principal axis of the 2×2 covariance, pointed away from the particle at 30 %.
+        // Principal axis of the 2×2 covariance, pointed towards the short end.
         let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
         let mut along = Vec2::new(angle.cos(), angle.sin());
-        if along.dot((grasp - tracked[1]).truncate()) < 0.0 {
+        if along.dot((tracked[0] - tracked[GRASP_TRACKED + 1]).truncate()) < 0.0 {
             along = -along;
         }
         Some((grasp, along))

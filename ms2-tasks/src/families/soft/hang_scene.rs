@@ -36,9 +36,13 @@ pub const ROPE_COLOR: [f32; 3] = [1.0, 1.0, 0.5];
 /// Range of the grasp point's arc length from the rope's short end (m): ManiSkill2's
 /// recorded starts hold the rope 20-24 % along it. Drawn in whole [`ROPE_SPACING`] steps.
 pub const GRASP_ARC: (f32, f32) = (0.08, 0.095);
-/// Fractions of the rope's length of the five tracked particles (ManiSkill2's
-/// `selected_indices`: two near each end, one in the middle), from the short end.
-pub const TRACKED_FRACTIONS: [f32; 5] = [0.1, 0.3, 0.5, 0.7, 0.9];
+/// Fractions of the rope's length of the five tracked particles, from the short end:
+/// ManiSkill2's `selected_indices`, the first particle (in its x-fastest lattice order) past
+/// the start of each of the bands 5-15 %, 25-35 %, 48-52 %, 65-75 % and 85-95 % along its
+/// straight rope, whose lower end is the short one. (Until 2026-11-28 ms2 took the bands'
+/// middles, 10/30/50/70/90 %, which asked the rod to lie 30-70 % along the rope instead of
+/// ManiSkill2's 25-65 %.)
+pub const TRACKED_FRACTIONS: [f32; 5] = [0.05, 0.25, 0.48, 0.65, 0.85];
 
 /// Grid cell (m) of the rope's solver: 5 mm, four cells across the rope. With 1 cm cells
 /// (two across, ManiSkill2 uses 1.5 cm) the rope tears under its own weight where it hangs
