@@ -39,12 +39,14 @@ pub(crate) struct BodyEntry {
 ///
 /// Its verdicts depend only on the set and on the colliders' `user_data` (their body ids, set
 /// once when a collider is created), so it lets rapier's narrow phase cache them per contact
-/// pair (`contact_pair_filter_epoch`): `epoch` changes with every change of the set and is
-/// unique in the process, so a pair's cached verdict from another set (a restored clone of the
-/// simulation, another world) never matches it.
+/// pair (`contact_pair_filter_epoch`, with the `rapier-filter-epoch` feature and ms2's vendored
+/// rapier3d): `epoch` changes with every change of the set and is unique in the process, so a
+/// pair's cached verdict from another set (a restored clone of the simulation, another world)
+/// never matches it.
 #[derive(Clone, Debug)]
 pub(crate) struct ExcludedPairs {
     pairs: FxHashSet<(u32, u32)>,
+    #[cfg_attr(not(feature = "rapier-filter-epoch"), allow(dead_code))]
     epoch: u64,
 }
 
@@ -94,6 +96,7 @@ impl PhysicsHooks for ExcludedPairs {
         }
     }
 
+    #[cfg(feature = "rapier-filter-epoch")]
     fn contact_pair_filter_epoch(&self) -> Option<u64> {
         Some(self.epoch)
     }
