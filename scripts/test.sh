@@ -21,6 +21,23 @@ if [ "${MS2_HEAVY_TESTS:-0}" != "0" ] && [ -n "${MS2_HEAVY_TESTS:-}" ]; then
   echo "[test] heavy: the long pytest sweeps too (MS2_HEAVY_TESTS=$MS2_HEAVY_TESTS)"
 fi
 started=$(date +%s)
+# Seconds per stage, printed at the end (and on failure), so that CI's log tail shows where
+# its time went.
+stage_names=(); stage_secs=(); stage_name="start"; stage_started=$started
+stage() {
+  local now; now=$(date +%s)
+  stage_names+=("$stage_name"); stage_secs+=($((now - stage_started)))
+  stage_name="$1"; stage_started=$now
+}
+print_stage_times() {
+  local status=$?
+  stage "end"
+  echo "[test] seconds per stage (exit status $status):"
+  for i in "${!stage_names[@]}"; do
+    printf '[test]   %6d  %s\n' "${stage_secs[$i]}" "${stage_names[$i]}"
+  done
+}
+trap print_stage_times EXIT
 # A build from scratch needs several GB of disk (less without the release profile's line tables,
 # which CI drops: CARGO_PROFILE_RELEASE_DEBUG=0); say so up front rather than failing mid-link.
 free_kb=$(df -Pk . | awk 'NR == 2 {print $4}')
@@ -28,10 +45,13 @@ echo "[test] free disk here: $((free_kb / 1024 / 1024)) GB"
 if [ "$free_kb" -lt $((8 * 1024 * 1024)) ]; then
   echo "[test] warning: less than 8 GB free; a build from scratch may stop with 'No space left on device'" >&2
 fi
+stage "repository hygiene"
 echo "[test] repository hygiene (no tracked build artefacts; the check's own test)"
 bash scripts/check_repo.sh
 bash scripts/test_check_repo.sh
+stage "setup (apt, venv, wheel build)"
 bash scripts/setup.sh
+stage "apt packages for the viewer tests"
 # The viewer's tests (ms2-py/tests/test_viewer.py, test_teleop.py) open windows on a virtual X
 # server and drive them with synthetic key and mouse events; the leaderboard's test
 # (test_leaderboard.py) screenshots its HTML page in headless Chromium.
@@ -48,23 +68,30 @@ if [ "${#missing[@]}" -gt 0 ]; then
 fi
 # shellcheck disable=SC1091
 . .venv/bin/activate
+stage "fmt + clippy"
 echo "[test] cargo fmt --check and clippy (workspace, all targets, warnings are errors)"
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets -- -D warnings
+stage "cargo doc"
 echo "[test] cargo doc (workspace crates, broken intra-doc links are errors)"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --workspace --exclude ms2-py
+stage "clippy ms2-physics --no-default-features"
 echo "[test] ms2-physics without its rapier engine (--no-default-features: the engine-neutral vocabulary)"
 cargo clippy -p ms2-physics --no-default-features --all-targets -- -D warnings
+stage "cargo test (workspace, release)"
 echo "[test] cargo test (workspace, release profile)"
 # Libraries, binaries, integration tests and examples marked `test = true`, then the doc tests.
 # The other examples are not built again in release here: clippy --all-targets above compiles
 # and lints every one of them, and no test runs an example binary (about 50 release links).
 cargo test --release --workspace --exclude ms2-py --lib --bins --tests
+stage "doc tests"
 cargo test --release --workspace --exclude ms2-py --doc
+stage "vendored rapier3d tests"
 echo "[test] the vendored rapier3d's patches: kernels bit for bit, cached filter verdicts (third_party/rapier3d/PATCHES.md)"
 # Not a workspace member (its own lock file and lints), so its patch tests run here.
 cargo test --release --manifest-path third_party/rapier3d/Cargo.toml --lib -- \
     multibody_kernels generic_joint_constraint::tests filter_verdicts_are_cached_per_epoch
+stage "ms2-tasks feature combinations"
 echo "[test] ms2-tasks feature combinations (clippy --all-targets each; state-only tests)"
 # Every feature combination of ms2-tasks must build (lints only, not builds), and the
 # state-only runtime (`rapier` alone: no wgpu, no MPM, no planner) must pass its tests.
@@ -78,10 +105,13 @@ for features in "" rapier rapier,render rapier,soft rapier,demos; do
     echo "[test]   cargo clippy -p ms2-tasks --all-targets --no-default-features --features '$features'"
     cargo clippy -q -p ms2-tasks --all-targets --no-default-features --features "$features" -- -D warnings
 done
+stage "ms2-tasks state-only tests"
 echo "[test]   cargo test --release -p ms2-tasks --no-default-features --features rapier"
 cargo test --release -p ms2-tasks --no-default-features --features rapier --lib --tests
+stage "ruff"
 echo "[test] ruff (ms2-py)"
 ruff check ms2-py
+stage "pytest"
 echo "[test] pytest (ms2-py/tests)"
 # One worker process per core (pytest-xdist; PYTEST_WORKERS overrides): most tests simulate on
 # one thread, so two workers use both cores; conftest.py starts the minutes-long tests first so
@@ -90,6 +120,7 @@ echo "[test] pytest (ms2-py/tests)"
 # scripted episode, 539 s), where the suite with the soft tasks' full sweeps took 3,782 s at
 # load 8-10 the same morning.
 python -m pytest -q -n "${PYTEST_WORKERS:-auto}" --dist load ms2-py/tests
+stage "cargo package"
 echo "[test] cargo package (every library crate packaged and built from its .crate alone)"
 bash scripts/check_packages.sh
 echo "[test] all tests passed in $(($(date +%s) - started)) s"
