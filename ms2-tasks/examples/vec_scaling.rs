@@ -7,8 +7,9 @@
 //!
 //! Prints, all measured in this one process on the same machine:
 //! - one env stepped alone (env steps/s);
-//! - `VecEnv` with `num_envs` envs on rayon's pool, episodes auto-reset as `make_vec` does
-//!   (env steps/s and the ratio to the single env);
+//! - `VecEnv` with `num_envs` envs, episodes auto-reset as `make_vec` does (env steps/s and the
+//!   ratio to the single env), on its default spinning pool and on rayon's, in alternating
+//!   blocks of 100 vector steps;
 //! - the **lockstep bound**: the `num_envs` envs stepped one after another on one thread, each
 //!   env step timed. A vector step lasts as long as its slowest env's (every env must finish
 //!   before the batch of observations returns), so with one env per core the best possible
@@ -89,34 +90,60 @@ fn main() -> Result<(), EnvError> {
     let single = steps as f64 / t.elapsed().as_secs_f64();
     drop(env);
 
-    // The vector env, auto-resetting an env whose episode ended (make_vec's convention).
-    let mut vec_env = VecEnv::new(&cfg, num_envs)?;
+    // The vector env, auto-resetting an env whose episode ended (make_vec's convention): on
+    // its default spinning pool and on rayon's, alternating blocks of vector steps so that both
+    // see the same machine.
     let seeds: Vec<Option<u64>> = (0..num_envs as u64).map(Some).collect();
-    vec_env.reset(&seeds)?;
-    let mut needs_reset = vec![false; num_envs];
-    let mut rng = episode_rng(1);
-    let t = Instant::now();
-    for _ in 0..rounds {
-        let actions: Vec<Vec<f32>> = (0..num_envs)
-            .map(|_| random_action(&mut rng, dim))
-            .collect();
-        let commands: Vec<EnvCommand<'_>> = actions
-            .iter()
-            .zip(&needs_reset)
-            .map(|(a, &reset)| match reset {
-                true => EnvCommand::Reset { seed: None },
-                false => EnvCommand::Step(a),
-            })
-            .collect();
-        let outs = vec_env.run(&commands)?;
-        for (flag, out) in needs_reset.iter_mut().zip(outs) {
-            *flag = out.is_some_and(|o| o.terminated || o.truncated);
-        }
+    let mut pools = Vec::new();
+    for spinning in [true, false] {
+        let mut vec_env = VecEnv::new(&cfg, num_envs)?;
+        vec_env.set_spinning_pool(spinning);
+        vec_env.reset(&seeds)?;
+        // (env, which envs reset at the next step, action RNG, seconds, env steps)
+        pools.push((
+            vec_env,
+            vec![false; num_envs],
+            episode_rng(1),
+            0.0f64,
+            0usize,
+        ));
     }
-    let vector = (rounds * num_envs) as f64 / t.elapsed().as_secs_f64();
-    drop(vec_env);
+    const BLOCK: usize = 100;
+    let mut done = 0;
+    while done < rounds {
+        let block = BLOCK.min(rounds - done);
+        for pool in &mut pools {
+            let (vec_env, needs_reset, rng, seconds, count) = pool;
+            let t = Instant::now();
+            for _ in 0..block {
+                let actions: Vec<Vec<f32>> =
+                    (0..num_envs).map(|_| random_action(rng, dim)).collect();
+                let commands: Vec<EnvCommand<'_>> = actions
+                    .iter()
+                    .zip(needs_reset.iter())
+                    .map(|(a, &reset)| match reset {
+                        true => EnvCommand::Reset { seed: None },
+                        false => EnvCommand::Step(a),
+                    })
+                    .collect();
+                let outs = vec_env.run(&commands)?;
+                for (flag, out) in needs_reset.iter_mut().zip(outs) {
+                    *flag = out.is_some_and(|o| o.terminated || o.truncated);
+                }
+            }
+            *seconds += t.elapsed().as_secs_f64();
+            *count += block * num_envs;
+        }
+        done += block;
+    }
+    let rates: Vec<f64> = pools
+        .iter()
+        .map(|(_, _, _, seconds, count)| *count as f64 / seconds)
+        .collect();
+    let (vector, vector_rayon) = (rates[0], rates[1]);
+    drop(pools);
 
-    // The same threaded loop (rayon, one env per task, as `VecEnv` runs them), each env's
+    // The same threaded loop (rayon, one env per task, as `VecEnv` runs them on rayon's pool), each env's
     // step timed inside its task: where a vector step's time goes beyond its slowest env.
     let mut envs = (0..num_envs)
         .map(|_| make_env(&cfg))
@@ -155,10 +182,11 @@ fn main() -> Result<(), EnvError> {
 
     println!(
         "{env_id} {mode}, {} threads: single {single:.0} env steps/s; VecEnv({num_envs}) \
-         {vector:.0} env steps/s = {:.2}x single; lockstep bound {bound:.2}x \
-         (mean env step {:.0} µs, mean slowest of {num_envs} {:.0} µs)",
+         {vector:.0} env steps/s = {:.2}x single (on rayon's pool {vector_rayon:.0} = {:.2}x); \
+         lockstep bound (one env per thread) {bound:.2}x (mean env step {:.0} µs, mean slowest of {num_envs} {:.0} µs)",
         rayon::current_num_threads(),
         vector / single,
+        vector_rayon / single,
         1e6 * sum_mean / rounds as f64,
         1e6 * sum_max / rounds as f64,
     );

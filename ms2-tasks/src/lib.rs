@@ -68,6 +68,7 @@ pub mod state_check;
 pub mod task;
 mod task_env;
 mod vec_env;
+mod vec_pool;
 
 pub use config::{EnvConfig, ObsMode, RewardMode, MAX_EPISODE_STEPS};
 pub use env::{make_env, Env, StepOutput};

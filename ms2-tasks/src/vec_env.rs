@@ -1,5 +1,5 @@
-//! [`VecEnv`]: several envs stepped in parallel on rayon's thread pool, their cameras rendered
-//! in one batch.
+//! [`VecEnv`]: several envs stepped in parallel (rigid state steps on a pool whose idle workers
+//! spin briefly, `vec_pool`; the rest on rayon's), their cameras rendered in one batch.
 
 use rayon::prelude::*;
 
@@ -57,6 +57,9 @@ pub struct VecEnv {
     /// Whether visual steps render in two pipelined halves (see [`VecEnv::run`]).
     #[cfg_attr(not(feature = "render"), allow(dead_code))]
     pipelined: bool,
+    /// Whether state steps of these (rigid) envs run on `vec_pool`'s spinning pool rather than
+    /// rayon's (always false for soft-body envs, whose MPM step uses rayon's pool itself).
+    spinning_pool: bool,
 }
 
 impl VecEnv {
@@ -68,15 +71,18 @@ impl VecEnv {
             )));
         }
         cfg.check_bounds()?;
+        let spinning = crate::vec_pool::spinning_by_default()?;
         let envs = (0..num_envs)
             .into_par_iter()
             .map(|_| Env::new(cfg))
             .collect::<Result<Vec<_>, _>>()?;
         let action_dim = envs[0].action_space().size();
+        let spinning_pool = spinning && !has_soft_bodies(&envs[0]);
         Ok(VecEnv {
             envs,
             action_dim,
             pipelined: true,
+            spinning_pool,
         })
     }
 
@@ -101,6 +107,17 @@ impl VecEnv {
     /// this changes nothing.
     pub fn set_pipelined_rendering(&mut self, pipelined: bool) {
         self.pipelined = pipelined;
+    }
+
+    /// Steps rigid envs in state modes on a pool whose idle workers spin about half a
+    /// millisecond before sleeping, the calling thread stepping envs too (the default), or on
+    /// rayon's pool (`false`), whose workers are woken for every vector step. The outputs are the
+    /// same either way. The default is the spinning pool unless the environment variable
+    /// `MS2_VEC_POOL` is `rayon` (for machines whose cores are busy with other work, where a
+    /// spinning worker slows the step down). Soft-body envs and visual steps always use rayon's
+    /// pool.
+    pub fn set_spinning_pool(&mut self, spinning: bool) {
+        self.spinning_pool = spinning && !has_soft_bodies(&self.envs[0]);
     }
 
     /// Resets every env; `seeds` has one entry per env (`None` = draw from that env's RNG).
@@ -167,7 +184,12 @@ impl VecEnv {
         if let Some((layout, robot_seg)) = self.envs[0].visual_layout() {
             return self.run_visual(commands, layout, robot_seg);
         }
-        let stepped = simulate(&mut self.envs, commands, |_| Ok(()))?;
+        let pool = if self.spinning_pool && self.envs.len() > 1 {
+            Pool::Spinning
+        } else {
+            Pool::Rayon
+        };
+        let stepped = simulate(&mut self.envs, commands, pool, |_| Ok(()))?;
         Ok(stepped.into_iter().map(|s| s.map(|(out, _)| out)).collect())
     }
 
@@ -188,9 +210,19 @@ impl VecEnv {
         };
         let (first_envs, second_envs) = self.envs.split_at_mut(split);
         let (first_commands, second_commands) = commands.split_at(split);
-        let first = simulate(first_envs, first_commands, Env::prepare_cameras)?;
+        let first = simulate(
+            first_envs,
+            first_commands,
+            Pool::Rayon,
+            Env::prepare_cameras,
+        )?;
         let first_batch = submit(first_envs, &first)?;
-        let second = simulate(second_envs, second_commands, Env::prepare_cameras)?;
+        let second = simulate(
+            second_envs,
+            second_commands,
+            Pool::Rayon,
+            Env::prepare_cameras,
+        )?;
         let second_batch = submit(second_envs, &second)?;
         let keys = self.envs[0].spec().non_privileged_extra_keys;
         let mut outs = assemble(first, first_batch.wait()?, keys, layout, robot_seg);
@@ -210,34 +242,70 @@ impl VecEnv {
 #[cfg(feature = "render")]
 type Simulated = Option<(StepOutput, Vec<ms2_render::Camera>)>;
 
-/// Runs the commands' physics in parallel, then `prepare` on each env that ran a command (in
-/// visual modes: pose its render scene and cameras); `None` for [`EnvCommand::Keep`].
+/// Whether an env steps MPM particles (its task has a soft-body component).
+fn has_soft_bodies(env: &Env) -> bool {
+    env.task().is_some_and(|task| task.soft().is_some())
+}
+
+/// The thread pool a vector step's physics runs on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Pool {
+    /// rayon's global pool.
+    Rayon,
+    /// `vec_pool`'s: the caller helps, idle workers spin before sleeping.
+    Spinning,
+}
+
+/// One env's output of [`simulate`].
+type Simulation<C> = Result<Option<(StepOutput, C)>, EnvError>;
+
+/// Runs the commands' physics in parallel on `pool`, then `prepare` on each env that ran a
+/// command (in visual modes: pose its render scene and cameras); `None` for
+/// [`EnvCommand::Keep`].
 fn simulate<C: Send>(
     envs: &mut [Env],
     commands: &[EnvCommand<'_>],
+    pool: Pool,
     prepare: impl Fn(&mut Env) -> Result<C, EnvError> + Sync,
 ) -> Result<Vec<Option<(StepOutput, C)>>, EnvError> {
-    envs.par_iter_mut()
-        .zip(commands.par_iter())
-        .map(|(env, command)| {
-            let out = match *command {
-                EnvCommand::Keep => return Ok(None),
-                EnvCommand::Step(action) => env.step_deferred(action)?,
-                EnvCommand::Reset { seed } => {
-                    let (obs, info) = env.reset_deferred(seed)?;
-                    StepOutput {
-                        obs,
-                        reward: 0.0,
-                        terminated: false,
-                        truncated: false,
-                        info,
-                    }
+    let run = |env: &mut Env, command: &EnvCommand<'_>| -> Simulation<C> {
+        let out = match *command {
+            EnvCommand::Keep => return Ok(None),
+            EnvCommand::Step(action) => env.step_deferred(action)?,
+            EnvCommand::Reset { seed } => {
+                let (obs, info) = env.reset_deferred(seed)?;
+                StepOutput {
+                    obs,
+                    reward: 0.0,
+                    terminated: false,
+                    truncated: false,
+                    info,
                 }
-            };
-            let prepared = prepare(env)?;
-            Ok(Some((out, prepared)))
-        })
-        .collect()
+            }
+        };
+        let prepared = prepare(env)?;
+        Ok(Some((out, prepared)))
+    };
+    match pool {
+        Pool::Rayon => envs
+            .par_iter_mut()
+            .zip(commands.par_iter())
+            .map(|(env, command)| run(env, command))
+            .collect(),
+        Pool::Spinning => {
+            let mut jobs: Vec<(&mut Env, &EnvCommand<'_>, Option<Simulation<C>>)> = envs
+                .iter_mut()
+                .zip(commands)
+                .map(|(env, command)| (env, command, None))
+                .collect();
+            crate::vec_pool::for_each(&mut jobs, &|(env, command, out)| {
+                *out = Some(run(env, command));
+            });
+            jobs.into_iter()
+                .map(|(_, _, out)| out.unwrap_or(Ok(None)))
+                .collect()
+        }
+    }
 }
 
 /// Submits every camera of the simulated envs in one batch.

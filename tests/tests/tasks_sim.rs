@@ -291,22 +291,33 @@ fn vec_env_steps_pick_cube_like_single_envs() {
         obs_mode: "state".into(),
         ..EnvConfig::new("PickCube-v0")
     };
-    let mut venv = VecEnv::new(&cfg, 2).unwrap();
-    venv.reset(&[Some(1), Some(2)]).unwrap();
+    let seeds = [1u64, 2, 3];
     let acts = actions(8, 3, 3);
-    let mut singles: Vec<Env> = [1u64, 2]
-        .iter()
-        .map(|&s| {
-            let mut e = make_env(&cfg).unwrap();
-            e.reset(Some(s), false).unwrap();
-            e
-        })
-        .collect();
-    for a in &acts {
-        let flat: Vec<f32> = a.iter().chain(a.iter()).copied().collect();
-        let outs = venv.step(&flat).unwrap();
-        for (single, out) in singles.iter_mut().zip(&outs) {
-            assert_eq!(single.step(a).unwrap().obs, out.obs);
+    // On the spinning pool (the default for rigid state steps: three envs split into a job for
+    // the caller and a nested join) and on rayon's.
+    for spinning in [true, false] {
+        let mut venv = VecEnv::new(&cfg, seeds.len()).unwrap();
+        venv.set_spinning_pool(spinning);
+        venv.reset(&seeds.map(Some)).unwrap();
+        let mut singles: Vec<Env> = seeds
+            .iter()
+            .map(|&s| {
+                let mut e = make_env(&cfg).unwrap();
+                e.reset(Some(s), false).unwrap();
+                e
+            })
+            .collect();
+        for a in &acts {
+            let flat: Vec<f32> = seeds.iter().flat_map(|_| a.iter().copied()).collect();
+            let outs = venv.step(&flat).unwrap();
+            assert_eq!(outs.len(), seeds.len());
+            for (single, out) in singles.iter_mut().zip(&outs) {
+                assert_eq!(
+                    single.step(a).unwrap().obs,
+                    out.obs,
+                    "spinning pool: {spinning}"
+                );
+            }
         }
     }
 }
