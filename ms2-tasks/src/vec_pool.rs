@@ -9,9 +9,10 @@
 //! step finds it awake when the caller comes back quickly (a benchmark loop, a cheap policy) and
 //! costs at most that spin when it does not (a policy on PyTorch between steps).
 //!
-//! Measured (docs/benchmarks.md): PickCube-v0, two envs on two idle cores, 10-14 % more env
-//! steps/s than rayon's pool in the same process (4-8 % with a spin a tenth as long); but on a
-//! core-starved machine (load 5 on 2 cores) 10-30 % fewer, because a spinning thread holds a core
+//! Measured (docs/benchmarks.md, `examples/vec_scaling.rs`): PickCube-v0 on two otherwise idle
+//! cores, 10-14 % more env steps/s than rayon's pool in the same process with two envs (medians
+//! per control mode, five runs each; 3-10 % with a spin a tenth as long) and 4-6 % with four; but on a
+//! core-starved machine (load 5 on 2 cores) 13-34 % fewer, because a spinning thread holds a core
 //! that another runnable thread needs. `MS2_VEC_POOL=rayon` ([`POOL_VARIABLE`]) selects rayon's
 //! pool for every vector env of the process.
 //!
