@@ -541,7 +541,7 @@ impl Multibody {
             return; // Nothing to do.
         }
 
-        self.accelerations.fill(0.0);
+        self.accelerations.as_mut_slice().fill(0.0);
 
         // If there is significant movement, the semi-implicit coriolis term
         // occasionally cause instabilities due to the matrix being near singular.
@@ -825,7 +825,7 @@ impl Multibody {
                 parent_to_world = parent_link.local_to_world;
 
                 let (link_j, parent_j) = self.body_jacobians.index_mut_const(i, parent_id);
-                link_j.copy_from(parent_j);
+                link_j.as_mut_slice().copy_from_slice(parent_j.as_slice());
 
                 {
                     // Columns at or after `width` are zero in both Jacobians: skip them.
@@ -837,7 +837,7 @@ impl Multibody {
                     gemm_small_acc(&mut link_j_v, 1.0, &shift_tr, &parent_j_w);
                 }
             } else {
-                self.body_jacobians[i].fill(0.0);
+                self.body_jacobians[i].as_mut_slice().fill(0.0);
                 parent_to_world = Pose::IDENTITY;
             }
 
@@ -871,8 +871,10 @@ impl Multibody {
             self.augmented_mass = DMatrix::zeros(self.ndofs, self.ndofs);
             self.acc_augmented_mass = DMatrix::zeros(self.ndofs, self.ndofs);
         } else {
-            self.augmented_mass.fill(0.0);
-            self.acc_augmented_mass.fill(0.0);
+            // Slice fills and copies (memset, memcpy) here and below, rather than nalgebra's
+            // element-by-element `fill` and `copy_from` on these contiguous matrices.
+            self.augmented_mass.as_mut_slice().fill(0.0);
+            self.acc_augmented_mass.as_mut_slice().fill(0.0);
         }
 
         self.augmented_mass_indices.clear();
@@ -1008,8 +1010,12 @@ impl Multibody {
                 let (coriolis_w, parent_coriolis_w) = self.coriolis_w.index_mut2(i, parent_id);
 
                 // Full copies: the columns at or after `width` stay the zeros the root starts with.
-                coriolis_v.copy_from(parent_coriolis_v);
-                coriolis_w.copy_from(parent_coriolis_w);
+                coriolis_v
+                    .as_mut_slice()
+                    .copy_from_slice(parent_coriolis_v.as_slice());
+                coriolis_w
+                    .as_mut_slice()
+                    .copy_from_slice(parent_coriolis_w.as_slice());
                 let mut coriolis_v = coriolis_v.columns_mut(0, width);
                 let mut coriolis_w = coriolis_w.columns_mut(0, width);
                 let parent_coriolis_w = parent_coriolis_w.columns(0, width);
@@ -1068,8 +1074,8 @@ impl Multibody {
                     }
                 }
             } else {
-                self.coriolis_v[i].fill(0.0);
-                self.coriolis_w[i].fill(0.0);
+                self.coriolis_v[i].as_mut_slice().fill(0.0);
+                self.coriolis_w[i].as_mut_slice().fill(0.0);
             }
 
             let mut coriolis_v = self.coriolis_v[i].columns_mut(0, width);

@@ -317,7 +317,7 @@ pub(crate) fn write_unit_dof_jacobians(
         }
         _ => {
             let dof_j_id = j_id + dof_id + link.assembly_id;
-            jacobians.rows_mut(j_id, ndofs * 2).fill(0.0);
+            jacobians.as_mut_slice()[j_id..j_id + ndofs * 2].fill(0.0);
             jacobians[dof_j_id] = 1.0;
             jacobians[dof_j_id + ndofs] = 1.0;
             multibody

@@ -291,7 +291,7 @@ impl GenericJointConstraint {
             // here. (An infinite or NaN velocity would make nalgebra's sum NaN.)
             let vel2 = solver_vel2[self.unit_jacobian2 as usize] + 0.0;
             let delta_impulse = self.update_impulse(vel2 - vel1);
-            axpy_in_nalgebra_order(solver_vel2, -delta_impulse, wj2);
+            axpy_unless_no_change(solver_vel2, -delta_impulse, wj2);
             return;
         }
 
@@ -303,12 +303,12 @@ impl GenericJointConstraint {
         let vel2 = dot_in_nalgebra_order(j2, self.solver_vel2(solver_vels, generic_solver_vels));
         let delta_impulse = self.update_impulse(vel2 - vel1);
 
-        axpy_in_nalgebra_order(
+        axpy_unless_no_change(
             self.solver_vel1_mut(solver_vels, generic_solver_vels),
             delta_impulse,
             wj1,
         );
-        axpy_in_nalgebra_order(
+        axpy_unless_no_change(
             self.solver_vel2_mut(solver_vels, generic_solver_vels),
             -delta_impulse,
             wj2,
@@ -427,6 +427,20 @@ pub(crate) fn axpy_in_nalgebra_order(y: &mut [Real], alpha: Real, x: &[Real]) {
     }
 }
 
+/// [`axpy_in_nalgebra_order`], skipped when it cannot change `y`'s bits: when `alpha` is
+/// `±0` (an impulse change of zero, e.g. every PGS pass of an inactive joint limit, whose
+/// impulse bounds are both zero) and no entry of `y` is zero. For a finite `x`, `alpha · x` is
+/// then `±0` and `y + (±0)` is `y` for every non-zero `y` (only a zero `y` can change:
+/// `-0 + +0` is `+0`). (With an infinite or NaN `x`, the skipped axpy would have written NaN.)
+#[inline(always)]
+pub(crate) fn axpy_unless_no_change(y: &mut [Real], alpha: Real, x: &[Real]) {
+    // No early exit: the scan is branch-free and vectorizes.
+    if alpha == 0.0 && !y.iter().fold(false, |any_zero, v| any_zero | (*v == 0.0)) {
+        return;
+    }
+    axpy_in_nalgebra_order(y, alpha, x);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -478,6 +492,38 @@ mod tests {
                 assert_eq!(bits(&y), bits(&expected), "axpy, n = {n}");
             }
         }
+    }
+
+    /// The zero-impulse shortcut writes exactly what the full axpy writes, for zero `alpha`s
+    /// of both signs and `y`s with and without zeros of both signs.
+    #[test]
+    fn axpy_shortcut_matches_the_full_axpy_bit_for_bit() {
+        let mut seed = 5;
+        let bits = |v: &[Real]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let mut shortcuts = 0;
+        for n in 0..=20 {
+            for round in 0..200 {
+                let x = values(&mut seed, n);
+                let mut y: Vec<Real> = values(&mut seed, n);
+                if round % 2 == 0 {
+                    // No zeros in `y` half of the time, so the shortcut is taken.
+                    y.iter_mut().filter(|v| **v == 0.0).for_each(|v| *v = 0.5);
+                }
+                let alpha = match round % 4 {
+                    0 | 1 => 0.0,
+                    2 => -0.0,
+                    _ => value(&mut seed),
+                };
+                let mut expected = y.clone();
+                axpy_in_nalgebra_order(&mut expected, alpha, &x);
+                if alpha == 0.0 && !y.contains(&0.0) {
+                    shortcuts += 1;
+                }
+                axpy_unless_no_change(&mut y, alpha, &x);
+                assert_eq!(bits(&y), bits(&expected), "n = {n}, alpha = {alpha:?}");
+            }
+        }
+        assert!(shortcuts > 1000, "the shortcut was taken {shortcuts} times");
     }
 
     /// What `solve` relies on for a unit-vector Jacobian `e_i`: nalgebra's `e_i · v` is
