@@ -82,7 +82,8 @@ pub const HIGH_ROD_Z: f32 = 0.25;
 /// on the rod, so that both legs (about 18 cm each) clear the ground by 3 cm.
 pub fn release_point(rod_z: f32) -> (f32, f32) {
     let t = ((rod_z - LOW_ROD_Z) / (HIGH_ROD_Z - LOW_ROD_Z)).clamp(0.0, 1.0);
-    let lerp = |low: f32, high: f32| low + (high - low) * t;
+    // Exactly the high (low) rods' point at t = 1 (0).
+    let lerp = |low: f32, high: f32| low * (1.0 - t) + high * t;
     (
         lerp(LOW_ROD_FAR_OFFSET, FAR_OFFSET),
         lerp(LOW_ROD_RELEASE_HEIGHT, RELEASE_HEIGHT),
