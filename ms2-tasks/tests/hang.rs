@@ -443,6 +443,12 @@ fn low_rods_get_their_own_release_point_within_the_arms_reach() {
         rotation_tolerance_rad: 1e-2,
         ..IkOptions::default()
     });
+    // The check can fail: a point 0.5 m beyond the farthest rod is out of reach.
+    let far = nalgebra::Isometry3::from_parts(
+        nalgebra::Translation3::new(0.73 - f64::from(BASE_X), 0.0, 0.25),
+        start.rotation,
+    );
+    assert!(ik.solve(&chain, &far, &seed, None).is_err());
     for u_angle in [0.0, 0.5, 0.999] {
         for u_height in [0.0, 0.5, 0.999] {
             let rod = RodPose::from_unit(0.999, u_angle, u_height);
