@@ -400,3 +400,79 @@ fn the_scripted_policy_first_lays_the_rope_down_and_lets_go_of_it() {
         e.finger_opening
     );
 }
+
+#[test]
+fn low_rods_get_their_own_release_point_within_the_arms_reach() {
+    use ms2_control::{DlsIk, IkOptions, RobotConfig};
+    use ms2_tasks::families::soft::hang::{ARM_START, BASE_X};
+    use ms2_tasks::families::soft::hang_policy::{
+        release_point, FAR_OFFSET, HIGH_ROD_Z, LOW_ROD_FAR_OFFSET, LOW_ROD_RELEASE_HEIGHT,
+        LOW_ROD_Z, RELEASE_HEIGHT,
+    };
+    // The committed release on high rods; on low rods the one measured to leave the rope's
+    // middle on the rod (the high rods' let the long leg reach the ground, seeds 7, 8, 10);
+    // continuous in between.
+    assert_eq!(release_point(0.3), (FAR_OFFSET, RELEASE_HEIGHT));
+    assert_eq!(release_point(HIGH_ROD_Z), (FAR_OFFSET, RELEASE_HEIGHT));
+    assert_eq!(
+        release_point(0.2),
+        (LOW_ROD_FAR_OFFSET, LOW_ROD_RELEASE_HEIGHT)
+    );
+    assert_ne!(release_point(0.2), release_point(0.3));
+    let (mut last, n) = (release_point(LOW_ROD_Z), 20);
+    for k in 1..=n {
+        let z = LOW_ROD_Z + (HIGH_ROD_Z - LOW_ROD_Z) * k as f32 / n as f32;
+        let p = release_point(z);
+        assert!(
+            (p.0 - last.0).abs() < 0.005 && (p.1 - last.1).abs() < 0.005,
+            "{last:?} -> {p:?} at {z} m"
+        );
+        last = p;
+    }
+    // The Panda reaches every release point with the start's hand orientation, turned about
+    // the vertical in quarter turns (the carry's yaw depends on the rope), for the farthest
+    // rods (0.23 m from the origin) in the extreme directions and heights.
+    let robot = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
+    let chain = robot.tcp_chain().unwrap();
+    let mut seed: Vec<f64> = ARM_START.iter().map(|&q| f64::from(q)).collect();
+    seed.resize(chain.dof(), 0.0);
+    let start = chain.forward_kinematics(&seed).unwrap();
+    let ik = DlsIk::new(IkOptions {
+        max_iterations: 200,
+        position_tolerance_m: 1e-3,
+        rotation_tolerance_rad: 1e-2,
+        ..IkOptions::default()
+    });
+    // The check can fail: a point 0.5 m beyond the farthest rod is out of reach.
+    let far = nalgebra::Isometry3::from_parts(
+        nalgebra::Translation3::new(0.73 - f64::from(BASE_X), 0.0, 0.25),
+        start.rotation,
+    );
+    assert!(ik.solve(&chain, &far, &seed, None).is_err());
+    for u_angle in [0.0, 0.5, 0.999] {
+        for u_height in [0.0, 0.5, 0.999] {
+            let rod = RodPose::from_unit(0.999, u_angle, u_height);
+            let (far, up) = release_point(rod.position.z);
+            let p = rod.position + rod.normal() * far + Vec3::Z * up;
+            for quarter in [-1.0f64, 0.0, 1.0] {
+                let turn = nalgebra::UnitQuaternion::from_axis_angle(
+                    &Vector3::z_axis(),
+                    quarter * std::f64::consts::FRAC_PI_2,
+                );
+                let target = nalgebra::Isometry3::from_parts(
+                    nalgebra::Translation3::new(
+                        f64::from(p.x - BASE_X),
+                        f64::from(p.y),
+                        f64::from(p.z),
+                    ),
+                    turn * start.rotation,
+                );
+                let r = ik.solve(&chain, &target, &seed, None);
+                assert!(
+                    r.is_ok(),
+                    "release {p:?} (rod {rod:?}, turn {quarter}) out of reach: {r:?}"
+                );
+            }
+        }
+    }
+}

@@ -48,19 +48,48 @@ pub const GRASP_HEIGHT: f32 = 0.015;
 /// (10 cm, 7 cm below the hand) passes over the rod, the long one catches on it about 60 %
 /// along the rope (seed 0).
 pub const CROSS_HEIGHT: f32 = 0.17;
-/// Height (m) of the hand above the rod's centre at the release: lowered from the crossing
-/// while it moves beyond the rod ([`FAR_OFFSET`]), the hand lets the rope slide back over the
-/// rod towards the robot, to about 52 % along, and the release to 42-47 % (seeds 0-2). Released
-/// 10 cm above the rod, the rope hung 48 % along on seed 8 (rod 0.212 m high), its lowest
-/// particle 3.1 cm up; released 2 cm above the rod's centre and 11 cm beyond it, the piece
-/// between hand and rod swung down taut (seed 8: 51 % along, 4.1 cm up), but on seed 2 the
-/// rope's short piece, stretched between hand and rod, tore off at the release.
+/// Height (m) of the hand above the rod's centre at the release on high rods (from
+/// [`HIGH_ROD_Z`] up): lowered from the crossing while it moves beyond the rod
+/// ([`FAR_OFFSET`]), the hand lets the rope slide back over the rod towards the robot, to
+/// about 52 % along, and the release to 42-47 % (seeds 0-2). On low rods the longer leg then
+/// reaches within 3 cm of the ground (seeds 7 and 8); see [`release_point`].
 pub const RELEASE_HEIGHT: f32 = 0.07;
 /// Horizontal offsets (m) from the rod's centre along its normal: where the hand starts the
-/// crossing (robot's side) and where it lowers the rope and releases it (far side).
+/// crossing (robot's side) and where it lowers the rope and releases it on high rods (far
+/// side).
 pub const NEAR_OFFSET: f32 = -0.1;
 /// See [`NEAR_OFFSET`].
 pub const FAR_OFFSET: f32 = 0.06;
+/// Height (m) of the hand above the rod's centre at the release on low rods (up to
+/// [`LOW_ROD_Z`]), with [`LOW_ROD_FAR_OFFSET`]: the release then moves the rope little
+/// (seed 10, rod 0.222 m high: on the rod 50 % along before the opening, 45-46 % after,
+/// success at step 315). How the release moves the rope depends on this point (seed 10):
+/// 13 cm above and 6 cm beyond, the falling piece dragged the rope from 60 % to 41 % along
+/// (its long leg on the ground); 2 cm above and 8.5 cm beyond, it pulled the whole rope off
+/// over the far side; 2 cm above and 11 cm beyond, the taut piece between hand and rod tore
+/// off (the rest stayed 52 % along).
+pub const LOW_ROD_RELEASE_HEIGHT: f32 = 0.045;
+/// Offset (m) beyond the rod's centre along its normal of the release on low rods.
+pub const LOW_ROD_FAR_OFFSET: f32 = 0.072;
+/// Rod height (m, its centre) up to which the release is the low rods' one.
+pub const LOW_ROD_Z: f32 = 0.23;
+/// Rod height (m, its centre) from which the release is the high rods' one; between
+/// [`LOW_ROD_Z`] and this the release point is interpolated linearly.
+pub const HIGH_ROD_Z: f32 = 0.25;
+
+/// The release point for a rod whose centre is `rod_z` (m) high: (offset beyond the rod's
+/// centre along its normal, height above it), both m. Low rods need the rope's middle
+/// on the rod, so that both legs (about 18 cm each) clear the ground by 3 cm.
+pub fn release_point(rod_z: f32) -> (f32, f32) {
+    let t = ((rod_z - LOW_ROD_Z) / (HIGH_ROD_Z - LOW_ROD_Z)).clamp(0.0, 1.0);
+    // Exactly the high (low) rods' point at t = 1 (0).
+    let lerp = |low: f32, high: f32| low * (1.0 - t) + high * t;
+    (
+        lerp(LOW_ROD_FAR_OFFSET, FAR_OFFSET),
+        lerp(LOW_ROD_RELEASE_HEIGHT, RELEASE_HEIGHT),
+    )
+}
+
 /// Index of the grasped tracked particle ([`super::hang_scene::TRACKED_FRACTIONS`]): the one
 /// a quarter along the rope from its short end.
 const GRASP_TRACKED: usize = 1;
@@ -141,7 +170,8 @@ impl HangPolicy {
         ];
         let s = s0 + 44;
         let up = grasp.truncate().extend(near.z);
-        let over = at(FAR_OFFSET, RELEASE_HEIGHT);
+        let (far, release) = release_point(c.z);
+        let over = at(far, release);
         let high = over + Vec3::Z * 0.05;
         // Lift straight up, then turn, then carry (the pinch of the rope's end let go when
         // the hand lifted, turned and moved at once): over the rod, where the long leg
