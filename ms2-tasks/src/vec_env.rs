@@ -302,7 +302,14 @@ fn simulate<C: Send>(
                 *out = Some(run(env, command));
             });
             jobs.into_iter()
-                .map(|(_, _, out)| out.unwrap_or(Ok(None)))
+                .map(|(_, _, out)| {
+                    // `vec_pool::for_each` runs every job; never report a skipped env as kept.
+                    out.unwrap_or_else(|| {
+                        Err(EnvError::InvalidConfig(
+                            "an env of the vector step was not stepped".to_owned(),
+                        ))
+                    })
+                })
                 .collect()
         }
     }
