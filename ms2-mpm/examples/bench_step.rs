@@ -1,5 +1,8 @@
 //! Times the clay benchmark scene (`ms2_mpm::scenes::clay_block`) and prints one line of
-//! `key=value` pairs, the format `bench/compare_taichi.sh` reads.
+//! `key=value` pairs, the format `bench/compare_taichi.sh` reads. `state_hash` fingerprints the
+//! final state (FNV-1a over the bits of every particle's position, velocity, deformation
+//! gradient and affine matrix, in canonical order): equal hashes from two builds mean
+//! bit-identical simulations.
 //!
 //! Usage: `cargo run --release -p ms2-mpm --example bench_step -- [particles] [threads] [substeps]`
 //! (defaults 32768, all cores, 400).
@@ -40,12 +43,40 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .iter()
             .map(|p| p.z)
             .fold(f32::MIN, f32::max);
+        let hash = state_hash(&solver.state());
         println!(
             "engine=ms2-mpm particles={particles} threads={threads} substeps={substeps} \
-             seconds={secs:.3} particle_substeps_per_s={:.4e} top_z={top:.4}",
+             seconds={secs:.3} particle_substeps_per_s={:.4e} top_z={top:.4} \
+             state_hash={hash:016x}",
             (particles * substeps) as f64 / secs
         );
         Ok(())
     })?;
     Ok(())
+}
+
+/// FNV-1a over the bits of the state's per-particle kinematics (see the module docs).
+fn state_hash(state: &ms2_mpm::MpmState) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |x: f32| {
+        for b in x.to_bits().to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for i in 0..state.positions.len() {
+        state.positions[i].to_array().into_iter().for_each(&mut eat);
+        state.velocities[i]
+            .to_array()
+            .into_iter()
+            .for_each(&mut eat);
+        state.deformation_gradients[i]
+            .to_cols_array()
+            .into_iter()
+            .for_each(&mut eat);
+        state.affine_velocities[i]
+            .to_cols_array()
+            .into_iter()
+            .for_each(&mut eat);
+    }
+    h
 }
