@@ -1,7 +1,7 @@
 //! Small dense linear algebra the solver needs per particle: a fast 3×3 singular value
 //! decomposition and the quadratic B-spline interpolation weights of MLS-MPM.
 
-use glam::{Mat3, Vec3};
+use glam::{Mat3, Vec3, Vec3A};
 
 pub use crate::math_x8::{left_stretch_x8, svd3_x8};
 
@@ -204,6 +204,50 @@ pub fn fast_floor3(v: Vec3) -> [i32; 3] {
     }
 }
 
+/// `floor` of the x, y, z lanes of `v`, as integers and as floats (the same integers
+/// converted back), in SIMD registers on x86-64 (same values as [`fast_floor3`]).
+#[inline(always)]
+pub(crate) fn fast_floor3a(v: Vec3A) -> ([i32; 3], Vec3A) {
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    {
+        use std::arch::x86_64::{
+            __m128, _mm_add_epi32, _mm_castps_si128, _mm_cmplt_ps, _mm_cvtepi32_ps,
+            _mm_cvttps_epi32, _mm_storeu_si128,
+        };
+        // SAFETY: SSE2 is enabled at compile time (checked by the cfg above); the store
+        // writes 16 bytes into a 16-byte array.
+        #[allow(unused_unsafe)]
+        unsafe {
+            let x: __m128 = v.into();
+            let t = _mm_cvttps_epi32(x);
+            // Truncation rounds negative non-integers up: subtract one there (mask = −1).
+            let below = _mm_castps_si128(_mm_cmplt_ps(x, _mm_cvtepi32_ps(t)));
+            let b = _mm_add_epi32(t, below);
+            let mut out = [0i32; 4];
+            _mm_storeu_si128(out.as_mut_ptr().cast(), b);
+            ([out[0], out[1], out[2]], Vec3A::from(_mm_cvtepi32_ps(b)))
+        }
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+    {
+        let b = [fast_floor(v.x), fast_floor(v.y), fast_floor(v.z)];
+        (b, Vec3A::new(b[0] as f32, b[1] as f32, b[2] as f32))
+    }
+}
+
+/// [`quadratic_weights`] in SIMD registers, for the transfers: returns `(base, fx, w)` with
+/// `w[k]` holding, along x, y and z, the weight of node `base + k`. Bit for bit the values of
+/// [`quadratic_weights`] (the same operations in the same order, per lane).
+#[inline(always)]
+pub(crate) fn quadratic_weights_a(xg: Vec3A) -> ([i32; 3], Vec3A, [Vec3A; 3]) {
+    let (base, basef) = fast_floor3a(xg - Vec3A::splat(0.5));
+    let fx = xg - basef;
+    let w0 = Vec3A::splat(0.5) * (Vec3A::splat(1.5) - fx) * (Vec3A::splat(1.5) - fx);
+    let w1 = Vec3A::splat(0.75) - (fx - Vec3A::ONE) * (fx - Vec3A::ONE);
+    let w2 = Vec3A::splat(0.5) * (fx - Vec3A::splat(0.5)) * (fx - Vec3A::splat(0.5));
+    (base, fx, [w0, w1, w2])
+}
+
 /// Quadratic B-spline weights of MLS-MPM along the three axes for a particle at grid
 /// coordinate `xg = (x - origin) / dx` (in cells), with `base = floor(xg - 0.5)`.
 ///
@@ -285,6 +329,30 @@ mod tests {
         check(Mat3::from_diagonal(Vec3::new(1.0, -1.0, 1.0)));
         check(Mat3::from_cols(Vec3::X, Vec3::X, Vec3::Z));
         check(Mat3::from_diagonal(Vec3::new(1.0, 1.0, 1e-8)));
+    }
+
+    #[test]
+    fn simd_weights_match_the_scalar_weights_bit_for_bit() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        for _ in 0..10_000 {
+            let xg = Vec3::new(
+                rng.random_range(-3.0..70.0),
+                rng.random_range(0.0..2.0),
+                rng.random_range(-1.0..1030.0),
+            );
+            let (base, fx, w) = quadratic_weights(xg);
+            let (base_a, fx_a, w_a) = quadratic_weights_a(Vec3A::from(xg));
+            assert_eq!(base, base_a, "{xg:?}");
+            assert_eq!(
+                fx.to_array().map(f32::to_bits),
+                Vec3::from(fx_a).to_array().map(f32::to_bits)
+            );
+            for axis in 0..3 {
+                for k in 0..3 {
+                    assert_eq!(w[axis][k].to_bits(), w_a[k][axis].to_bits(), "{xg:?}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -8,12 +8,12 @@
 //! colour) and every unit busy at once, whatever the number of bins; and since the sums run
 //! in a fixed order, results are bitwise independent of the thread count.
 
-use glam::{Mat3, Vec3, Vec4};
+use glam::{Mat3, Mat3A, Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 use crate::grid::{GridSpec, GridStorage, BLOCK};
 use crate::material::{CompiledKind, CompiledMaterial};
-use crate::math::{left_stretch_x8, quadratic_weights, LeftStretch};
+use crate::math::{fast_floor3a, left_stretch_x8, quadratic_weights_a, LeftStretch};
 use crate::parallel::SyncPtr;
 use crate::particles::{Binning, Particles};
 
@@ -139,7 +139,7 @@ fn accumulate_unit(
 ) {
     let dx = prm.spec.cell_size;
     let inv_dx = 1.0 / dx;
-    let origin = prm.spec.origin;
+    let origin = Vec3A::from(prm.spec.origin);
     let dt = prm.dt;
     let stress_scale = -dt * 4.0 * inv_dx * inv_dx;
     let (x, v, c, mass, volume, material) = (&p.x, &p.v, &p.c, &p.mass, &p.volume, &p.material);
@@ -165,13 +165,21 @@ fn accumulate_unit(
             let mat = &prm.materials[material[pi] as usize];
             let (f_new, tau) = mat.project_and_stress_left(trial[l], &stretches[l]);
             f_out[pi - first] = f_new;
-            let (base, fx, w) = quadratic_weights((x[pi] - origin) * inv_dx);
+            let (base, fx, wv) = quadratic_weights_a((Vec3A::from(x[pi]) - origin) * inv_dx);
+            // w[axis][k]: the weight of node base + k along axis.
+            let w = [
+                [wv[0].x, wv[1].x, wv[2].x],
+                [wv[0].y, wv[1].y, wv[2].y],
+                [wv[0].z, wv[1].z, wv[2].z],
+            ];
             let m = mass[pi];
-            let stress = (stress_scale * volume[pi]) * tau;
-            let affine = stress + m * c[pi];
-            let mut mv = m * v[pi];
+            // The per-particle algebra in SIMD registers (`Mat3A`, `Vec3A`): the same
+            // operations in the same order as on `Mat3` and `Vec3`, bit for bit.
+            let stress = (stress_scale * volume[pi]) * Mat3A::from(tau);
+            let affine = stress + m * Mat3A::from(c[pi]);
+            let mut mv = m * Vec3A::from(v[pi]);
             if let Some(forces) = prm.forces {
-                mv += dt * forces[pi];
+                mv += dt * Vec3A::from(forces[pi]);
             }
             let blocked = prm.blocked.map_or(0, |b| b[pi]);
             // Momentum at node offset (i, j, k): mv + affine·((i, j, k) − r)·dx; the mass
@@ -187,7 +195,7 @@ fn accumulate_unit(
             // water against a coupled surface, and a column in a coupled container sank to
             // 60 % of its volume in 0.8 s.
             let r = if blocked != 0 {
-                reachable_centroid(&w, blocked).unwrap_or(fx)
+                reachable_centroid(&w, blocked).map_or(fx, Vec3A::from)
             } else {
                 fx
             };
@@ -196,11 +204,11 @@ fn accumulate_unit(
             if blocked != 0 && mat.kind == CompiledKind::Water {
                 m0 += stress * dx * (r - fx);
             }
-            let m0 = m0.extend(m);
+            let m0 = Vec4::from((m0, m));
             let (ax, ay, az) = (
-                a.x_axis.extend(0.0),
-                a.y_axis.extend(0.0),
-                a.z_axis.extend(0.0),
+                Vec4::from((a.x_axis, 0.0)),
+                Vec4::from((a.y_axis, 0.0)),
+                Vec4::from((a.z_axis, 0.0)),
             );
             let o = [
                 (base[0] - corner[0]) as usize,
@@ -266,7 +274,8 @@ pub(crate) fn grid_to_particle(
     let (spec, dt) = (prm.spec, prm.dt);
     let dx = spec.cell_size;
     let inv_dx = 1.0 / dx;
-    let origin = spec.origin;
+    let origin = Vec3A::from(spec.origin);
+    let (lo, hi) = (Vec3A::from(lo), Vec3A::from(hi));
     let bins = grid.bins;
     let (mass, material) = (&p.mass, &p.material);
     let x_ptr = SyncPtr::new(p.x.as_mut_ptr());
@@ -303,7 +312,13 @@ pub(crate) fn grid_to_particle(
             let mut out_of_bin = false;
             let mut diverged = None;
             for q in 0..len {
-                let (base, fx, w) = quadratic_weights((xs[q] - origin) * inv_dx);
+                let xq = Vec3A::from(xs[q]);
+                let (base, fx, wv) = quadratic_weights_a((xq - origin) * inv_dx);
+                let w = [
+                    [wv[0].x, wv[1].x, wv[2].x],
+                    [wv[0].y, wv[1].y, wv[2].y],
+                    [wv[0].z, wv[1].z, wv[2].z],
+                ];
                 let o = [
                     (base[0] - corner[0]) as usize,
                     (base[1] - corner[1]) as usize,
@@ -343,18 +358,16 @@ pub(crate) fn grid_to_particle(
                         bk += (g1 + g2 * 2.0) * wij;
                     }
                 }
-                let (vel, b) = (
-                    vel.truncate(),
-                    [bi.truncate(), bj.truncate(), bk.truncate()],
-                );
-                // C = 4/dx² Σ w v (x_i − x_p)ᵀ with x_i − x_p = ((i, j, k) − fx)·dx.
+                // C = 4/dx² Σ w v (x_i − x_p)ᵀ with x_i − x_p = ((i, j, k) − fx)·dx, in the
+                // Vec4 lanes (the w lane is dropped).
                 let s = 4.0 * inv_dx;
                 cs[q] = Mat3::from_cols(
-                    (b[0] - vel * fx.x) * s,
-                    (b[1] - vel * fx.y) * s,
-                    (b[2] - vel * fx.z) * s,
+                    ((bi - vel * fx.x) * s).truncate(),
+                    ((bj - vel * fx.y) * s).truncate(),
+                    ((bk - vel * fx.z) * s).truncate(),
                 );
-                let moved = xs[q] + dt * vel;
+                let vel = Vec3A::from_vec4(vel);
+                let moved = xq + dt * vel;
                 let xn = moved.clamp(lo, hi);
                 // Water held at the domain's edge keeps no speed into it. Its velocity comes
                 // from the grid, whose walls stop it, unless every node of its stencil is
@@ -364,18 +377,19 @@ pub(crate) fn grid_to_particle(
                 let vel = if xn != moved
                     && prm.materials[material[pi] as usize].kind == CompiledKind::Water
                 {
-                    let held_low = moved.cmplt(lo) & vel.cmplt(Vec3::ZERO);
-                    let held_high = moved.cmpgt(hi) & vel.cmpgt(Vec3::ZERO);
-                    Vec3::select(held_low | held_high, Vec3::ZERO, vel)
+                    let held_low = moved.cmplt(lo) & vel.cmplt(Vec3A::ZERO);
+                    let held_high = moved.cmpgt(hi) & vel.cmpgt(Vec3A::ZERO);
+                    Vec3A::select(held_low | held_high, Vec3A::ZERO, vel)
                 } else {
                     vel
                 };
-                vs[q] = vel;
+                vs[q] = vel.into();
                 if !vel.is_finite() && diverged.is_none() {
                     diverged = Some(start + q);
                 }
-                xs[q] = xn;
-                let nb = crate::particles::base_node(xn, origin, inv_dx);
+                xs[q] = xn.into();
+                // Bin of the new B-spline base node (as `particles::base_node`).
+                let (nb, _) = fast_floor3a((xn - origin) * inv_dx - Vec3A::splat(0.5));
                 for a in 0..3 {
                     let rel = nb[a] - corner[a];
                     // Allowed bases: corner .. corner + BLOCK + 1 (one node of slack each side).
