@@ -4,7 +4,7 @@
 //! `F ← (I + Δt·C)·F`) to the projected gradient kept by the particle and its Kirchhoff
 //! stress `τ = J·σ` (Pa), the quantity the MLS-MPM momentum transfer needs.
 
-use glam::{Mat3, Vec3};
+use glam::{Mat3, Mat3A, Vec3};
 
 use crate::error::MpmError;
 use crate::math::{svd3, LeftStretch, Svd3};
@@ -245,13 +245,13 @@ impl CompiledMaterial {
                 let p = self.lambda * (j - 1.0) * j;
                 (f_new, Mat3::from_diagonal(Vec3::splat(p)))
             }
-            CompiledKind::Elastic => (f, self.corotated_stress(d.u, d.sigma)),
+            CompiledKind::Elastic => (f, self.corotated_stress(d.u.into(), d.sigma).into()),
             CompiledKind::Clay => {
                 let sig = d.sigma.max(Vec3::splat(CLAY_MIN_STRETCH));
                 // Sorted stretches (see `Svd3`): sig.x largest, sig.z smallest. Inside the yield
                 // surface and not clamped: F stays as it is.
                 if d.sigma.z >= CLAY_MIN_STRETCH && sig.x <= self.elastic_stretch_ratio * sig.z {
-                    return (f, self.corotated_stress(d.u, sig));
+                    return (f, self.corotated_stress(d.u.into(), sig).into());
                 }
                 let eps = Vec3::new(sig.x.ln(), sig.y.ln(), sig.z.ln());
                 let dev = eps - Vec3::splat((eps.x + eps.y + eps.z) / 3.0);
@@ -264,7 +264,7 @@ impl CompiledMaterial {
                     sig
                 };
                 let f_new = d.u * Mat3::from_diagonal(sig) * d.v.transpose();
-                (f_new, self.corotated_stress(d.u, sig))
+                (f_new, self.corotated_stress(d.u.into(), sig).into())
             }
         }
     }
@@ -273,41 +273,47 @@ impl CompiledMaterial {
     /// SVD (ignored by water): cheaper, since the common cases need no right rotation. An
     /// elastic state stays `f`; a clay state beyond the yield surface is projected as
     /// `U·diag(σ_new/σ)·Uᵀ·f` (= `U·diag(σ_new)·Vᵀ`). Inverted or collapsed states (det ≤ 0,
-    /// or clay stretches below its floor), rare, take the SVD path.
+    /// or clay stretches below its floor), rare, take the SVD path. In SIMD registers
+    /// (`Mat3A`): the same operations in the same order as on `Mat3`, bit for bit.
     #[inline(always)]
-    pub fn project_and_stress_left(&self, f: Mat3, ls: &LeftStretch) -> (Mat3, Mat3) {
+    pub fn project_and_stress_left(&self, f: Mat3A, ls: &LeftStretch) -> (Mat3A, Mat3A) {
         let sig = ls.sigma;
+        let full = |f: Mat3A, d: &Svd3| {
+            let (f_new, tau) = self.project_and_stress_svd(f.into(), d);
+            (Mat3A::from(f_new), Mat3A::from(tau))
+        };
         let usual = match self.kind {
-            CompiledKind::Water => return self.project_and_stress_svd(f, &IDENTITY_SVD),
+            CompiledKind::Water => return full(f, &IDENTITY_SVD),
             CompiledKind::Elastic => sig.z > 0.0,
             CompiledKind::Clay => sig.z >= CLAY_MIN_STRETCH,
         };
         if !usual || f.determinant() <= 0.0 {
-            return self.project_and_stress_svd(f, &svd3(f));
+            return full(f, &svd3(f.into()));
         }
+        let u = Mat3A::from(ls.u);
         if self.kind == CompiledKind::Elastic || sig.x <= self.elastic_stretch_ratio * sig.z {
-            return (f, self.corotated_stress(ls.u, sig));
+            return (f, self.corotated_stress(u, sig));
         }
         let eps = Vec3::new(sig.x.ln(), sig.y.ln(), sig.z.ln());
         let dev = eps - Vec3::splat((eps.x + eps.y + eps.z) / 3.0);
         let dev_norm = dev.length();
         let excess = dev_norm - self.yield_strain;
         if excess <= 0.0 {
-            return (f, self.corotated_stress(ls.u, sig));
+            return (f, self.corotated_stress(u, sig));
         }
         let e = eps - dev * (excess / dev_norm);
         let sig_new = Vec3::new(e.x.exp(), e.y.exp(), e.z.exp());
-        let f_new = ls.u * Mat3::from_diagonal(sig_new / sig) * ls.u.transpose() * f;
-        (f_new, self.corotated_stress(ls.u, sig_new))
+        let f_new = u * Mat3A::from_diagonal(sig_new / sig) * u.transpose() * f;
+        (f_new, self.corotated_stress(u, sig_new))
     }
 
     /// Fixed-corotated Kirchhoff stress `2μ(F − R)Fᵀ + λ(J − 1)J·I` from `F = U·Σ·Vᵀ`.
     #[inline(always)]
-    fn corotated_stress(&self, u: Mat3, sig: Vec3) -> Mat3 {
+    fn corotated_stress(&self, u: Mat3A, sig: Vec3) -> Mat3A {
         let j = sig.x * sig.y * sig.z;
         let d = 2.0 * self.mu * (sig - Vec3::ONE) * sig;
-        let us = Mat3::from_cols(u.x_axis * d.x, u.y_axis * d.y, u.z_axis * d.z);
-        us * u.transpose() + Mat3::from_diagonal(Vec3::splat(self.lambda * (j - 1.0) * j))
+        let us = Mat3A::from_cols(u.x_axis * d.x, u.y_axis * d.y, u.z_axis * d.z);
+        us * u.transpose() + Mat3A::from_diagonal(Vec3::splat(self.lambda * (j - 1.0) * j))
     }
 }
 
@@ -388,7 +394,8 @@ mod tests {
                     f.z_axis *= 0.02;
                 }
                 let ls = crate::math::left_stretch_x8(&[f; 8])[0];
-                let (fa, ta) = m.project_and_stress_left(f, &ls);
+                let (fa, ta) = m.project_and_stress_left(f.into(), &ls);
+                let (fa, ta) = (Mat3::from(fa), Mat3::from(ta));
                 let (fb, tb) = m.project_and_stress(f);
                 let tol = 1e-4 * (1.0 + max_abs(fb));
                 assert!(

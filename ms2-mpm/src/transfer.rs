@@ -152,7 +152,7 @@ fn accumulate_unit(
         let mut any_svd = false;
         for (l, t) in trial.iter_mut().enumerate().take(n) {
             let pi = group + l;
-            *t = (Mat3::IDENTITY + dt * c[pi]) * p_f[pi];
+            *t = ((Mat3A::IDENTITY + dt * Mat3A::from(c[pi])) * Mat3A::from(p_f[pi])).into();
             any_svd |= prm.materials[material[pi] as usize].needs_svd();
         }
         let stretches = if any_svd {
@@ -163,8 +163,8 @@ fn accumulate_unit(
         for l in 0..n {
             let pi = group + l;
             let mat = &prm.materials[material[pi] as usize];
-            let (f_new, tau) = mat.project_and_stress_left(trial[l], &stretches[l]);
-            f_out[pi - first] = f_new;
+            let (f_new, tau) = mat.project_and_stress_left(trial[l].into(), &stretches[l]);
+            f_out[pi - first] = f_new.into();
             let (base, fx, wv) = quadratic_weights_a((Vec3A::from(x[pi]) - origin) * inv_dx);
             // w[axis][k]: the weight of node base + k along axis.
             let w = [
@@ -175,7 +175,7 @@ fn accumulate_unit(
             let m = mass[pi];
             // The per-particle algebra in SIMD registers (`Mat3A`, `Vec3A`): the same
             // operations in the same order as on `Mat3` and `Vec3`, bit for bit.
-            let stress = (stress_scale * volume[pi]) * Mat3A::from(tau);
+            let stress = (stress_scale * volume[pi]) * tau;
             let affine = stress + m * Mat3A::from(c[pi]);
             let mut mv = m * Vec3A::from(v[pi]);
             if let Some(forces) = prm.forces {
