@@ -58,6 +58,20 @@ fn bin_corner(b: u32, bins: [usize; 3]) -> [i32; 3] {
     ]
 }
 
+/// Offset of a particle's stencil (B-spline base node `base`) in the neighbourhood of its bin
+/// starting at real node `corner`. The binning keeps every base node within one node of its
+/// bin, so the offsets are at most `LOCAL − 3`; clamping to that lets the compiler drop the
+/// bounds checks of the 27 node accesses (and would only misplace, never write out of the
+/// neighbourhood, a particle the binning had lost).
+#[inline(always)]
+fn stencil_offset(base: [i32; 3], corner: [i32; 3]) -> [usize; 3] {
+    std::array::from_fn(|a| {
+        let o = (base[a] - corner[a]) as usize;
+        debug_assert!(o <= LOCAL - 3, "stencil outside its bin's neighbourhood");
+        o.min(LOCAL - 3)
+    })
+}
+
 /// Fixed per-step constants of the transfers.
 pub(crate) struct TransferParams<'a> {
     pub spec: &'a GridSpec,
@@ -210,27 +224,73 @@ fn accumulate_unit(
                 Vec4::from((a.y_axis, 0.0)),
                 Vec4::from((a.z_axis, 0.0)),
             );
-            let o = [
-                (base[0] - corner[0]) as usize,
-                (base[1] - corner[1]) as usize,
-                (base[2] - corner[2]) as usize,
-            ];
-            for i in 0..3 {
-                let mi = m0 + ax * i as f32;
-                for j in 0..3 {
-                    let mij = mi + ay * j as f32;
-                    let wij = w[0][i] * w[1][j];
-                    let row = local_index(o[0] + i, o[1] + j, o[2]);
-                    for k in 0..3 {
-                        if blocked != 0 && blocked & (1 << ((i * 3 + j) * 3 + k)) != 0 {
-                            continue;
-                        }
-                        local[row + k] += (mij + az * k as f32) * (wij * w[2][k]);
-                    }
-                }
+            let o = stencil_offset(base, corner);
+            // Two copies of the loop: the common one without a mask test per node.
+            let (mv, a) = (m0, [ax, ay, az]);
+            if blocked == 0 {
+                scatter27(local, o, mv, a, &w, |_| false);
+            } else {
+                scatter27(local, o, mv, a, &w, |bit| blocked & (1 << bit) != 0);
             }
         }
     }
+}
+
+/// Adds a particle's mass and momentum to the 27 nodes of its stencil (offset `o` in the
+/// neighbourhood `local`, B-spline weights `w[axis][k]`), skipping the nodes whose bit
+/// `(i·3 + j)·3 + k` `skip` reports: node `(i, j, k)` receives
+/// `(m0 + a[0]·i + a[1]·j + a[2]·k)·w[0][i]·w[1][j]·w[2][k]`.
+#[inline(always)]
+fn scatter27(
+    local: &mut LocalGrid,
+    o: [usize; 3],
+    m0: Vec4,
+    a: [Vec4; 3],
+    w: &[[f32; 3]; 3],
+    skip: impl Fn(usize) -> bool,
+) {
+    let [ax, ay, az] = a;
+    for i in 0..3 {
+        let mi = m0 + ax * i as f32;
+        for j in 0..3 {
+            let mij = mi + ay * j as f32;
+            let wij = w[0][i] * w[1][j];
+            let row = local_index(o[0] + i, o[1] + j, o[2]);
+            for k in 0..3 {
+                if skip((i * 3 + j) * 3 + k) {
+                    continue;
+                }
+                local[row + k] += (mij + az * k as f32) * (wij * w[2][k]);
+            }
+        }
+    }
+}
+
+/// Gathers over the 27 nodes of a stencil (offset `o`, weights `w[axis][k]`; `node(index,
+/// bit)` gives the value of the node at `index` in the neighbourhood whose stencil bit is
+/// `bit`): returns `Σ w·v` and the moments `Σ w·v·i`, `Σ w·v·j`, `Σ w·v·k`.
+#[inline(always)]
+fn gather27(
+    o: [usize; 3],
+    w: &[[f32; 3]; 3],
+    node: impl Fn(usize, usize) -> Vec4,
+) -> (Vec4, Vec4, Vec4, Vec4) {
+    let (mut vel, mut bi, mut bj, mut bk) = (Vec4::ZERO, Vec4::ZERO, Vec4::ZERO, Vec4::ZERO);
+    for i in 0..3 {
+        for j in 0..3 {
+            let row = local_index(o[0] + i, o[1] + j, o[2]);
+            let bit = (i * 3 + j) * 3;
+            let g1 = node(row + 1, bit + 1) * w[2][1];
+            let g2 = node(row + 2, bit + 2) * w[2][2];
+            let wij = w[0][i] * w[1][j];
+            let r = (node(row, bit) * w[2][0] + g1 + g2) * wij;
+            vel += r;
+            bi += r * i as f32;
+            bj += r * j as f32;
+            bk += (g1 + g2 * 2.0) * wij;
+        }
+    }
+    (vel, bi, bj, bk)
 }
 
 /// Weighted centroid (in node units from the stencil's base node) of the stencil nodes not
@@ -319,11 +379,7 @@ pub(crate) fn grid_to_particle(
                     [wv[0].y, wv[1].y, wv[2].y],
                     [wv[0].z, wv[1].z, wv[2].z],
                 ];
-                let o = [
-                    (base[0] - corner[0]) as usize,
-                    (base[1] - corner[1]) as usize,
-                    (base[2] - corner[2]) as usize,
-                ];
+                let o = stencil_offset(base, corner);
                 let pi = start + q;
                 let blocked = prm.blocked.map_or(0, |bl| bl[pi]);
                 // Blocked nodes stand in with the particle's own update (its velocity plus
@@ -334,30 +390,19 @@ pub(crate) fn grid_to_particle(
                 } else {
                     Vec4::ZERO
                 };
-                let node = |index: usize, bit: usize| {
-                    if blocked != 0 && blocked & (1 << bit) != 0 {
-                        own
-                    } else {
-                        local[index]
-                    }
-                };
                 // Σ w·v, and Σ w·v·i, Σ w·v·j, Σ w·v·k (xyz lanes; w carries no meaning).
-                let (mut vel, mut bi, mut bj, mut bk) =
-                    (Vec4::ZERO, Vec4::ZERO, Vec4::ZERO, Vec4::ZERO);
-                for i in 0..3 {
-                    for j in 0..3 {
-                        let row = local_index(o[0] + i, o[1] + j, o[2]);
-                        let bit = (i * 3 + j) * 3;
-                        let g1 = node(row + 1, bit + 1) * w[2][1];
-                        let g2 = node(row + 2, bit + 2) * w[2][2];
-                        let wij = w[0][i] * w[1][j];
-                        let r = (node(row, bit) * w[2][0] + g1 + g2) * wij;
-                        vel += r;
-                        bi += r * i as f32;
-                        bj += r * j as f32;
-                        bk += (g1 + g2 * 2.0) * wij;
-                    }
-                }
+                // Two copies of the loop: the common one without a mask test per node.
+                let (vel, bi, bj, bk) = if blocked == 0 {
+                    gather27(o, &w, |index, _| local[index])
+                } else {
+                    gather27(o, &w, |index, bit| {
+                        if blocked & (1 << bit) != 0 {
+                            own
+                        } else {
+                            local[index]
+                        }
+                    })
+                };
                 // C = 4/dx² Σ w v (x_i − x_p)ᵀ with x_i − x_p = ((i, j, k) − fx)·dx, in the
                 // Vec4 lanes (the w lane is dropped).
                 let s = 4.0 * inv_dx;
