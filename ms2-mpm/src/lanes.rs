@@ -25,6 +25,34 @@ fn sqrt4(v: Vec4) -> Vec4 {
     }
 }
 
+/// Transposes the 4×4 matrix whose rows are `r` (four shuffle pairs on x86-64).
+#[inline(always)]
+pub(crate) fn transpose4(r: [Vec4; 4]) -> [Vec4; 4] {
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    {
+        use std::arch::x86_64::{_mm_movehl_ps, _mm_movelh_ps, _mm_unpackhi_ps, _mm_unpacklo_ps};
+        // SAFETY: SSE2 is enabled at compile time (checked by the cfg above).
+        #[allow(unused_unsafe)]
+        unsafe {
+            let [r0, r1, r2, r3] = r.map(std::arch::x86_64::__m128::from);
+            let (t0, t1) = (_mm_unpacklo_ps(r0, r1), _mm_unpacklo_ps(r2, r3));
+            let (t2, t3) = (_mm_unpackhi_ps(r0, r1), _mm_unpackhi_ps(r2, r3));
+            [
+                _mm_movelh_ps(t0, t1),
+                _mm_movehl_ps(t1, t0),
+                _mm_movelh_ps(t2, t3),
+                _mm_movehl_ps(t3, t2),
+            ]
+            .map(Vec4::from)
+        }
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+    {
+        let a = r.map(Vec4::to_array);
+        std::array::from_fn(|i| Vec4::new(a[0][i], a[1][i], a[2][i], a[3][i]))
+    }
+}
+
 /// Eight f32 lanes.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct F8(Vec4, Vec4);
@@ -44,6 +72,16 @@ impl F8 {
     pub const ZERO: Self = Self(Vec4::ZERO, Vec4::ZERO);
     pub const ONE: Self = Self(Vec4::ONE, Vec4::ONE);
 
+    /// Lanes 0-3 from `lo`, 4-7 from `hi`.
+    #[inline(always)]
+    pub fn from_halves(lo: Vec4, hi: Vec4) -> Self {
+        Self(lo, hi)
+    }
+    /// Lanes 0-3 and 4-7.
+    #[inline(always)]
+    pub fn halves(self) -> [Vec4; 2] {
+        [self.0, self.1]
+    }
     #[inline(always)]
     pub fn splat(v: f32) -> Self {
         Self(Vec4::splat(v), Vec4::splat(v))
@@ -146,5 +184,22 @@ impl Neg for F8 {
     #[inline(always)]
     fn neg(self) -> Self {
         Self(-self.0, -self.1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transpose4_transposes() {
+        let r: [Vec4; 4] =
+            std::array::from_fn(|i| Vec4::from_array(std::array::from_fn(|j| (4 * i + j) as f32)));
+        let t = transpose4(r);
+        for i in 0..4 {
+            for j in 0..4 {
+                assert_eq!(t[j][i], r[i][j]);
+            }
+        }
     }
 }

@@ -7,7 +7,7 @@
 use glam::{Mat3, Mat3A, Vec3};
 
 use crate::error::MpmError;
-use crate::math::{svd3, LeftStretch, Svd3};
+use crate::math::{svd3, Svd3};
 
 /// Constitutive behaviour of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -269,15 +269,14 @@ impl CompiledMaterial {
         }
     }
 
-    /// As [`Self::project_and_stress_svd`], given the left stretch `ls` of `f` instead of its
-    /// SVD (ignored by water): cheaper, since the common cases need no right rotation. An
+    /// As [`Self::project_and_stress_svd`], given the left stretch of `f` (its rotation `u`
+    /// and stretches `sig`, see [`crate::math::LeftStretch`]) instead of its SVD (ignored by water): cheaper, since the common cases need no right rotation. An
     /// elastic state stays `f`; a clay state beyond the yield surface is projected as
     /// `U·diag(σ_new/σ)·Uᵀ·f` (= `U·diag(σ_new)·Vᵀ`). Inverted or collapsed states (det ≤ 0,
     /// or clay stretches below its floor), rare, take the SVD path. In SIMD registers
     /// (`Mat3A`): the same operations in the same order as on `Mat3`, bit for bit.
     #[inline(always)]
-    pub fn project_and_stress_left(&self, f: Mat3A, ls: &LeftStretch) -> (Mat3A, Mat3A) {
-        let sig = ls.sigma;
+    pub fn project_and_stress_left(&self, f: Mat3A, u: Mat3A, sig: Vec3) -> (Mat3A, Mat3A) {
         let full = |f: Mat3A, d: &Svd3| {
             let (f_new, tau) = self.project_and_stress_svd(f.into(), d);
             (Mat3A::from(f_new), Mat3A::from(tau))
@@ -290,7 +289,6 @@ impl CompiledMaterial {
         if !usual || f.determinant() <= 0.0 {
             return full(f, &svd3(f.into()));
         }
-        let u = Mat3A::from(ls.u);
         if self.kind == CompiledKind::Elastic || sig.x <= self.elastic_stretch_ratio * sig.z {
             return (f, self.corotated_stress(u, sig));
         }
@@ -394,7 +392,7 @@ mod tests {
                     f.z_axis *= 0.02;
                 }
                 let ls = crate::math::left_stretch_x8(&[f; 8])[0];
-                let (fa, ta) = m.project_and_stress_left(f.into(), &ls);
+                let (fa, ta) = m.project_and_stress_left(f.into(), ls.u.into(), ls.sigma);
                 let (fa, ta) = (Mat3::from(fa), Mat3::from(ta));
                 let (fb, tb) = m.project_and_stress(f);
                 let tol = 1e-4 * (1.0 + max_abs(fb));

@@ -2,9 +2,9 @@
 //! algorithm as [`crate::math::svd3`], with branches replaced by per-lane selects; the sweeps
 //! stop when all eight lanes have converged.
 
-use glam::{Mat3, Vec3};
+use glam::{Mat3, Mat3A, Vec3, Vec3A, Vec4};
 
-use crate::lanes::{F8, M8};
+use crate::lanes::{transpose4, F8, M8};
 use crate::math::{LeftStretch, Svd3};
 
 /// Eight 3-vectors, component-wise in lanes.
@@ -155,13 +155,44 @@ fn jacobi_eigen_x8(s: [F8; 6]) -> ([F8; 3], [V3x8; 3]) {
 /// eigenvectors are the left singular vectors and eigenvalues the squared singular values.
 /// No right rotation is formed, which is what makes it cheaper than [`svd3_x8`].
 pub fn left_stretch_x8(f: &[Mat3; 8]) -> [LeftStretch; 8] {
-    // Rows of F (glam stores columns).
-    let row = |r: usize| V3x8 {
-        x: F8::from_fn(|l| f[l].x_axis[r]),
-        y: F8::from_fn(|l| f[l].y_axis[r]),
-        z: F8::from_fn(|l| f[l].z_axis[r]),
+    left_stretch_x8_cols(&f.map(Mat3A::from)).map(|[c0, c1, c2]| LeftStretch {
+        u: Mat3::from_cols(c0.truncate(), c1.truncate(), c2.truncate()),
+        sigma: Vec3::new(c0.w, c1.w, c2.w),
+    })
+}
+
+/// Raw SIMD register of a `Vec3A` (its w lane unspecified).
+#[inline(always)]
+fn raw4(v: Vec3A) -> Vec4 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    {
+        Vec4::from(std::arch::x86_64::__m128::from(v))
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+    {
+        v.extend(0.0)
+    }
+}
+
+/// [`left_stretch_x8`] in the transfers' layout: lane `l`'s `U` as three columns, each with the
+/// matching stretch in its w lane (`[[u0, σ0], [u1, σ1], [u2, σ2]]`). The matrices go into
+/// the lanes and back by 4×4 transposes instead of one element at a time; same operations on
+/// the lanes, so the same results bit for bit.
+#[inline(always)]
+pub(crate) fn left_stretch_x8_cols(f: &[Mat3A; 8]) -> [[Vec4; 3]; 8] {
+    // Column c of four matrices, transposed: rows 0-2 of F's entries in column c.
+    let lanes = |c: usize| {
+        let lo = transpose4(std::array::from_fn(|l| raw4(f[l].col(c))));
+        let hi = transpose4(std::array::from_fn(|l| raw4(f[4 + l].col(c))));
+        [0, 1, 2].map(|r| F8::from_halves(lo[r], hi[r]))
     };
-    let rows = [row(0), row(1), row(2)];
+    let (cx, cy, cz) = (lanes(0), lanes(1), lanes(2));
+    // Rows of F (glam stores columns).
+    let rows: [V3x8; 3] = std::array::from_fn(|r| V3x8 {
+        x: cx[r],
+        y: cy[r],
+        z: cz[r],
+    });
     let (mut lam, mut uc) = jacobi_eigen_x8([
         rows[0].dot(rows[0]),
         rows[1].dot(rows[1]),
@@ -184,10 +215,13 @@ pub fn left_stretch_x8(f: &[Mat3; 8]) -> [LeftStretch; 8] {
     swap(0, 2, &mut uc, &mut lam);
     swap(1, 2, &mut uc, &mut lam);
     let sigma = lam.map(|l| l.max(F8::ZERO).sqrt());
-    std::array::from_fn(|l| LeftStretch {
-        u: Mat3::from_cols(uc[0].lane(l), uc[1].lane(l), uc[2].lane(l)),
-        sigma: Vec3::new(sigma[0].lane(l), sigma[1].lane(l), sigma[2].lane(l)),
-    })
+    // Back to one matrix per lane: (column c of U, σc) of lanes 0-3 and 4-7.
+    let out: [[[Vec4; 4]; 2]; 3] = std::array::from_fn(|c| {
+        let (u, s) = (uc[c], sigma[c]);
+        let [x, y, z, s] = [u.x, u.y, u.z, s].map(F8::halves);
+        [0, 1].map(|h| transpose4([x[h], y[h], z[h], s[h]]))
+    });
+    std::array::from_fn(|l| [0, 1, 2].map(|c| out[c][l / 4][l % 4]))
 }
 
 /// SVDs of eight matrices (see [`crate::math::svd3`] for the conventions).

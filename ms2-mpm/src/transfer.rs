@@ -13,7 +13,8 @@ use rayon::prelude::*;
 
 use crate::grid::{GridSpec, GridStorage, BLOCK};
 use crate::material::{CompiledKind, CompiledMaterial};
-use crate::math::{fast_floor3a, left_stretch_x8, quadratic_weights_a, LeftStretch};
+use crate::math::{fast_floor3a, quadratic_weights_a};
+use crate::math_x8::left_stretch_x8_cols;
 use crate::parallel::SyncPtr;
 use crate::particles::{Binning, Particles};
 
@@ -22,10 +23,13 @@ use crate::particles::{Binning, Particles};
 const LOCAL: usize = BLOCK + 4;
 const LOCAL_NODES: usize = LOCAL * LOCAL * LOCAL;
 
-const IDENTITY_STRETCH: LeftStretch = LeftStretch {
-    u: Mat3::IDENTITY,
-    sigma: Vec3::ONE,
-};
+/// The left stretch of the identity in [`left_stretch_x8_cols`]'s layout: `U`'s columns with
+/// the stretches (1) in w.
+const IDENTITY_STRETCH: [Vec4; 3] = [
+    Vec4::new(1.0, 0.0, 0.0, 1.0),
+    Vec4::new(0.0, 1.0, 0.0, 1.0),
+    Vec4::new(0.0, 0.0, 1.0, 1.0),
+];
 
 /// A bin's grid neighbourhood: momentum or velocity (xyz) and mass (w) per node, in SIMD
 /// registers.
@@ -162,22 +166,29 @@ fn accumulate_unit(
     // lanes.
     for group in (first..end).step_by(8) {
         let n = (end - group).min(8);
-        let mut trial = [Mat3::IDENTITY; 8];
+        let mut trial = [Mat3A::IDENTITY; 8];
         let mut any_svd = false;
         for (l, t) in trial.iter_mut().enumerate().take(n) {
             let pi = group + l;
-            *t = ((Mat3A::IDENTITY + dt * Mat3A::from(c[pi])) * Mat3A::from(p_f[pi])).into();
+            *t = (Mat3A::IDENTITY + dt * Mat3A::from(c[pi])) * Mat3A::from(p_f[pi]);
             any_svd |= prm.materials[material[pi] as usize].needs_svd();
         }
         let stretches = if any_svd {
-            left_stretch_x8(&trial)
+            left_stretch_x8_cols(&trial)
         } else {
             [IDENTITY_STRETCH; 8]
         };
         for l in 0..n {
             let pi = group + l;
             let mat = &prm.materials[material[pi] as usize];
-            let (f_new, tau) = mat.project_and_stress_left(trial[l].into(), &stretches[l]);
+            let [u0, u1, u2] = stretches[l];
+            let u = Mat3A::from_cols(
+                Vec3A::from_vec4(u0),
+                Vec3A::from_vec4(u1),
+                Vec3A::from_vec4(u2),
+            );
+            let sigma = Vec3::new(u0.w, u1.w, u2.w);
+            let (f_new, tau) = mat.project_and_stress_left(trial[l], u, sigma);
             f_out[pi - first] = f_new.into();
             let (base, fx, wv) = quadratic_weights_a((Vec3A::from(x[pi]) - origin) * inv_dx);
             // w[axis][k]: the weight of node base + k along axis.
