@@ -194,6 +194,10 @@ fn gather_unit(
 /// encodings: about 5 % of the substep on an AMD EPYC (Zen 5), 2026-11-29.
 #[inline]
 fn wide_simd() -> bool {
+    #[cfg(test)]
+    if BASELINE_ONLY.load(std::sync::atomic::Ordering::Relaxed) {
+        return false;
+    }
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx512f")
@@ -206,6 +210,12 @@ fn wide_simd() -> bool {
         false
     }
 }
+
+/// Tests: run the baseline build even where the CPU has AVX-512 (both builds must agree bit
+/// for bit, so other tests running meanwhile are unaffected).
+#[cfg(test)]
+pub(crate) static BASELINE_ONLY: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
 
 /// [`accumulate_unit`] compiled with AVX-512 F, VL, DQ and BW (and what they imply: AVX2,
 /// FMA).
@@ -562,5 +572,98 @@ pub(crate) fn grid_to_particle(
     G2pReport {
         needs_sort,
         diverged,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::Ordering;
+
+    use glam::Vec3;
+
+    use super::BASELINE_ONLY;
+    use crate::grid::GridSpec;
+    use crate::material::Material;
+    use crate::sampling::sample_box;
+    use crate::solver::{MpmSolver, ParticleForces, ParticleView, SolverConfig};
+
+    /// Pseudo-random external forces and blocked stencil nodes, so that both transfer paths
+    /// (with and without masks) run.
+    struct Stir(u32);
+
+    impl ParticleForces for Stir {
+        fn particle_forces(&mut self, p: ParticleView<'_>, _dt: f32, forces: &mut [Vec3]) {
+            for (f, &m) in forces.iter_mut().zip(p.masses) {
+                self.0 = self.0.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                let r = (self.0 >> 8) as f32 / (1u32 << 24) as f32 - 0.5;
+                *f = Vec3::new(r, -r, 2.0 * r) * (5.0 * m);
+            }
+        }
+
+        fn blocked_nodes(&mut self, p: ParticleView<'_>, _g: &GridSpec, masks: &mut [u32]) -> bool {
+            for (mask, &id) in masks.iter_mut().zip(p.ids) {
+                if id % 7 == 0 {
+                    *mask = (id.wrapping_mul(2_654_435_761) >> 5) & ((1 << 27) - 1);
+                }
+            }
+            true
+        }
+    }
+
+    fn run(baseline: bool) -> Vec<u32> {
+        BASELINE_ONLY.store(baseline, Ordering::Relaxed);
+        let grid = GridSpec::new(Vec3::ZERO, 0.01, [32; 3]);
+        let mut solver = MpmSolver::new(SolverConfig::new(grid)).unwrap();
+        let clay = solver
+            .add_material(Material::clay(1000.0, 1e4, 0.3, 2e3))
+            .unwrap();
+        let water = solver.add_material(Material::water(1000.0, 1e4)).unwrap();
+        let jelly = solver
+            .add_material(Material::elastic(1000.0, 3e4, 0.3))
+            .unwrap();
+        let vol = 0.005f32.powi(3);
+        let boxes = [
+            (Vec3::new(0.05, 0.05, 0.04), clay, Vec3::new(0.3, 0.0, -0.5)),
+            (Vec3::new(0.15, 0.05, 0.04), water, Vec3::ZERO),
+            (
+                Vec3::new(0.08, 0.16, 0.10),
+                jelly,
+                Vec3::new(0.0, -0.4, 0.0),
+            ),
+        ];
+        for (lo, m, v) in boxes {
+            let pts = sample_box(lo, lo + Vec3::splat(0.08), 0.005);
+            solver.add_particles(&pts, m, vol, v).unwrap();
+        }
+        let mut stir = Stir(1);
+        for step in 0..120 {
+            if step % 2 == 0 {
+                solver.substep_with_forces(&mut stir).unwrap();
+            } else {
+                solver.substep().unwrap();
+            }
+        }
+        BASELINE_ONLY.store(false, Ordering::Relaxed);
+        let s = solver.state();
+        let mut bits = Vec::new();
+        for i in 0..s.positions.len() {
+            bits.extend(s.positions[i].to_array().map(f32::to_bits));
+            bits.extend(s.velocities[i].to_array().map(f32::to_bits));
+            bits.extend(s.deformation_gradients[i].to_cols_array().map(f32::to_bits));
+            bits.extend(s.affine_velocities[i].to_cols_array().map(f32::to_bits));
+        }
+        bits
+    }
+
+    #[test]
+    fn wide_simd_build_matches_the_baseline_bit_for_bit() {
+        if !super::wide_simd() {
+            eprintln!("no AVX-512 on this CPU: only the baseline build runs");
+        }
+        let wide = run(false);
+        let base = run(true);
+        assert_eq!(wide.len(), base.len());
+        let first_diff = wide.iter().zip(&base).position(|(a, b)| a != b);
+        assert_eq!(first_diff, None, "builds differ");
     }
 }
