@@ -270,11 +270,12 @@ impl CompiledMaterial {
     }
 
     /// As [`Self::project_and_stress_svd`], given the left stretch of `f` (its rotation `u`
-    /// and stretches `sig`, see [`crate::math::LeftStretch`]) instead of its SVD (ignored by water): cheaper, since the common cases need no right rotation. An
-    /// elastic state stays `f`; a clay state beyond the yield surface is projected as
-    /// `U·diag(σ_new/σ)·Uᵀ·f` (= `U·diag(σ_new)·Vᵀ`). Inverted or collapsed states (det ≤ 0,
-    /// or clay stretches below its floor), rare, take the SVD path. In SIMD registers
-    /// (`Mat3A`): the same operations in the same order as on `Mat3`, bit for bit.
+    /// and stretches `sig`, see [`crate::math::LeftStretch`]) instead of its SVD (ignored by
+    /// water): cheaper, since the common cases need no right rotation. An elastic state stays
+    /// `f`; a clay state beyond the yield surface is projected as `U·diag(σ_new/σ)·Uᵀ·f`
+    /// (= `U·diag(σ_new)·Vᵀ`). Inverted or collapsed states (det ≤ 0, or clay stretches below
+    /// its floor), rare, take the SVD path. In SIMD registers (`Mat3A`): the same operations
+    /// in the same order as on `Mat3`, bit for bit.
     #[inline(always)]
     pub fn project_and_stress_left(&self, f: Mat3A, u: Mat3A, sig: Vec3) -> (Mat3A, Mat3A) {
         let full = |f: Mat3A, d: &Svd3| {

@@ -190,8 +190,9 @@ fn gather_unit(
 /// Whether this CPU runs the transfers' AVX-512 build (x86-64 with AVX-512 F, VL, DQ and BW).
 /// The same operations in the same order as the baseline (SSE2) build, so bit for bit the
 /// same results (no fused multiply-adds: Rust never contracts `a * b + c`); what it gains is
-/// twice the vector registers (the 8-lane stretch batch no longer spills) and the 3-operand
-/// encodings: about 5 % of the substep on an AMD EPYC (Zen 5), 2026-11-29.
+/// twice the vector registers (fewer spills around the 8-lane stretch batch) and the 3-operand
+/// encodings: 4-10 % of the substep on an AMD EPYC (Zen 5) with AVX-512, 2026-11-29 (runs
+/// alternated with the SSE2-only build, load about 5).
 #[inline]
 fn wide_simd() -> bool {
     #[cfg(test)]
@@ -305,11 +306,13 @@ pub(crate) fn particle_to_grid(
             // its last read.
             let f_out = unsafe { f_ptr.slice_mut(start as usize, (end - start) as usize) };
             let first = start as usize;
-            #[cfg(target_arch = "x86_64")]
             if wide {
                 // SAFETY: `wide_simd` checked that the CPU has the function's features.
-                unsafe { accumulate_unit_avx512(prm, p, p_f, first, f_out, corner, local) };
-                return;
+                #[cfg(target_arch = "x86_64")]
+                {
+                    unsafe { accumulate_unit_avx512(prm, p, p_f, first, f_out, corner, local) };
+                    return;
+                }
             }
             accumulate_unit(prm, p, p_f, first, f_out, corner, local);
         });
@@ -556,9 +559,9 @@ pub(crate) fn grid_to_particle(
                 )
             };
             let (bounds, xv) = ([lo, hi], [xs, vs]);
-            #[cfg(target_arch = "x86_64")]
             if wide {
                 // SAFETY: `wide_simd` checked that the CPU has the function's features.
+                #[cfg(target_arch = "x86_64")]
                 return unsafe {
                     gather_unit_avx512(prm, grid, bounds, corner, start, xv, cs, mass, material)
                 };
