@@ -2,7 +2,8 @@
 //! `key=value` pairs, the format `bench/compare_taichi.sh` reads. `state_hash` fingerprints the
 //! final state (FNV-1a over the bits of every particle's position, velocity, deformation
 //! gradient and affine matrix, in canonical order): equal hashes from two builds mean
-//! bit-identical simulations.
+//! bit-identical simulations. `build` names the transfer kernels' build that ran
+//! (`ms2_mpm::transfer_build`: `avx512` or `baseline`).
 //!
 //! Usage: `cargo run --release -p ms2-mpm --example bench_step -- [particles] [threads] [substeps]`
 //! (defaults 32768, all cores, 400).
@@ -47,8 +48,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!(
             "engine=ms2-mpm particles={particles} threads={threads} substeps={substeps} \
              seconds={secs:.3} particle_substeps_per_s={:.4e} top_z={top:.4} \
-             state_hash={hash:016x}",
-            (particles * substeps) as f64 / secs
+             state_hash={hash:016x} build={}",
+            (particles * substeps) as f64 / secs,
+            ms2_mpm::transfer_build()
         );
         Ok(())
     })?;

@@ -56,3 +56,4 @@ pub use mesh::TriMesh;
 pub use particles::ParticleId;
 pub use solver::{MaterialId, MpmSolver, ParticleForces, ParticleView, SolverConfig};
 pub use state::MpmState;
+pub use transfer::transfer_build;

@@ -212,6 +212,17 @@ fn wide_simd() -> bool {
     }
 }
 
+/// Which build of the transfer kernels runs on this CPU: `"avx512"` (x86-64 with AVX-512 F,
+/// VL, DQ and BW) or `"baseline"` (what the crate was compiled for; SSE2 on x86-64). Both give
+/// bit for bit the same results; benchmarks report it because the speed differs.
+pub fn transfer_build() -> &'static str {
+    if wide_simd() {
+        "avx512"
+    } else {
+        "baseline"
+    }
+}
+
 /// Tests: run the baseline build even where the CPU has AVX-512 (both builds must agree bit
 /// for bit, so other tests running meanwhile are unaffected).
 #[cfg(test)]
