@@ -27,6 +27,7 @@ pub const ENV_KWARGS: [&str; 15] = [
     "render_camera_cfgs",
     "bg_name",
     "exact_restore",
+    "mass_matrix_substeps",
     "model_ids",
 ];
 
@@ -153,6 +154,11 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                 }
                 cfg.exact_restore = value.extract()?;
             }
+            "mass_matrix_substeps" => {
+                let n: i128 = extract_int(&key, &value, "an int (physics substeps)")?;
+                // Range errors come from `EnvConfig::check_bounds` (a `ValueError`).
+                cfg.mass_matrix_substeps = u32::try_from(n).unwrap_or(0);
+            }
             "bg_name" => cfg.bg_name = Some(extract_kwarg(&key, &value, "a str")?),
             "model_ids" => cfg.model_ids = Some(extract_model_ids(&value)?),
             other => {
@@ -181,6 +187,7 @@ pub fn config_to_py<'py>(py: Python<'py>, cfg: &EnvConfig) -> PyResult<Bound<'py
     dict.set_item("enable_shadow", cfg.enable_shadow)?;
     dict.set_item("bg_name", &cfg.bg_name)?;
     dict.set_item("exact_restore", cfg.exact_restore)?;
+    dict.set_item("mass_matrix_substeps", cfg.mass_matrix_substeps)?;
     dict.set_item("model_ids", &cfg.model_ids)?;
     Ok(dict)
 }
