@@ -12,7 +12,7 @@ use crate::cameras::camera_updates_from_py;
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
 /// (ManiSkill2's `state` obs mode, then [`EnvConfig::new`]'s: the task's control/reward mode, 500 Hz / 20 Hz, the task's
 /// episode limit, no render mode, the task's default robot and cameras, the soft-body task's MPM frequency).
-pub const ENV_KWARGS: [&str; 15] = [
+pub const ENV_KWARGS: [&str; 16] = [
     "obs_mode",
     "robot",
     "control_mode",
@@ -156,8 +156,15 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
             }
             "mass_matrix_substeps" => {
                 let n: i128 = extract_int(&key, &value, "an int (physics substeps)")?;
-                // Range errors come from `EnvConfig::check_bounds` (a `ValueError`).
-                cfg.mass_matrix_substeps = u32::try_from(n).unwrap_or(0);
+                let max = ms2_tasks::MAX_SUBSTEPS;
+                cfg.mass_matrix_substeps = u32::try_from(n)
+                    .ok()
+                    .filter(|n| (1..=max).contains(n))
+                    .ok_or_else(|| {
+                        PyValueError::new_err(format!(
+                            "mass_matrix_substeps must be in 1..={max} physics substeps, got {n}"
+                        ))
+                    })?;
             }
             "bg_name" => cfg.bg_name = Some(extract_kwarg(&key, &value, "a str")?),
             "model_ids" => cfg.model_ids = Some(extract_model_ids(&value)?),

@@ -520,5 +520,3 @@ impl EnvBackend for TaskEnv {
         Some(self.task.as_ref())
     }
 }
-
-

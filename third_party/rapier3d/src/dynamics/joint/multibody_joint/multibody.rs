@@ -150,7 +150,7 @@ pub struct Multibody {
 }
 
 /// What a multibody's mass matrices depend on besides its configuration and velocities.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde-serialize", derive(Serialize, Deserialize))]
 struct MassMatrixKey {
     dt: Real,
@@ -906,22 +906,29 @@ impl Multibody {
         self.reuse_mass_matrix
     }
 
-    fn mass_matrix_key(&self, dt: Real) -> MassMatrixKey {
-        MassMatrixKey {
-            dt,
-            ndofs: self.ndofs,
-            kinematic: self.links.iter().map(|l| l.joint.kinematic).collect(),
-            coords: self
-                .links
-                .iter()
-                .flat_map(|l| l.joint.coords.as_slice().to_vec())
-                .collect(),
+    /// Records what the mass matrices are being built for (reusing the key's buffers).
+    fn record_mass_matrix_key(&mut self, dt: Real) {
+        let mut key = self.mass_matrix_built_for.take().unwrap_or_default();
+        key.dt = dt;
+        key.ndofs = self.ndofs;
+        key.kinematic.clear();
+        key.kinematic
+            .extend(self.links.iter().map(|l| l.joint.kinematic));
+        key.coords.clear();
+        for l in self.links.iter() {
+            key.coords.extend_from_slice(l.joint.coords.as_slice());
         }
+        self.mass_matrix_built_for = Some(key);
     }
 
     /// Whether the matrices built for `key` may serve a step of `dt` now, joints displaced by
     /// at most `max_displacement` (rad or m) from their coordinates then.
-    fn mass_matrix_still_valid(&self, key: &MassMatrixKey, dt: Real, max_displacement: Real) -> bool {
+    fn mass_matrix_still_valid(
+        &self,
+        key: &MassMatrixKey,
+        dt: Real,
+        max_displacement: Real,
+    ) -> bool {
         key.dt == dt
             && key.ndofs == self.ndofs
             && self
@@ -948,7 +955,7 @@ impl Multibody {
                 return;
             }
         }
-        self.mass_matrix_built_for = Some(self.mass_matrix_key(dt));
+        self.record_mass_matrix_key(dt);
 
         if self.augmented_mass.ncols() != self.ndofs {
             // TODO: do a resize instead of a full reallocation.
