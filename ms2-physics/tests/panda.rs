@@ -7,6 +7,17 @@ use common::{max_speed, panda_scene, TcpKinematics};
 use ms2_physics::WorldConfig;
 use nalgebra::Vector3;
 
+/// One 2 ms step of a 20 Hz control loop: with `reuse`, the substeps after the first of each
+/// 25 keep the Panda's mass matrix for up to two substeps (ms2-tasks' default
+/// `mass_matrix_substeps`, 3), as ms2-tasks steps its envs.
+fn substep(world: &mut ms2_physics::World, k: usize, reuse: bool) {
+    if reuse && k % 25 % 3 != 0 {
+        world.step_reusing_mass_matrices(f32::INFINITY);
+    } else {
+        world.step();
+    }
+}
+
 #[test]
 fn panda_holds_rest_pose_under_gravity_for_two_seconds() {
     let (mut world, panda, _) = panda_scene(WorldConfig::default(), None);
@@ -21,6 +32,15 @@ fn panda_holds_rest_pose_under_gravity_for_two_seconds() {
 
 #[test]
 fn arm_joint_steps_of_0_3_rad_settle_within_one_second_without_overshoot() {
+    joint_steps_settle(false);
+}
+
+#[test]
+fn arm_joint_steps_settle_the_same_with_mass_matrices_reused_between_rebuilds() {
+    joint_steps_settle(true);
+}
+
+fn joint_steps_settle(reuse: bool) {
     // No ground: some steps swing the hand below z = 0; this test is about the drives.
     let config = WorldConfig {
         ground: None,
@@ -36,7 +56,7 @@ fn arm_joint_steps_of_0_3_rad_settle_within_one_second_without_overshoot() {
         let mut settled_at = None;
         let mut worst_err_after_settling = 0.0f32;
         for step in 1..=500 {
-            world.step();
+            substep(&mut world, step - 1, reuse);
             let q = world.qpos(panda).unwrap()[joint];
             overshoot = overshoot.max(q - target[joint]);
             let err = (q - target[joint]).abs();
@@ -70,6 +90,15 @@ fn arm_joint_steps_of_0_3_rad_settle_within_one_second_without_overshoot() {
 
 #[test]
 fn grasped_cube_lifted_15_cm_holds_for_ten_seconds() {
+    grasp_lift_hold(false);
+}
+
+#[test]
+fn grasp_holds_the_same_with_mass_matrices_reused_between_rebuilds() {
+    grasp_lift_hold(true);
+}
+
+fn grasp_lift_hold(reuse: bool) {
     let cube_centre = Vector3::new(0.0, 0.0, 0.02);
     let (mut world, panda, cube) = panda_scene(WorldConfig::default(), Some(cube_centre));
     let cube = cube.unwrap();
@@ -96,7 +125,7 @@ fn grasped_cube_lifted_15_cm_holds_for_ten_seconds() {
                 t.extend_from_slice(&gripper);
                 world.set_drive_targets(panda, &t).unwrap();
             }
-            world.step();
+            substep(world, k, reuse);
             let (v, finite) = max_speed(world);
             max_v = max_v.max(v);
             all_finite &= finite;

@@ -12,7 +12,7 @@ use crate::cameras::camera_updates_from_py;
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
 /// (ManiSkill2's `state` obs mode, then [`EnvConfig::new`]'s: the task's control/reward mode, 500 Hz / 20 Hz, the task's
 /// episode limit, no render mode, the task's default robot and cameras, the soft-body task's MPM frequency).
-pub const ENV_KWARGS: [&str; 15] = [
+pub const ENV_KWARGS: [&str; 16] = [
     "obs_mode",
     "robot",
     "control_mode",
@@ -27,6 +27,7 @@ pub const ENV_KWARGS: [&str; 15] = [
     "render_camera_cfgs",
     "bg_name",
     "exact_restore",
+    "mass_matrix_substeps",
     "model_ids",
 ];
 
@@ -153,6 +154,18 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                 }
                 cfg.exact_restore = value.extract()?;
             }
+            "mass_matrix_substeps" => {
+                let n: i128 = extract_int(&key, &value, "an int (physics substeps)")?;
+                let max = ms2_tasks::MAX_SUBSTEPS;
+                cfg.mass_matrix_substeps = u32::try_from(n)
+                    .ok()
+                    .filter(|n| (1..=max).contains(n))
+                    .ok_or_else(|| {
+                        PyValueError::new_err(format!(
+                            "mass_matrix_substeps must be in 1..={max} physics substeps, got {n}"
+                        ))
+                    })?;
+            }
             "bg_name" => cfg.bg_name = Some(extract_kwarg(&key, &value, "a str")?),
             "model_ids" => cfg.model_ids = Some(extract_model_ids(&value)?),
             other => {
@@ -181,6 +194,7 @@ pub fn config_to_py<'py>(py: Python<'py>, cfg: &EnvConfig) -> PyResult<Bound<'py
     dict.set_item("enable_shadow", cfg.enable_shadow)?;
     dict.set_item("bg_name", &cfg.bg_name)?;
     dict.set_item("exact_restore", cfg.exact_restore)?;
+    dict.set_item("mass_matrix_substeps", cfg.mass_matrix_substeps)?;
     dict.set_item("model_ids", &cfg.model_ids)?;
     Ok(dict)
 }

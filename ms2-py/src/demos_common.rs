@@ -124,7 +124,8 @@ pub fn episode_from_py(env_id: &str, dict: &Bound<'_, PyDict>) -> PyResult<DemoE
 /// The keyword arguments that rebuild env `env_id` made with `env_kwargs`, as a trajectory
 /// file's `env_info` records them, resolved by making the env: `{"obs_mode", "control_mode",
 /// "reward_mode", "sim_freq", "control_freq", "max_episode_steps"}` plus `"mpm_freq"` (Hz) for
-/// soft-body envs, and `"exact_restore": True` when set. `ValueError` for an unknown id or bad `env_kwargs`.
+/// soft-body envs, `"exact_restore": True` when set and `"mass_matrix_substeps"` when not the
+/// default. `ValueError` for an unknown id or bad `env_kwargs`.
 #[pyfunction]
 #[pyo3(signature = (env_id, env_kwargs=None))]
 pub fn recorded_env_kwargs<'py>(
@@ -145,6 +146,11 @@ pub fn recorded_env_kwargs<'py>(
     // ManiSkill2 has no such keyword: recorded only when on.
     if !resolved.exact_restore {
         dict.del_item("exact_restore")?;
+    }
+    // ms2's own keyword too: recorded only when not the default, so that a demo made with
+    // another value replays with it.
+    if resolved.mass_matrix_substeps == ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS {
+        dict.del_item("mass_matrix_substeps")?;
     }
     Ok(dict)
 }

@@ -488,6 +488,48 @@ def test_exact_restore_is_recorded_only_when_on_and_must_be_a_bool():
         ms2.Ms2Env("PickCube-v0", exact_restore=1)
 
 
+def test_mass_matrix_substeps_is_checked_recorded_when_not_default_and_changes_the_run():
+    """Issue #21: ``mass_matrix_substeps`` (ms2's own keyword) must be an int in [1, 1000];
+    the default agrees with the native one; a trajectory records it only when it is not the
+    default; 1 (rebuild every substep) gives another run than the default, each repeatable."""
+    from ms2 import _native
+    from ms2.envs import DEFAULT_MASS_MATRIX_SUBSTEPS
+
+    env = ms2.Ms2Env("PickCube-v0", obs_mode="state")
+    assert env.mass_matrix_substeps == DEFAULT_MASS_MATRIX_SUBSTEPS
+    assert env._native.config()["mass_matrix_substeps"] == DEFAULT_MASS_MATRIX_SUBSTEPS
+    for bad in ("3", 2.0, True):
+        with pytest.raises(TypeError, match="mass_matrix_substeps must be an int"):
+            ms2.Ms2Env("PickCube-v0", mass_matrix_substeps=bad)
+    # None means the default, as for every keyword of the native env.
+    none = ms2.Ms2Env("PickCube-v0", mass_matrix_substeps=None)
+    assert none.mass_matrix_substeps == DEFAULT_MASS_MATRIX_SUBSTEPS
+    for bad in (0, -1, 1001, 2**40):
+        with pytest.raises(
+            ValueError, match=rf"mass_matrix_substeps must be in 1\.\.=1000 physics substeps, got {bad}$"
+        ):
+            ms2.Ms2Env("PickCube-v0", mass_matrix_substeps=bad)
+    default = _native.recorded_env_kwargs("PickCube-v0", {"obs_mode": "state"})
+    assert "mass_matrix_substeps" not in default
+    one = _native.recorded_env_kwargs(
+        "PickCube-v0", {"obs_mode": "state", "mass_matrix_substeps": 1}
+    )
+    assert one["mass_matrix_substeps"] == 1
+
+    def run(n):
+        e = ms2.Ms2Env("PickCube-v0", obs_mode="state", mass_matrix_substeps=n)
+        e.reset(seed=2)
+        rng = np.random.default_rng(0)
+        for _ in range(20):
+            e.step(rng.uniform(-1, 1, e.action_space.shape).astype(np.float32))
+        return e.get_state()
+
+    reused, rebuilt = run(DEFAULT_MASS_MATRIX_SUBSTEPS), run(1)
+    np.testing.assert_array_equal(reused, run(DEFAULT_MASS_MATRIX_SUBSTEPS))
+    assert not np.array_equal(reused, rebuilt)
+    assert float(np.abs(reused - rebuilt).max()) < 0.05
+
+
 def test_soak_runs_every_obs_mode_of_a_task_in_worker_processes(capsys):
     """``ms2 bench --soak --jobs 2`` in small: every obs mode of PickCube soaked with resets and
     set_state, no NaN handed out, no errors; image modes get the small soak cameras."""

@@ -6,7 +6,8 @@
 //!
 //! For each env (default: every env with a solution) runs seeds `0..seeds` on one thread and
 //! prints the success rate, the failed seeds with the reason, wall seconds per episode and the
-//! planning time per query.
+//! planning time per query. `MASS_MATRIX_SUBSTEPS` sets
+//! [`EnvConfig::mass_matrix_substeps`] (default [`ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS`]).
 
 use ms2_tasks::demos::solutions::{solution_env_ids, DemoSolver};
 use ms2_tasks::EnvConfig;
@@ -22,7 +23,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         env_ids = solution_env_ids().into_iter().map(str::to_owned).collect();
     }
     for env_id in env_ids {
-        let mut solver = DemoSolver::new(&EnvConfig::new(&env_id))?;
+        let mut solver = DemoSolver::new(&EnvConfig {
+            mass_matrix_substeps: match std::env::var("MASS_MATRIX_SUBSTEPS") {
+                Ok(s) => s.parse()?,
+                Err(_) => ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS,
+            },
+            ..EnvConfig::new(&env_id)
+        })?;
         let (mut successes, mut total_s, mut plan_s, mut queries, mut steps) = (0, 0.0, 0.0, 0, 0);
         let mut failures = Vec::new();
         for seed in 0..seeds {

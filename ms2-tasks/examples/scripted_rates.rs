@@ -5,6 +5,9 @@
 //! ```
 //! Prints one line per env: successes, rate, mean steps to success and wall time. `FIRST_SEED`
 //! continues a sweep where an earlier run stopped (the slow soft-body tasks run in parts).
+//! `MASS_MATRIX_SUBSTEPS` sets [`EnvConfig::mass_matrix_substeps`] (default
+//! [`ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS`]; 1 rebuilds the robot's mass matrix every
+//! substep).
 
 use std::time::Instant;
 
@@ -33,6 +36,14 @@ fn main() -> Result<(), EnvError> {
         })?,
         Err(_) => 0,
     };
+    let mass_matrix_substeps = match std::env::var("MASS_MATRIX_SUBSTEPS") {
+        Ok(s) => s.parse().map_err(|_| {
+            EnvError::InvalidConfig(format!(
+                "MASS_MATRIX_SUBSTEPS must be a whole number of substeps, got {s:?}"
+            ))
+        })?,
+        Err(_) => ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS,
+    };
     let mode = args
         .get(1)
         .cloned()
@@ -54,6 +65,7 @@ fn main() -> Result<(), EnvError> {
         let mut env = make_env(&EnvConfig {
             obs_mode: "state".to_owned(),
             control_mode: Some(mode.clone()),
+            mass_matrix_substeps,
             ..EnvConfig::new(&id)
         })?;
         let start = Instant::now();

@@ -68,6 +68,16 @@ pub struct EnvConfig {
     /// exact, and a restore mid-episode into a fresh env drifts once objects touch (see
     /// docs/trajectory_format.md, "Restoring states").
     pub exact_restore: bool,
+    /// How many consecutive physics substeps of an env step share one joint-space mass matrix
+    /// of each articulation (default [`DEFAULT_MASS_MATRIX_SUBSTEPS`]; 1 rebuilds it every
+    /// substep, as upstream rapier does). The matrix is rebuilt at the first substep of every
+    /// env step and then every `mass_matrix_substeps` substeps, so a run is deterministic and a
+    /// state restored between env steps continues bit for bit. Reusing it saves about a sixth
+    /// of the CPU time of a rigid env step (issue #21); the joints move by milliradians in the
+    /// substeps between rebuilds (ms2-physics/README.md, "Round 5", has the measured effects). Only with
+    /// the `rapier-mass-matrix-reuse` feature (ms2's vendored rapier3d); without it every
+    /// substep rebuilds the matrix whatever this says. At least 1.
+    pub mass_matrix_substeps: u32,
     /// ManiSkill2's `model_ids` of the object-variation tasks (`PickSingleYCB-v0`,
     /// `PickSingleEGAD-v0`, `PickClutterYCB-v0`): the model ids episodes draw from; `None` (or
     /// empty) = every model of the task's info json. An id not in the json is an error naming
@@ -95,6 +105,7 @@ impl Default for EnvConfig {
             render_camera_updates: None,
             bg_name: None,
             exact_restore: false,
+            mass_matrix_substeps: DEFAULT_MASS_MATRIX_SUBSTEPS,
             model_ids: None,
         }
     }
@@ -147,6 +158,12 @@ impl EnvConfig {
         if let Some(hz) = self.mpm_freq {
             check_range("mpm_freq", hz, MPM_FREQ_RANGE, "Hz")?;
         }
+        if !(1..=MAX_SUBSTEPS).contains(&self.mass_matrix_substeps) {
+            return Err(EnvError::InvalidConfig(format!(
+                "mass_matrix_substeps must be in 1..={MAX_SUBSTEPS} physics substeps, got {}",
+                self.mass_matrix_substeps
+            )));
+        }
         self.substeps().map(|_| ())
     }
 
@@ -188,6 +205,12 @@ pub const MPM_FREQ_RANGE: (f64, f64) = (10.0, 20_000.0);
 /// Most physics substeps per env step (`sim_freq / control_freq`; 25 by default): bounds the
 /// time one `step` takes (well under a second for the rigid tasks).
 pub const MAX_SUBSTEPS: u32 = 1000;
+/// Default [`EnvConfig::mass_matrix_substeps`]: an articulation's mass matrix is rebuilt every
+/// 3rd physics substep (every 6 ms at 500 Hz), at substeps 0, 3, …, 24 of a 20 Hz env step.
+/// Chosen from issue #21's measurements (ms2-physics/README.md, "Round 5"): the most reuse that
+/// left the motion-planning solutions' success on AssemblingKits-v0 (the task most sensitive
+/// to it) where it was; 5 cost it 3 % of seeds.
+pub const DEFAULT_MASS_MATRIX_SUBSTEPS: u32 = 3;
 /// Most MPM substeps per env step (`mpm_freq / control_freq`; 100 at the default, ManiSkill2's
 /// 2 kHz): bounds the time one soft-body `step` takes (a few seconds at most).
 pub const MAX_MPM_SUBSTEPS: u32 = 2000;
@@ -417,6 +440,19 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("mpm_freq"));
+        for bad in [0, MAX_SUBSTEPS + 1] {
+            let msg = EnvConfig {
+                mass_matrix_substeps: bad,
+                ..EnvConfig::default()
+            }
+            .check_bounds()
+            .unwrap_err()
+            .to_string();
+            assert!(
+                msg.contains("mass_matrix_substeps") && msg.contains(&format!("got {bad}")),
+                "{msg}"
+            );
+        }
         assert!(EnvConfig::default().check_bounds().is_ok());
     }
 

@@ -70,7 +70,9 @@ mod task_env;
 mod vec_env;
 mod vec_pool;
 
-pub use config::{EnvConfig, ObsMode, RewardMode, MAX_EPISODE_STEPS};
+pub use config::{
+    EnvConfig, ObsMode, RewardMode, DEFAULT_MASS_MATRIX_SUBSTEPS, MAX_EPISODE_STEPS, MAX_SUBSTEPS,
+};
 pub use env::{make_env, Env, StepOutput};
 pub use error::EnvError;
 pub use info::{info_get, Evaluation, Info, InfoValue};

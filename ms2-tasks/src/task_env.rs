@@ -55,6 +55,8 @@ pub(crate) struct TaskEnv {
     enable_shadow: bool,
     /// [`crate::EnvConfig::exact_restore`].
     exact_restore: bool,
+    /// [`crate::EnvConfig::mass_matrix_substeps`].
+    mass_matrix_substeps: u32,
     /// Cameras and render scene, built on the first render (state-only envs never render).
     #[cfg(feature = "render")]
     sensors: Mutex<Option<Sensors>>,
@@ -174,6 +176,7 @@ impl TaskEnv {
             #[cfg(feature = "render")]
             enable_shadow: cfg.enable_shadow,
             exact_restore: cfg.exact_restore,
+            mass_matrix_substeps: cfg.mass_matrix_substeps.max(1),
             #[cfg(feature = "render")]
             sensors: Mutex::new(None),
         })
@@ -355,9 +358,14 @@ impl EnvBackend for TaskEnv {
         }
         agent.set_action(world, action)?;
         let mut soft = self.task.soft_mut();
-        for _ in 0..self.substeps {
+        let period = self.mass_matrix_substeps;
+        for substep in 0..self.substeps {
             agent.before_substep(world);
-            world.step();
+            if substep % period == 0 {
+                world.step();
+            } else {
+                world.step_reusing_mass_matrices(f32::INFINITY);
+            }
             if let Some(soft) = soft.as_mut() {
                 soft.after_physics_step(world)?;
             }

@@ -480,7 +480,14 @@ def replay(
         out_mode = target_control_mode or next(iter(source_modes))
         native_kwargs = {
             key: env_kwargs[key]
-            for key in ("reward_mode", "sim_freq", "control_freq", "mpm_freq", "exact_restore")
+            for key in (
+                "reward_mode",
+                "sim_freq",
+                "control_freq",
+                "mpm_freq",
+                "exact_restore",
+                "mass_matrix_substeps",
+            )
             if key in env_kwargs
         }
         if obs_mode is None:

@@ -38,6 +38,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from .envs import DEFAULT_MASS_MATRIX_SUBSTEPS
 from .visualization import put_info_on_image
 
 #: Render modes whose frames ``RecordEpisode`` can save as video.
@@ -105,6 +106,12 @@ def _env_info(env: gym.Env) -> dict[str, Any]:
             "control_freq": unwrapped.control_freq,
             **({"mpm_freq": unwrapped.mpm_freq} if unwrapped.mpm_freq is not None else {}),
             **({"exact_restore": True} if getattr(unwrapped, "exact_restore", False) else {}),
+            **(
+                {"mass_matrix_substeps": unwrapped.mass_matrix_substeps}
+                if getattr(unwrapped, "mass_matrix_substeps", DEFAULT_MASS_MATRIX_SUBSTEPS)
+                != DEFAULT_MASS_MATRIX_SUBSTEPS
+                else {}
+            ),
         },
     }
 

@@ -43,6 +43,14 @@ pub trait RigidWorld: Send {
     fn timestep(&self) -> f32;
     /// Advances the world by one time step.
     fn step(&mut self);
+    /// Advances the world by one time step that may reuse the articulations' dynamics (their
+    /// joint-space mass matrices) from an earlier step, unless a joint moved more than
+    /// `max_displacement` (rad or m) since they were built; for the inner substeps of a
+    /// control step. The next [`RigidWorld::step`] rebuilds them. The default is `step`.
+    fn step_reusing_mass_matrices(&mut self, max_displacement: f32) {
+        let _ = max_displacement;
+        self.step()
+    }
     /// Length of [`RigidWorld::get_state`].
     fn state_len(&self) -> usize;
     /// The flat simulation state (poses and velocities of every actor and articulation, drive

@@ -35,6 +35,10 @@ impl RigidWorld for World {
         World::step(self)
     }
 
+    fn step_reusing_mass_matrices(&mut self, max_displacement: f32) {
+        World::step_reusing_mass_matrices(self, max_displacement)
+    }
+
     fn state_len(&self) -> usize {
         World::state_len(self)
     }

@@ -141,6 +141,23 @@ pub struct Multibody {
     coriolis_v: Vec<OMatrix<Real, Dim, Dyn>>,
     coriolis_w: Vec<OMatrix<Real, AngDim, Dyn>>,
     i_coriolis_dt: Jacobian<Real>,
+    /// Whether (and within which joint displacement) the next `update_mass_matrix` may keep
+    /// the matrices it built last time (see [`Multibody::set_reuse_mass_matrix`]).
+    reuse_mass_matrix: Option<Real>,
+    /// What the current mass matrices were built for: the time step, the dofs and the links'
+    /// kinematic flags. `None` when they were never built or the multibody changed since.
+    mass_matrix_built_for: Option<MassMatrixKey>,
+}
+
+/// What a multibody's mass matrices depend on besides its configuration and velocities.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde-serialize", derive(Serialize, Deserialize))]
+struct MassMatrixKey {
+    dt: Real,
+    ndofs: usize,
+    kinematic: Vec<bool>,
+    /// Every link's joint coordinates when the matrices were built, link after link.
+    coords: Vec<Real>,
 }
 impl Default for Multibody {
     fn default() -> Self {
@@ -174,6 +191,8 @@ impl Multibody {
             coriolis_v: Vec::new(),
             coriolis_w: Vec::new(),
             i_coriolis_dt: Jacobian::zeros(0),
+            reuse_mass_matrix: None,
+            mass_matrix_built_for: None,
             root_is_dynamic: false,
             self_contacts_enabled,
             couplings: Vec::new(),
@@ -432,6 +451,7 @@ impl Multibody {
     /// Mutable vector of damping applied to this multibody.
     #[inline]
     pub fn damping_mut(&mut self) -> &mut DVector {
+        self.mass_matrix_built_for = None; // On the mass matrix's diagonal: rebuild it.
         &mut self.damping
     }
 
@@ -446,6 +466,7 @@ impl Multibody {
     /// multibody.
     #[inline]
     pub fn armature_mut(&mut self) -> &mut DVector {
+        self.mass_matrix_built_for = None; // On the mass matrix's diagonal: rebuild it.
         &mut self.armature
     }
 
@@ -861,10 +882,80 @@ impl Multibody {
         }
     }
 
+    /// With `Some(max_displacement)`, lets the following steps keep this multibody's mass
+    /// matrices (and their LU factorisations, with the semi-implicit Coriolis and gyroscopic
+    /// terms) from the last step that built them, instead of rebuilding them from the current
+    /// configuration and velocities, while every joint coordinate stays within
+    /// `max_displacement` (rad for angular, m for linear coordinates) of its value then. They
+    /// are also rebuilt when the time step, the number of dofs or a link's kinematic flag
+    /// changed since. `None` (the default): every step rebuilds them, as upstream.
+    ///
+    /// This trades exactness for time: the mass matrix of a configuration a few substeps old
+    /// differs from the current one by terms of the order of the joint displacement since then
+    /// (and the velocity terms by the change of the velocities). A caller that turns it on for
+    /// some steps and off for others (for example: rebuild on the first substep of each control
+    /// step, reuse on the others) keeps the simulation deterministic, and a state restored
+    /// before a rebuilding step continues bit for bit.
+    pub fn set_reuse_mass_matrix(&mut self, max_displacement: Option<Real>) {
+        self.reuse_mass_matrix = max_displacement;
+    }
+
+    /// The joint displacement within which [`Multibody::set_reuse_mass_matrix`] lets steps
+    /// keep the mass matrices (`None`: every step rebuilds them).
+    pub fn reuse_mass_matrix(&self) -> Option<Real> {
+        self.reuse_mass_matrix
+    }
+
+    /// Records what the mass matrices are being built for (reusing the key's buffers).
+    fn record_mass_matrix_key(&mut self, dt: Real) {
+        let mut key = self.mass_matrix_built_for.take().unwrap_or_default();
+        key.dt = dt;
+        key.ndofs = self.ndofs;
+        key.kinematic.clear();
+        key.kinematic
+            .extend(self.links.iter().map(|l| l.joint.kinematic));
+        key.coords.clear();
+        for l in self.links.iter() {
+            key.coords.extend_from_slice(l.joint.coords.as_slice());
+        }
+        self.mass_matrix_built_for = Some(key);
+    }
+
+    /// Whether the matrices built for `key` may serve a step of `dt` now, joints displaced by
+    /// at most `max_displacement` (rad or m) from their coordinates then.
+    fn mass_matrix_still_valid(
+        &self,
+        key: &MassMatrixKey,
+        dt: Real,
+        max_displacement: Real,
+    ) -> bool {
+        key.dt == dt
+            && key.ndofs == self.ndofs
+            && self
+                .links
+                .iter()
+                .map(|l| l.joint.kinematic)
+                .eq(key.kinematic.iter().copied())
+            && self
+                .links
+                .iter()
+                .flat_map(|l| l.joint.coords.as_slice().iter().copied())
+                .zip(&key.coords)
+                .all(|(now, then)| (now - then).abs() <= max_displacement)
+    }
+
     pub(crate) fn update_mass_matrix(&mut self, dt: Real, bodies: &RigidBodySet) {
         if self.ndofs == 0 {
             return; // Nothing to do.
         }
+        if let (Some(max_displacement), Some(key)) =
+            (self.reuse_mass_matrix, &self.mass_matrix_built_for)
+        {
+            if self.mass_matrix_still_valid(key, dt, max_displacement) {
+                return;
+            }
+        }
+        self.record_mass_matrix_key(dt);
 
         if self.augmented_mass.ncols() != self.ndofs {
             // TODO: do a resize instead of a full reallocation.
@@ -1213,7 +1304,9 @@ impl Multibody {
         // so `ndofs` is final, then assemble `M`. `dt = 0` drops the `dt·damping` and
         // `dt²·stiffness` diagonal terms, leaving exactly `M + armature`.
         self.forward_kinematics(bodies, false);
+        self.mass_matrix_built_for = None; // Always built here, whatever the reuse flag says.
         self.update_mass_matrix(0.0, bodies);
+        self.mass_matrix_built_for = None; // Built for `dt = 0`: never reused by a step.
 
         let n = self.ndofs;
         let mut out = DVector::zeros(n);
