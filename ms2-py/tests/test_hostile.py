@@ -505,9 +505,8 @@ def test_mass_matrix_substeps_is_checked_recorded_when_not_default_and_changes_t
     none = ms2.Ms2Env("PickCube-v0", mass_matrix_substeps=None)
     assert none.mass_matrix_substeps == DEFAULT_MASS_MATRIX_SUBSTEPS
     for bad in (0, -1, 1001, 2**40):
-        with pytest.raises(
-            ValueError, match=rf"mass_matrix_substeps must be in 1\.\.=1000 physics substeps, got {bad}$"
-        ):
+        expected = rf"mass_matrix_substeps must be in 1\.\.=1000 physics substeps, got {bad}$"
+        with pytest.raises(ValueError, match=expected):
             ms2.Ms2Env("PickCube-v0", mass_matrix_substeps=bad)
     default = _native.recorded_env_kwargs("PickCube-v0", {"obs_mode": "state"})
     assert "mass_matrix_substeps" not in default
