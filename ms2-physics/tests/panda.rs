@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 /// 25 keep the Panda's mass matrix for up to two substeps (ms2-tasks' default
 /// `mass_matrix_substeps`, 3), as ms2-tasks steps its envs.
 fn substep(world: &mut ms2_physics::World, k: usize, reuse: bool) {
-    if reuse && k % 25 % 3 != 0 {
+    if reuse && !(k % 25).is_multiple_of(3) {
         world.step_reusing_mass_matrices(f32::INFINITY);
     } else {
         world.step();
