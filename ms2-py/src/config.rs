@@ -157,14 +157,16 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
             "mass_matrix_substeps" => {
                 let n: i128 = extract_int(&key, &value, "an int (physics substeps)")?;
                 let max = ms2_tasks::MAX_SUBSTEPS;
-                cfg.mass_matrix_substeps = u32::try_from(n)
-                    .ok()
-                    .filter(|n| (1..=max).contains(n))
-                    .ok_or_else(|| {
-                        PyValueError::new_err(format!(
-                            "mass_matrix_substeps must be in 1..={max} physics substeps, got {n}"
-                        ))
-                    })?;
+                cfg.mass_matrix_substeps = Some(
+                    u32::try_from(n)
+                        .ok()
+                        .filter(|n| (1..=max).contains(n))
+                        .ok_or_else(|| {
+                            PyValueError::new_err(format!(
+                                "mass_matrix_substeps must be in 1..={max} physics substeps, got {n}"
+                            ))
+                        })?,
+                );
             }
             "bg_name" => cfg.bg_name = Some(extract_kwarg(&key, &value, "a str")?),
             "model_ids" => cfg.model_ids = Some(extract_model_ids(&value)?),

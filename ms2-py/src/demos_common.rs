@@ -125,7 +125,7 @@ pub fn episode_from_py(env_id: &str, dict: &Bound<'_, PyDict>) -> PyResult<DemoE
 /// file's `env_info` records them, resolved by making the env: `{"obs_mode", "control_mode",
 /// "reward_mode", "sim_freq", "control_freq", "max_episode_steps"}` plus `"mpm_freq"` (Hz) for
 /// soft-body envs, `"exact_restore": True` when set and `"mass_matrix_substeps"` when not the
-/// default. `ValueError` for an unknown id or bad `env_kwargs`.
+/// task's default. `ValueError` for an unknown id or bad `env_kwargs`.
 #[pyfunction]
 #[pyo3(signature = (env_id, env_kwargs=None))]
 pub fn recorded_env_kwargs<'py>(
@@ -149,7 +149,12 @@ pub fn recorded_env_kwargs<'py>(
     }
     // ms2's own keyword too: recorded only when not the default, so that a demo made with
     // another value replays with it.
-    if resolved.mass_matrix_substeps == ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS {
+    // A soft-body env resolves an `mpm_freq`; the rigid ones do not.
+    let task_default = ms2_tasks::default_mass_matrix_substeps(resolved.mpm_freq.is_some());
+    if resolved
+        .mass_matrix_substeps
+        .is_none_or(|n| n == task_default)
+    {
         dict.del_item("mass_matrix_substeps")?;
     }
     Ok(dict)

@@ -497,11 +497,12 @@ def test_mass_matrix_substeps_is_checked_recorded_when_not_default_and_changes_t
 
     env = ms2.Ms2Env("PickCube-v0", obs_mode="state")
     assert env.mass_matrix_substeps == DEFAULT_MASS_MATRIX_SUBSTEPS
+    assert ms2.Ms2Env("Fill-v0", obs_mode="state").mass_matrix_substeps == 1  # soft: exact
     assert env._native.config()["mass_matrix_substeps"] == DEFAULT_MASS_MATRIX_SUBSTEPS
     for bad in ("3", 2.0, True):
         with pytest.raises(TypeError, match="mass_matrix_substeps must be an int"):
             ms2.Ms2Env("PickCube-v0", mass_matrix_substeps=bad)
-    # None means the default, as for every keyword of the native env.
+    # None means the task's default, as for every keyword of the native env.
     none = ms2.Ms2Env("PickCube-v0", mass_matrix_substeps=None)
     assert none.mass_matrix_substeps == DEFAULT_MASS_MATRIX_SUBSTEPS
     for bad in (0, -1, 1001, 2**40):
@@ -514,6 +515,8 @@ def test_mass_matrix_substeps_is_checked_recorded_when_not_default_and_changes_t
         "PickCube-v0", {"obs_mode": "state", "mass_matrix_substeps": 1}
     )
     assert one["mass_matrix_substeps"] == 1
+    fill = _native.recorded_env_kwargs("Fill-v0", {"obs_mode": "state", "mass_matrix_substeps": 1})
+    assert "mass_matrix_substeps" not in fill  # the soft tasks' default
 
     def run(n):
         e = ms2.Ms2Env("PickCube-v0", obs_mode="state", mass_matrix_substeps=n)

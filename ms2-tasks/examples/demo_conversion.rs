@@ -16,8 +16,8 @@
 //! ```
 //! `--source-mode MODE` records the source episodes in MODE instead of `pd_joint_pos`.
 //! `--mpm-freq HZ` sets the soft-body envs' MPM substep frequency (default: the env's).
-//! `--mass-matrix-substeps N` sets `EnvConfig::mass_matrix_substeps` (default
-//! `ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS`) for the sources and the conversions.
+//! `--mass-matrix-substeps N` sets `EnvConfig::mass_matrix_substeps` (default: the
+//! task's) for the sources and the conversions.
 //! `--track-hand-only` converts by the source's hand path alone (`ReplayOptions::track_hand_only`,
 //! ManiSkill2's way), without the in-hand correction.
 //! Episodes run in parallel on rayon's pool (`RAYON_NUM_THREADS`); times are CPU-seconds per
@@ -73,10 +73,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => "pd_joint_pos".to_owned(),
     };
     let mpm_freq: Option<f64> = flag("--mpm-freq").map(|s| s.parse()).transpose()?;
-    let mass_matrix_substeps: u32 = flag("--mass-matrix-substeps")
+    let mass_matrix_substeps: Option<u32> = flag("--mass-matrix-substeps")
         .map(|s| s.parse())
-        .transpose()?
-        .unwrap_or(ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS);
+        .transpose()?;
     let cfg = EnvConfig {
         obs_mode: "state".to_owned(),
         control_mode: Some(source_mode),

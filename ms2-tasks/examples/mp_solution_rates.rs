@@ -7,7 +7,7 @@
 //! For each env (default: every env with a solution) runs seeds `0..seeds` on one thread and
 //! prints the success rate, the failed seeds with the reason, wall seconds per episode and the
 //! planning time per query. `MASS_MATRIX_SUBSTEPS` sets
-//! [`EnvConfig::mass_matrix_substeps`] (default [`ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS`]).
+//! [`EnvConfig::mass_matrix_substeps`] (default: the task's).
 
 use ms2_tasks::demos::solutions::{solution_env_ids, DemoSolver};
 use ms2_tasks::EnvConfig;
@@ -25,8 +25,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for env_id in env_ids {
         let mut solver = DemoSolver::new(&EnvConfig {
             mass_matrix_substeps: match std::env::var("MASS_MATRIX_SUBSTEPS") {
-                Ok(s) => s.parse()?,
-                Err(_) => ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS,
+                Ok(s) => Some(s.parse()?),
+                Err(_) => None,
             },
             ..EnvConfig::new(&env_id)
         })?;

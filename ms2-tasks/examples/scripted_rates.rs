@@ -5,8 +5,8 @@
 //! ```
 //! Prints one line per env: successes, rate, mean steps to success and wall time. `FIRST_SEED`
 //! continues a sweep where an earlier run stopped (the slow soft-body tasks run in parts).
-//! `MASS_MATRIX_SUBSTEPS` sets [`EnvConfig::mass_matrix_substeps`] (default
-//! [`ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS`]; 1 rebuilds the robot's mass matrix every
+//! `MASS_MATRIX_SUBSTEPS` sets [`EnvConfig::mass_matrix_substeps`] (default: the
+//! task's; 1 rebuilds the robot's mass matrix every
 //! substep).
 
 use std::time::Instant;
@@ -37,12 +37,12 @@ fn main() -> Result<(), EnvError> {
         Err(_) => 0,
     };
     let mass_matrix_substeps = match std::env::var("MASS_MATRIX_SUBSTEPS") {
-        Ok(s) => s.parse().map_err(|_| {
+        Ok(s) => Some(s.parse().map_err(|_| {
             EnvError::InvalidConfig(format!(
                 "MASS_MATRIX_SUBSTEPS must be a whole number of substeps, got {s:?}"
             ))
-        })?,
-        Err(_) => ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS,
+        })?),
+        Err(_) => None,
     };
     let mode = args
         .get(1)

@@ -7,7 +7,7 @@
 //! perf stat -e task-clock target/release/examples/step_cost StackCube-v0 pd_joint_delta_pos 4000
 //! ```
 //! Prints the wall time per env step (µs) and env steps/s. `MASS_MATRIX_SUBSTEPS` sets
-//! `EnvConfig::mass_matrix_substeps` (default `ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS`).
+//! `EnvConfig::mass_matrix_substeps` (default: the task's).
 
 use std::time::Instant;
 
@@ -21,12 +21,12 @@ fn main() -> Result<(), EnvError> {
     let mode = args.get(1).map_or("pd_ee_delta_pose", String::as_str);
     let steps: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(4000);
     let mass_matrix_substeps = match std::env::var("MASS_MATRIX_SUBSTEPS") {
-        Ok(s) => s.parse().map_err(|_| {
+        Ok(s) => Some(s.parse().map_err(|_| {
             EnvError::InvalidConfig(format!(
                 "MASS_MATRIX_SUBSTEPS must be a whole number of substeps, got {s:?}"
             ))
-        })?,
-        Err(_) => ms2_tasks::DEFAULT_MASS_MATRIX_SUBSTEPS,
+        })?),
+        Err(_) => None,
     };
     let mut env = make_env(&EnvConfig {
         obs_mode: "state".to_owned(),

@@ -69,15 +69,17 @@ pub struct EnvConfig {
     /// docs/trajectory_format.md, "Restoring states").
     pub exact_restore: bool,
     /// How many consecutive physics substeps of an env step share one joint-space mass matrix
-    /// of each articulation (default [`DEFAULT_MASS_MATRIX_SUBSTEPS`]; 1 rebuilds it every
-    /// substep, as upstream rapier does). The matrix is rebuilt at the first substep of every
-    /// env step and then every `mass_matrix_substeps` substeps, so a run is deterministic and a
-    /// state restored between env steps continues bit for bit. Reusing it saves about a sixth
-    /// of the CPU time of a rigid env step (issue #21); the joints move by milliradians in the
-    /// substeps between rebuilds (ms2-physics/README.md, "Round 5", has the measured effects). Only with
-    /// the `rapier-mass-matrix-reuse` feature (ms2's vendored rapier3d); without it every
-    /// substep rebuilds the matrix whatever this says. At least 1.
-    pub mass_matrix_substeps: u32,
+    /// of each articulation; `None` = the task's default ([`default_mass_matrix_substeps`]:
+    /// [`DEFAULT_MASS_MATRIX_SUBSTEPS`] for the rigid tasks, 1 for the soft-body tasks, whose
+    /// step is the MPM solver's and whose measured success rates predate the reuse). 1 rebuilds
+    /// it every substep, as upstream rapier does. The matrix is rebuilt at the first substep of
+    /// every env step and then every `mass_matrix_substeps` substeps, so a run is deterministic
+    /// and a state restored between env steps continues bit for bit. Reusing it saves about a
+    /// sixth of the CPU time of a rigid env step (issue #21); the joints move by milliradians in
+    /// the substeps between rebuilds (ms2-physics/README.md, "Round 5", has the measured
+    /// effects). Only with the `rapier-mass-matrix-reuse` feature (ms2's vendored rapier3d);
+    /// without it every substep rebuilds the matrix whatever this says. At least 1.
+    pub mass_matrix_substeps: Option<u32>,
     /// ManiSkill2's `model_ids` of the object-variation tasks (`PickSingleYCB-v0`,
     /// `PickSingleEGAD-v0`, `PickClutterYCB-v0`): the model ids episodes draw from; `None` (or
     /// empty) = every model of the task's info json. An id not in the json is an error naming
@@ -105,7 +107,7 @@ impl Default for EnvConfig {
             render_camera_updates: None,
             bg_name: None,
             exact_restore: false,
-            mass_matrix_substeps: DEFAULT_MASS_MATRIX_SUBSTEPS,
+            mass_matrix_substeps: None,
             model_ids: None,
         }
     }
@@ -158,11 +160,12 @@ impl EnvConfig {
         if let Some(hz) = self.mpm_freq {
             check_range("mpm_freq", hz, MPM_FREQ_RANGE, "Hz")?;
         }
-        if !(1..=MAX_SUBSTEPS).contains(&self.mass_matrix_substeps) {
-            return Err(EnvError::InvalidConfig(format!(
-                "mass_matrix_substeps must be in 1..={MAX_SUBSTEPS} physics substeps, got {}",
-                self.mass_matrix_substeps
-            )));
+        if let Some(n) = self.mass_matrix_substeps {
+            if !(1..=MAX_SUBSTEPS).contains(&n) {
+                return Err(EnvError::InvalidConfig(format!(
+                    "mass_matrix_substeps must be in 1..={MAX_SUBSTEPS} physics substeps, got {n}"
+                )));
+            }
         }
         self.substeps().map(|_| ())
     }
@@ -211,6 +214,16 @@ pub const MAX_SUBSTEPS: u32 = 1000;
 /// left the motion-planning solutions' success on AssemblingKits-v0 (the task most sensitive
 /// to it) where it was; 5 cost it 3 % of seeds.
 pub const DEFAULT_MASS_MATRIX_SUBSTEPS: u32 = 3;
+
+/// The task's default [`EnvConfig::mass_matrix_substeps`]: [`DEFAULT_MASS_MATRIX_SUBSTEPS`]
+/// for a rigid task, 1 (rebuilt every substep) for a task with soft bodies.
+pub fn default_mass_matrix_substeps(soft_bodies: bool) -> u32 {
+    if soft_bodies {
+        1
+    } else {
+        DEFAULT_MASS_MATRIX_SUBSTEPS
+    }
+}
 /// Most MPM substeps per env step (`mpm_freq / control_freq`; 100 at the default, ManiSkill2's
 /// 2 kHz): bounds the time one soft-body `step` takes (a few seconds at most).
 pub const MAX_MPM_SUBSTEPS: u32 = 2000;
@@ -442,7 +455,7 @@ mod tests {
             .contains("mpm_freq"));
         for bad in [0, MAX_SUBSTEPS + 1] {
             let msg = EnvConfig {
-                mass_matrix_substeps: bad,
+                mass_matrix_substeps: Some(bad),
                 ..EnvConfig::default()
             }
             .check_bounds()

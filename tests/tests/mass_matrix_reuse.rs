@@ -11,7 +11,7 @@ fn env(mass_matrix_substeps: u32) -> Env {
     make_env(&EnvConfig {
         obs_mode: "state".to_owned(),
         control_mode: Some("pd_joint_delta_pos".to_owned()),
-        mass_matrix_substeps,
+        mass_matrix_substeps: Some(mass_matrix_substeps),
         ..EnvConfig::new("PickCube-v0")
     })
     .unwrap()
@@ -42,9 +42,17 @@ fn scripted_states(mass_matrix_substeps: u32, seed: u64, steps: usize) -> (Vec<V
 
 #[test]
 fn reuse_is_on_by_default_deterministic_and_close_to_rebuilding_every_substep() {
+    let resolved = |id: &str| {
+        make_env(&EnvConfig::new(id))
+            .unwrap()
+            .config()
+            .mass_matrix_substeps
+    };
+    assert_eq!(resolved("PickCube-v0"), Some(DEFAULT_MASS_MATRIX_SUBSTEPS));
     assert_eq!(
-        EnvConfig::default().mass_matrix_substeps,
-        DEFAULT_MASS_MATRIX_SUBSTEPS
+        resolved("Fill-v0"),
+        Some(1),
+        "soft-body tasks rebuild every substep"
     );
     const { assert!(DEFAULT_MASS_MATRIX_SUBSTEPS > 1, "the default reuses") };
     let (reused, _) = scripted_states(DEFAULT_MASS_MATRIX_SUBSTEPS, 3, 40);

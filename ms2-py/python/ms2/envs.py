@@ -23,9 +23,16 @@ from .visualization import camera_images_to_tiles, tile_images
 #: (``gymnasium.make`` applies one with the registered or the given ``max_episode_steps``).
 UNLIMITED_EPISODE_STEPS = 2**31 - 1
 
-#: Physics substeps that share one articulation mass matrix unless ``mass_matrix_substeps``
-#: says otherwise (the native ``DEFAULT_MASS_MATRIX_SUBSTEPS``; a test checks they agree).
+#: Physics substeps that share one articulation mass matrix in the rigid tasks unless
+#: ``mass_matrix_substeps`` says otherwise (the native ``DEFAULT_MASS_MATRIX_SUBSTEPS``; a test
+#: checks they agree). The soft-body tasks rebuild it every substep.
 DEFAULT_MASS_MATRIX_SUBSTEPS = 3
+
+
+def default_mass_matrix_substeps(soft_bodies: bool) -> int:
+    """A task's default ``mass_matrix_substeps``: 1 with soft bodies, else
+    ``DEFAULT_MASS_MATRIX_SUBSTEPS``."""
+    return 1 if soft_bodies else DEFAULT_MASS_MATRIX_SUBSTEPS
 
 
 def adopt_config(env: Any, config: dict[str, Any]) -> None:
@@ -152,10 +159,11 @@ class Ms2Env(gym.Env):
             20 % of the state step rate. Off by default (then a restore into the same env,
             or of an episode's first state, is still exact; see docs/trajectory_format.md).
         mass_matrix_substeps: how many consecutive 2 ms physics substeps share one joint-space
-            mass matrix of each robot or articulated object (default 3: rebuilt at substeps 0,
-            3, ..., 24 of each env step, saving about a sixth of the CPU time of a rigid env
-            step; 1 rebuilds it every substep, as upstream rapier). ms2's own keyword; an int
-            in ``[1, 1000]``, else ``TypeError`` / ``ValueError``.
+            mass matrix of each robot or articulated object; ``None`` = the task's default (3
+            for the rigid tasks: rebuilt at substeps 0, 3, ..., 24 of each env step, saving
+            about a sixth of the CPU time of a rigid env step; 1 for the soft-body tasks). 1
+            rebuilds it every substep, as upstream rapier. ms2's own keyword; an int in
+            ``[1, 1000]``, else ``TypeError`` / ``ValueError``.
         model_ids: the object models episodes draw from in the object-variation tasks
             (``PickSingleYCB-v0``, ``PickSingleEGAD-v0``; ``PickClutterYCB-v0``'s procedural
             clutters), ManiSkill2's keyword: one id or a list; ``None`` = every model of the
@@ -184,7 +192,7 @@ class Ms2Env(gym.Env):
         render_camera_cfgs: dict[str, Any] | None = None,
         bg_name: str | None = None,
         exact_restore: bool = False,
-        mass_matrix_substeps: int = DEFAULT_MASS_MATRIX_SUBSTEPS,
+        mass_matrix_substeps: int | None = None,
         model_ids: str | list[str] | None = None,
     ) -> None:
         _assets.register_installed_packages()

@@ -38,7 +38,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from .envs import DEFAULT_MASS_MATRIX_SUBSTEPS
+from .envs import default_mass_matrix_substeps
 from .visualization import put_info_on_image
 
 #: Render modes whose frames ``RecordEpisode`` can save as video.
@@ -108,8 +108,8 @@ def _env_info(env: gym.Env) -> dict[str, Any]:
             **({"exact_restore": True} if getattr(unwrapped, "exact_restore", False) else {}),
             **(
                 {"mass_matrix_substeps": unwrapped.mass_matrix_substeps}
-                if getattr(unwrapped, "mass_matrix_substeps", DEFAULT_MASS_MATRIX_SUBSTEPS)
-                != DEFAULT_MASS_MATRIX_SUBSTEPS
+                if getattr(unwrapped, "mass_matrix_substeps", None)
+                not in (None, default_mass_matrix_substeps(unwrapped.mpm_freq is not None))
                 else {}
             ),
         },
