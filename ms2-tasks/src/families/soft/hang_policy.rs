@@ -25,6 +25,7 @@ use glam::{Vec2, Vec3};
 use nalgebra::{Translation3, UnitQuaternion, Vector3};
 
 use super::hang::Hang;
+use super::hang_scene::RodPose;
 use crate::env::Env;
 use crate::error::EnvError;
 use crate::geometry::Pose3;
@@ -104,9 +105,10 @@ pub const OPEN_STEPS: u32 = 20;
 
 /// A waypoint: control step, TCP position (m, world), yaw added to the start (rad), finger
 /// target (m).
-type Waypoint = (u32, Vec3, f32, f64);
+pub type Waypoint = (u32, Vec3, f32, f64);
 
 /// The policy (see the [module docs](self)).
+#[derive(Clone)]
 pub struct HangPolicy {
     oracle: TcpOracle,
     start: Option<Pose3>,
@@ -117,12 +119,29 @@ pub struct HangPolicy {
 impl HangPolicy {
     /// The policy of `env` (an error when its control mode is not position-based).
     pub fn boxed(env: &Env) -> Result<Box<dyn ScriptedPolicy>, EnvError> {
-        Ok(Box::new(Self {
+        Ok(Box::new(Self::new(env)?))
+    }
+
+    /// The policy of `env` (an error when its control mode is not position-based).
+    pub fn new(env: &Env) -> Result<Self, EnvError> {
+        Ok(Self {
             oracle: tcp_oracle(env)?,
             start: None,
             waypoints: Vec::new(),
             planned: false,
-        }))
+        })
+    }
+
+    /// The plan so far: waypoints in control-step order (the re-grasp's are added at
+    /// [`PLAN_STEP`]).
+    pub fn waypoints(&self) -> &[Waypoint] {
+        &self.waypoints
+    }
+
+    /// Replaces the plan (for experiments that branch an episode, e.g. `hang_probe`);
+    /// `waypoints` must be in control-step order.
+    pub fn set_waypoints(&mut self, waypoints: Vec<Waypoint>) {
+        self.waypoints = waypoints;
     }
 
     /// The drop: from the TCP's start position `p0` (m), open the fingers and rise 3 cm
@@ -139,9 +158,8 @@ impl HangPolicy {
 
     /// The re-grasp and hang from the TCP at `p` (m) at control step `s0`, the grasp point
     /// at `grasp` (m), the rope running along horizontal unit vector `along` there (towards
-    /// its nearer end), for `hang`'s rod.
-    pub fn hang_plan(s0: u32, p: Vec3, grasp: Vec3, along: Vec2, hang: &Hang) -> Vec<Waypoint> {
-        let rod = hang.rod_pose();
+    /// its nearer end), for the rod at `rod`.
+    pub fn hang_plan(s0: u32, p: Vec3, grasp: Vec3, along: Vec2, rod: &RodPose) -> Vec<Waypoint> {
         let (c, n) = (rod.position, rod.normal());
         let pi = std::f32::consts::PI;
         // The hand's "along" (across the closing axis) is +x at yaw 0; a pinch is symmetric,
@@ -254,7 +272,7 @@ impl HangPolicy {
         };
         self.waypoints.retain(|w| w.0 < step);
         self.waypoints
-            .extend(Self::hang_plan(step, p, grasp, along, hang));
+            .extend(Self::hang_plan(step, p, grasp, along, &hang.rod_pose()));
     }
 }
 
@@ -273,7 +291,14 @@ impl ScriptedPolicy for HangPolicy {
     }
 
     fn act(&mut self, env: &Env) -> Vec<f32> {
-        let step = env.elapsed_steps();
+        self.act_at(env, env.elapsed_steps())
+    }
+}
+
+impl HangPolicy {
+    /// The action at control step `step` (the episode's step counter in [`ScriptedPolicy::act`];
+    /// an experiment that restores a saved state counts its own steps).
+    pub fn act_at(&mut self, env: &Env, step: u32) -> Vec<f32> {
         if step >= PLAN_STEP && !self.planned {
             self.plan_regrasp(env, step);
         }
