@@ -91,6 +91,28 @@ pub fn release_point(rod_z: f32) -> (f32, f32) {
     )
 }
 
+/// Distance (m) the hand moves away from the rod, along its normal, while the fingers open at
+/// the release on the rods of [`opens_away_from_rod`]: one finger's travel from the grip to
+/// open, so that the finger on the rod's side stays where it is (to within 4 mm: the hand's
+/// path is eased, the fingers' opening linear) and only the other one moves, away from the
+/// rope. Opened in place, the rod-side finger moves 3.3 cm towards the rod. Measured
+/// (`hang_probe`, 2026-11-29): on seeds 39 and 44 the rope fell off the rod, straight down,
+/// 15-25 control steps after the opening began, also with the hand kept still after it; no
+/// finger was within 2.5 cm of the rope after the grip let go, so how the opening throws it
+/// off is not known. Opening away from the rod saved seed 44 (success at step 285), not 39.
+pub const OPEN_SHIFT: f32 = (GRIPPER_OPEN - GRIP_FINGER_TARGET) as f32;
+/// Rod direction (rad, from +y towards +x: [`RodPose::from_unit`]'s angle, 45°-135°) beyond
+/// which the hand opens away from the rod ([`OPEN_SHIFT`]): the rods turned furthest towards
+/// the robot's right, where the two high rods of seeds 0-49 that lost the rope at the opening
+/// lie (39 and 44, 131.4° and 132.5°; seed 35, 133.1°, succeeds either way). A measured gate,
+/// not a derived one: only rods beyond it get the changed plan.
+pub const OPEN_AWAY_FROM_DIRECTION: f32 = 130.0 * std::f32::consts::PI / 180.0;
+
+/// Whether the hand opens away from the rod at the release ([`OPEN_SHIFT`]) for `rod`.
+pub fn opens_away_from_rod(rod: &RodPose) -> bool {
+    -rod.yaw > OPEN_AWAY_FROM_DIRECTION
+}
+
 /// Index of the grasped tracked particle ([`super::hang_scene::TRACKED_FRACTIONS`]): the one
 /// a quarter along the rope from its short end.
 const GRASP_TRACKED: usize = 1;
@@ -190,7 +212,14 @@ impl HangPolicy {
         let up = grasp.truncate().extend(near.z);
         let (far, release) = release_point(c.z);
         let over = at(far, release);
-        let high = over + Vec3::Z * 0.05;
+        // Where the opening ends: on the rods of `opens_away_from_rod` one finger's travel
+        // further from the rod, so that the rod-side finger stays put.
+        let opened = if opens_away_from_rod(rod) {
+            at(far + OPEN_SHIFT, release)
+        } else {
+            over
+        };
+        let high = opened + Vec3::Z * 0.05;
         // Lift straight up, then turn, then carry (the pinch of the rope's end let go when
         // the hand lifted, turned and moved at once): over the rod, where the long leg
         // catches, then beyond and down on the far side at once (the rope slides back over
@@ -205,7 +234,7 @@ impl HangPolicy {
             (s + 135, at(0.0, CROSS_HEIGHT), carry_yaw, hold),
             (s + 160, over, carry_yaw, hold),
             (s + 160 + SETTLE_STEPS, over, carry_yaw, hold),
-            (s + 160 + SETTLE_STEPS + OPEN_STEPS, over, carry_yaw, open),
+            (s + 160 + SETTLE_STEPS + OPEN_STEPS, opened, carry_yaw, open),
             (s + 175 + SETTLE_STEPS + OPEN_STEPS, high, carry_yaw, open),
             (u32::MAX, high, carry_yaw, open),
         ]);
