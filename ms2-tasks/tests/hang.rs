@@ -486,23 +486,26 @@ fn low_rods_get_their_own_release_point_within_the_arms_reach() {
 }
 
 #[test]
-fn the_hand_opens_away_from_the_rod_only_on_the_rods_turned_furthest_right() {
+fn the_hand_opens_away_from_the_rod_only_on_the_rods_turned_furthest_aside() {
     use ms2_tasks::families::soft::hang_policy::{
         opens_away_from_rod, HangPolicy, Waypoint, GRIP_FINGER_TARGET, OPEN_SHIFT, OPEN_STEPS,
     };
     use ms2_tasks::scripted::oracle::GRIPPER_OPEN;
-    // The rod's direction is 45° + 90° × u_angle from +y: only the rods beyond 130° (u_angle
-    // above 0.944; seeds 35, 39 and 44 of 0-49) open away from the rod.
+    // The rod's direction is 45° + 90° × u_angle from +y: only the rods more than 30° from
+    // straight ahead (below 60° or above 120°: u_angle below 1/6 or above 5/6) open away from
+    // the rod.
     let gated: Vec<bool> = (0..=100)
         .map(|k| opens_away_from_rod(&RodPose::from_unit(0.5, k as f32 / 100.0, 0.5)))
         .collect();
-    assert!(gated[..=94].iter().all(|g| !g), "{gated:?}");
-    assert!(gated[95..].iter().all(|g| *g), "{gated:?}");
+    assert!(gated[..=16].iter().all(|g| *g), "{gated:?}");
+    assert!(gated[17..=83].iter().all(|g| !g), "{gated:?}");
+    assert!(gated[84..].iter().all(|g| *g), "{gated:?}");
     for (u_angle, u_height, away) in [
-        (0.0, 0.2, false),
+        (0.0, 0.2, true),
+        (0.2, 0.9, false),
         (0.5, 0.2, false),
-        (0.94, 0.9, false),
-        (0.96, 0.9, true),
+        (0.8, 0.9, false),
+        (0.9, 0.9, true),
         (0.999, 0.2, true),
     ] {
         let rod = RodPose::from_unit(0.5, u_angle, u_height);

@@ -99,18 +99,21 @@ pub fn release_point(rod_z: f32) -> (f32, f32) {
 /// (`hang_probe`, 2026-11-29): on seeds 39 and 44 the rope fell off the rod, straight down,
 /// 15-25 control steps after the opening began, also with the hand kept still after it; no
 /// finger was within 2.5 cm of the rope after the grip let go, so how the opening throws it
-/// off is not known. Opening away from the rod saved seed 44 (success at step 285), not 39.
+/// off is not known (on seed 16 the rope tore over the rod). Opening away from the rod saved
+/// seeds 16, 43 and 44 (full episodes), not 39.
 pub const OPEN_SHIFT: f32 = (GRIPPER_OPEN - GRIP_FINGER_TARGET) as f32;
-/// Rod direction (rad, from +y towards +x: [`RodPose::from_unit`]'s angle, 45°-135°) beyond
-/// which the hand opens away from the rod ([`OPEN_SHIFT`]): the rods turned furthest towards
-/// the robot's right, where the two high rods of seeds 0-49 that lost the rope at the opening
-/// lie (39 and 44, 131.4° and 132.5°; seed 35, 133.1°, succeeds either way). A measured gate,
-/// not a derived one: only rods beyond it get the changed plan.
-pub const OPEN_AWAY_FROM_DIRECTION: f32 = 130.0 * std::f32::consts::PI / 180.0;
+/// Angle (rad) between the rod's direction ([`RodPose::from_unit`]'s angle from +y towards +x,
+/// 45°-135°) and straight ahead (+x, 90°) beyond which the hand opens away from the rod
+/// ([`OPEN_SHIFT`]): the rods turned furthest to either side (below 60° or above 120°; seeds
+/// 2, 7-9, 12, 16, 18, 20, 24, 31, 35, 36, 39, 43 and 44 of 0-49), where three of the four
+/// high rods of seeds 0-49 that lost the rope after the opening lie (16, 39, 44 at 57.8°,
+/// 131.4° and 132.5°; 43, at 52.2°, is a middle rod). A measured gate, not a derived one: only
+/// rods beyond it get the changed plan, and every seed it covers was run on it.
+pub const OPEN_AWAY_OFF_AHEAD: f32 = 30.0 * std::f32::consts::PI / 180.0;
 
 /// Whether the hand opens away from the rod at the release ([`OPEN_SHIFT`]) for `rod`.
 pub fn opens_away_from_rod(rod: &RodPose) -> bool {
-    -rod.yaw > OPEN_AWAY_FROM_DIRECTION
+    (-rod.yaw - std::f32::consts::FRAC_PI_2).abs() > OPEN_AWAY_OFF_AHEAD
 }
 
 /// Index of the grasped tracked particle ([`super::hang_scene::TRACKED_FRACTIONS`]): the one
