@@ -406,8 +406,8 @@ fn low_rods_get_their_own_release_point_within_the_arms_reach() {
     use ms2_control::{DlsIk, IkOptions, RobotConfig};
     use ms2_tasks::families::soft::hang::{ARM_START, BASE_X};
     use ms2_tasks::families::soft::hang_policy::{
-        release_point, FAR_OFFSET, HIGH_ROD_Z, LOW_ROD_FAR_OFFSET, LOW_ROD_RELEASE_HEIGHT,
-        LOW_ROD_Z, RELEASE_HEIGHT,
+        opens_away_from_rod, release_point, FAR_OFFSET, HIGH_ROD_Z, LOW_ROD_FAR_OFFSET,
+        LOW_ROD_RELEASE_HEIGHT, LOW_ROD_Z, OPEN_SHIFT, RELEASE_HEIGHT,
     };
     // The committed release on high rods; on low rods the one measured to leave the rope's
     // middle on the rod (the high rods' let the long leg reach the ground, seeds 7, 8, 10);
@@ -431,7 +431,8 @@ fn low_rods_get_their_own_release_point_within_the_arms_reach() {
     }
     // The Panda reaches every release point with the start's hand orientation, turned about
     // the vertical in quarter turns (the carry's yaw depends on the rope), for the farthest
-    // rods (0.23 m from the origin) in the extreme directions and heights.
+    // rods (0.23 m from the origin) in the extreme directions and heights; on the rods where
+    // the hand opens away from the rod, also where the opening ends.
     let robot = RobotConfig::panda(ms2_assets::PANDA_URDF).unwrap();
     let chain = robot.tcp_chain().unwrap();
     let mut seed: Vec<f64> = ARM_START.iter().map(|&q| f64::from(q)).collect();
@@ -453,8 +454,15 @@ fn low_rods_get_their_own_release_point_within_the_arms_reach() {
         for u_height in [0.0, 0.5, 0.999] {
             let rod = RodPose::from_unit(0.999, u_angle, u_height);
             let (far, up) = release_point(rod.position.z);
-            let p = rod.position + rod.normal() * far + Vec3::Z * up;
-            for quarter in [-1.0f64, 0.0, 1.0] {
+            let mut offsets = vec![far];
+            if opens_away_from_rod(&rod) {
+                offsets.push(far + OPEN_SHIFT);
+            }
+            for (far, quarter) in offsets
+                .into_iter()
+                .flat_map(|f| [-1.0f64, 0.0, 1.0].map(|q| (f, q)))
+            {
+                let p = rod.position + rod.normal() * far + Vec3::Z * up;
                 let turn = nalgebra::UnitQuaternion::from_axis_angle(
                     &Vector3::z_axis(),
                     quarter * std::f64::consts::FRAC_PI_2,
@@ -474,5 +482,60 @@ fn low_rods_get_their_own_release_point_within_the_arms_reach() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn the_hand_opens_away_from_the_rod_only_on_the_rods_turned_furthest_aside() {
+    use ms2_tasks::families::soft::hang_policy::{
+        opens_away_from_rod, HangPolicy, Waypoint, GRIP_FINGER_TARGET, OPEN_SHIFT, OPEN_STEPS,
+    };
+    use ms2_tasks::scripted::oracle::GRIPPER_OPEN;
+    // The rod's direction is 45° + 90° × u_angle from +y: only the rods more than 30° from
+    // straight ahead (below 60° or above 120°: u_angle below 1/6 or above 5/6) open away from
+    // the rod.
+    let gated: Vec<bool> = (0..=100)
+        .map(|k| opens_away_from_rod(&RodPose::from_unit(0.5, k as f32 / 100.0, 0.5)))
+        .collect();
+    assert!(gated[..=16].iter().all(|g| *g), "{gated:?}");
+    assert!(gated[17..=83].iter().all(|g| !g), "{gated:?}");
+    assert!(gated[84..].iter().all(|g| *g), "{gated:?}");
+    for (u_angle, u_height, away) in [
+        (0.0, 0.2, true),
+        (0.2, 0.9, false),
+        (0.5, 0.2, false),
+        (0.8, 0.9, false),
+        (0.9, 0.9, true),
+        (0.999, 0.2, true),
+    ] {
+        let rod = RodPose::from_unit(0.5, u_angle, u_height);
+        let (s0, tcp, grasp) = (20, Vec3::new(0.0, 0.0, 0.12), Vec3::new(-0.03, 0.0, 0.01));
+        let plan = HangPolicy::hang_plan(s0, tcp, grasp, glam::Vec2::X, &rod);
+        // The opening at the release: the last waypoint holding the rope, then the first one
+        // open after the grasp (44 steps after the plan starts).
+        let i = plan
+            .iter()
+            .position(|w| w.0 > s0 + 44 && w.3 == GRIPPER_OPEN)
+            .unwrap();
+        let (closed, opened) = (plan[i - 1], plan[i]);
+        assert_eq!(opened.0 - closed.0, OPEN_STEPS);
+        assert_eq!(closed.3, GRIP_FINGER_TARGET);
+        // The finger on the rod's side: the TCP less one finger's opening along the normal.
+        let n = rod.normal();
+        let rod_side_finger = |w: &Waypoint| w.1 - n * w.3 as f32;
+        let moved = rod_side_finger(&opened).distance(rod_side_finger(&closed));
+        if away {
+            assert!(moved < 1e-5, "the rod-side finger moved {moved} m");
+            let shift = opened.1 - closed.1;
+            assert!((shift.dot(n) - OPEN_SHIFT).abs() < 1e-5, "{shift:?}");
+            assert!(shift.z.abs() < 1e-6, "{shift:?}");
+        } else {
+            // The committed plan: the hand opens in place, the finger sweeps towards the rod.
+            assert_eq!(closed.1, opened.1, "u_angle {u_angle}");
+            assert!((moved - OPEN_SHIFT).abs() < 1e-5, "{moved}");
+        }
+        // Then the hand rises 5 cm from where the opening ended.
+        let rise = plan[i + 1].1 - opened.1;
+        assert!(rise.truncate().length() < 1e-6 && (rise.z - 0.05).abs() < 1e-6);
     }
 }

@@ -29,6 +29,7 @@ pub const GRIPPER_OPEN: f64 = 0.04;
 pub const GRIPPER_CLOSED: f64 = -0.01;
 
 /// IK plus controller conversion for the Panda.
+#[derive(Clone)]
 pub struct TcpOracle {
     chain: KinematicChain,
     ik: DlsIk,
