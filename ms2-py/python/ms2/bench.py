@@ -31,9 +31,13 @@ import numpy as np
 
 from .bench_peer import run_peer
 
-#: ManiSkill2 0.5.3 measured on the same 2-core machine, PickCube-v0, state obs, 500/20 Hz:
-#: single-env steps/s per control mode, and its peak RSS.
-MANISKILL2_SINGLE_STEPS_PER_S = {"pd_ee_delta_pose": 556.0, "pd_joint_delta_pos": 648.0}
+#: ManiSkill2 0.5.3 measured on the same kind of 2-core machine, PickCube-v0, state obs,
+#: 500/20 Hz: single-env steps/s per control mode (medians of 5 interleaved rounds,
+#: 2026-11-29, docs/benchmarks.md; the host of that day, about twice as fast as 11-25's), and
+#: its peak RSS. A stored figure: a ratio counts only against a peer run in the same session.
+MANISKILL2_SINGLE_STEPS_PER_S = {"pd_ee_delta_pose": 737.0, "pd_joint_delta_pos": 847.0}
+#: When the figures above were measured.
+MANISKILL2_SINGLE_MEASURED = "2026-11-29"
 MANISKILL2_PEAK_RSS_MB = 336.0
 #: ManiSkill2 0.5.3, same machine, PickCube-v0 single env in rgbd / pointcloud (lavapipe, 2
 #: cameras 128×128: base_camera + hand_camera): ~18 steps/s in both.
@@ -289,7 +293,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     ]
     rows = _run_rows(args.env_id, steps, specs, num_envs_list, state_row)
     print(
-        "ManiSkill2 0.5.3 on this machine (single env): "
+        f"x MS2 single: against ManiSkill2 0.5.3's stored figures ({MANISKILL2_SINGLE_MEASURED}, "
+        "single env, not measured in this run): "
         + ", ".join(f"{m} {v:.0f} steps/s" for m, v in MANISKILL2_SINGLE_STEPS_PER_S.items())
         + f", peak RSS {MANISKILL2_PEAK_RSS_MB:.0f} MB"
     )
