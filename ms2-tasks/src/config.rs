@@ -170,6 +170,14 @@ impl EnvConfig {
         self.substeps().map(|_| ())
     }
 
+    /// [`EnvConfig::mass_matrix_substeps`], or the task's default when `None`
+    /// ([`default_mass_matrix_substeps`] of whether the task has soft bodies); at least 1.
+    pub fn resolved_mass_matrix_substeps(&self, soft_bodies: bool) -> u32 {
+        self.mass_matrix_substeps
+            .unwrap_or_else(|| default_mass_matrix_substeps(soft_bodies))
+            .max(1)
+    }
+
     /// The MPM substep length (s) of a soft-body task whose default MPM frequency is
     /// `default_hz`: `1 / mpm_freq`, after checking that `mpm_freq` is finite, positive and a
     /// whole multiple (>= 1) of `sim_freq`.

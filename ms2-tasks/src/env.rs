@@ -160,18 +160,15 @@ impl Env {
             }
             Simulation::Backend(make) => make(cfg, substeps)?,
         };
-        let resolved =
-            EnvConfig {
-                mpm_freq: backend.mpm_freq(),
-                mass_matrix_substeps: Some(cfg.mass_matrix_substeps.unwrap_or_else(|| {
-                    crate::config::default_mass_matrix_substeps(spec.soft_bodies)
-                })),
-                robot: robot.map(str::to_owned),
-                control_mode: Some(backend.control_mode().to_owned()),
-                reward_mode: Some(reward_mode.as_str().to_owned()),
-                max_episode_steps: Some(cfg.max_episode_steps.unwrap_or(spec.max_episode_steps)),
-                ..cfg.clone()
-            };
+        let resolved = EnvConfig {
+            mpm_freq: backend.mpm_freq(),
+            mass_matrix_substeps: Some(cfg.resolved_mass_matrix_substeps(spec.soft_bodies)),
+            robot: robot.map(str::to_owned),
+            control_mode: Some(backend.control_mode().to_owned()),
+            reward_mode: Some(reward_mode.as_str().to_owned()),
+            max_episode_steps: Some(cfg.max_episode_steps.unwrap_or(spec.max_episode_steps)),
+            ..cfg.clone()
+        };
         let mut env = Env {
             max_episode_steps: resolved.max_episode_steps.unwrap_or(1),
             cfg: resolved,

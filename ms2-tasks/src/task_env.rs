@@ -176,10 +176,7 @@ impl TaskEnv {
             #[cfg(feature = "render")]
             enable_shadow: cfg.enable_shadow,
             exact_restore: cfg.exact_restore,
-            mass_matrix_substeps: cfg
-                .mass_matrix_substeps
-                .unwrap_or_else(|| crate::config::default_mass_matrix_substeps(spec.soft_bodies))
-                .max(1),
+            mass_matrix_substeps: cfg.resolved_mass_matrix_substeps(spec.soft_bodies),
             #[cfg(feature = "render")]
             sensors: Mutex::new(None),
         })
