@@ -77,8 +77,9 @@ pub struct EnvConfig {
     /// and a state restored between env steps continues bit for bit. Reusing it saves about a
     /// sixth of the CPU time of a rigid env step (issue #21); the joints move by milliradians in
     /// the substeps between rebuilds (ms2-physics/README.md, "Round 5", has the measured
-    /// effects). Only with the `rapier-mass-matrix-reuse` feature (ms2's vendored rapier3d);
-    /// without it every substep rebuilds the matrix whatever this says. At least 1.
+    /// effects). Reuse needs the `rapier-mass-matrix-reuse` feature (ms2's vendored rapier3d,
+    /// on in the Python module): without it the default is 1 and a larger value is an
+    /// [`EnvError::InvalidConfig`]. At least 1.
     pub mass_matrix_substeps: Option<u32>,
     /// ManiSkill2's `model_ids` of the object-variation tasks (`PickSingleYCB-v0`,
     /// `PickSingleEGAD-v0`, `PickClutterYCB-v0`): the model ids episodes draw from; `None` (or
@@ -166,6 +167,13 @@ impl EnvConfig {
                     "mass_matrix_substeps must be in 1..={MAX_SUBSTEPS} physics substeps, got {n}"
                 )));
             }
+            if n > 1 && !cfg!(feature = "rapier-mass-matrix-reuse") {
+                return Err(EnvError::InvalidConfig(format!(
+                    "mass_matrix_substeps = {n} needs ms2-tasks' feature \
+                     `rapier-mass-matrix-reuse` (ms2's vendored rapier3d); this build rebuilds \
+                     the mass matrix every substep: use 1 or None"
+                )));
+            }
         }
         self.substeps().map(|_| ())
     }
@@ -224,9 +232,10 @@ pub const MAX_SUBSTEPS: u32 = 1000;
 pub const DEFAULT_MASS_MATRIX_SUBSTEPS: u32 = 3;
 
 /// The task's default [`EnvConfig::mass_matrix_substeps`]: [`DEFAULT_MASS_MATRIX_SUBSTEPS`]
-/// for a rigid task, 1 (rebuilt every substep) for a task with soft bodies.
+/// for a rigid task, 1 (rebuilt every substep) for a task with soft bodies, and 1 for every
+/// task in a build without the `rapier-mass-matrix-reuse` feature (which cannot reuse it).
 pub fn default_mass_matrix_substeps(soft_bodies: bool) -> u32 {
-    if soft_bodies {
+    if soft_bodies || !cfg!(feature = "rapier-mass-matrix-reuse") {
         1
     } else {
         DEFAULT_MASS_MATRIX_SUBSTEPS
