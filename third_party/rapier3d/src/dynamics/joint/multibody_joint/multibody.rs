@@ -147,6 +147,12 @@ pub struct Multibody {
     /// What the current mass matrices were built for: the time step, the dofs and the links'
     /// kinematic flags. `None` when they were never built or the multibody changed since.
     mass_matrix_built_for: Option<MassMatrixKey>,
+    /// `M⁻¹ eᵢ` for every dof `i` (column `i`, `ndofs` values each), solved through
+    /// `inv_augmented_mass` when it was last factorised with mass-matrix reuse on, so that
+    /// the steps reusing that factorisation copy the unit constraints' weighted Jacobians
+    /// instead of solving for them again (see [`Multibody::unit_inv_mass_column`]).
+    /// Empty when not valid for the current factorisation.
+    unit_inv_columns: DVector,
 }
 
 /// What a multibody's mass matrices depend on besides its configuration and velocities.
@@ -193,6 +199,7 @@ impl Multibody {
             i_coriolis_dt: Jacobian::zeros(0),
             reuse_mass_matrix: None,
             mass_matrix_built_for: None,
+            unit_inv_columns: DVector::zeros(0),
             root_is_dynamic: false,
             self_contacts_enabled,
             couplings: Vec::new(),
@@ -952,6 +959,14 @@ impl Multibody {
             (self.reuse_mass_matrix, &self.mass_matrix_built_for)
         {
             if self.mass_matrix_still_valid(key, dt, max_displacement) {
+                if self.unit_inv_columns.is_empty() {
+                    // Factorised by a step without reuse: solve the columns once for the
+                    // steps that reuse it.
+                    let effective_dim = self
+                        .augmented_mass_indices
+                        .dim_after_removal(self.acc_augmented_mass.nrows());
+                    self.update_unit_inv_columns(effective_dim);
+                }
                 return;
             }
         }
@@ -1292,6 +1307,40 @@ impl Multibody {
         ));
         self.inv_augmented_mass =
             LU::new(leading_square_block(&self.augmented_mass, effective_dim));
+        self.update_unit_inv_columns(effective_dim);
+    }
+
+    /// Solves `M⁻¹ eᵢ` for every dof once per factorisation while mass-matrix reuse is on (the
+    /// factorisation then serves several steps, each of which needs these columns for its
+    /// unit joint constraints); forgets them otherwise (a step that rebuilds without reuse
+    /// forgets them, and the first step that reuses its factorisation solves them). Each column is solved exactly as
+    /// [`write_unit_dof_jacobians`](super::unit_multibody_joint) solves it (same LU, same
+    /// right-hand side, same view type), so copies of it are bit-identical to a fresh solve.
+    fn update_unit_inv_columns(&mut self, effective_dim: usize) {
+        let n = self.ndofs;
+        if self.reuse_mass_matrix.is_none() || effective_dim != n {
+            self.unit_inv_columns = DVector::zeros(0);
+            return;
+        }
+        if self.unit_inv_columns.nrows() != n * n {
+            self.unit_inv_columns = DVector::zeros(n * n);
+        } else {
+            self.unit_inv_columns.as_mut_slice().fill(0.0);
+        }
+        for i in 0..n {
+            self.unit_inv_columns[i * n + i] = 1.0;
+            self.inv_augmented_mass
+                .solve_mut(&mut self.unit_inv_columns.rows_mut(i * n, n));
+        }
+    }
+
+    /// `M⁻¹ e_dof` (`ndofs` values) through the current factorisation of the augmented mass
+    /// matrix, if it was solved when the matrix was last factorised (mass-matrix reuse on,
+    /// no kinematic dof); `None` otherwise.
+    pub(crate) fn unit_inv_mass_column(&self, dof: usize) -> Option<&[Real]> {
+        let n = self.ndofs;
+        (self.unit_inv_columns.nrows() == n * n && dof < n)
+            .then(|| &self.unit_inv_columns.as_slice()[dof * n..(dof + 1) * n])
     }
 
     /// Per-DoF inverse joint-space inertia `diag(M⁻¹)` at the current configuration, where `M`

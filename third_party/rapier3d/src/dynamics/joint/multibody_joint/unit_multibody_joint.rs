@@ -317,12 +317,19 @@ pub(crate) fn write_unit_dof_jacobians(
         }
         _ => {
             let dof_j_id = j_id + dof_id + link.assembly_id;
-            jacobians.as_mut_slice()[j_id..j_id + ndofs * 2].fill(0.0);
-            jacobians[dof_j_id] = 1.0;
-            jacobians[dof_j_id + ndofs] = 1.0;
-            multibody
-                .inv_augmented_mass()
-                .solve_mut(&mut jacobians.rows_mut(j_id + ndofs, ndofs));
+            let block = &mut jacobians.as_mut_slice()[j_id..j_id + ndofs * 2];
+            block[..ndofs].fill(0.0);
+            block[dof_j_id - j_id] = 1.0;
+            if let Some(column) = multibody.unit_inv_mass_column(dof_id + link.assembly_id) {
+                // Solved when the (reused) factorisation was built: the same values.
+                block[ndofs..].copy_from_slice(column);
+            } else {
+                block[ndofs..].fill(0.0);
+                block[dof_j_id - j_id + ndofs] = 1.0;
+                multibody
+                    .inv_augmented_mass()
+                    .solve_mut(&mut jacobians.rows_mut(j_id + ndofs, ndofs));
+            }
         }
     }
     *dof_block = Some(j_id);

@@ -279,6 +279,13 @@ impl GenericJointConstraint {
     ) {
         let jacobians = jacobians.as_slice();
 
+        if self.impulse_bounds == [0.0, 0.0] && self.impulse == 0.0 {
+            // An inactive constraint (a joint limit away from its bounds): the impulse is
+            // clamped to zero at every pass, so the velocities would only receive `±0 · w`.
+            // (That leaves every finite velocity as it is, except that a `-0.0` would turn
+            // into `+0.0`; nothing downstream depends on the sign of a zero velocity.)
+            return;
+        }
         if self.unit_jacobian2 != u32::MAX && self.ndofs1 == 0 && !self.is_rigid_body2 {
             // A constraint on one coordinate of a multibody (the common case): no side 1,
             // whose empty dot product would be `+0.0` and whose axpy would do nothing.
