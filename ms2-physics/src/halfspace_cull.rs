@@ -9,11 +9,17 @@
 //! farther than the prediction distance, no vertex of the support face can be a contact, and the
 //! manifold parry would build is empty with the same normals. Pairs within reach (or within
 //! [`CULL_MARGIN`] of it) go on to parry unchanged.
+//!
+//! Before the walk comes a cheaper test: the deepest corner of the hull's local bounding box
+//! (one transformed point and three products). A link well above the floor is culled by it
+//! alone; the walk decides only when the box reaches the plane. A cuboid (the Panda's finger
+//! pads, a cube) is its own box, so the box test alone decides for it.
 
+use parry3d::bounding_volume::Aabb;
 use parry3d::math::{Pose, Vector};
 use parry3d::query::{details::NormalConstraints, Unsupported};
 use parry3d::query::{ContactManifold, ContactManifoldsWorkspace, PersistentQueryDispatcher};
-use parry3d::shape::{HalfSpace, Shape};
+use parry3d::shape::{Cuboid, HalfSpace, Shape};
 
 use crate::graph_hull::GraphHull;
 
@@ -38,22 +44,53 @@ fn normals_if_out_of_reach(
     g2: &dyn Shape,
     prediction: f32,
 ) -> Option<(Vector, Vector)> {
-    // `pos_plane_hull` maps the hull's frame into the plane's.
-    let out_of_reach = |plane: &HalfSpace, hull: &GraphHull, pos_plane_hull: &Pose| {
-        let normal_in_hull = pos_plane_hull.rotation.inverse() * plane.normal;
-        let deepest = hull.polyhedron().points()[hull.support_vertex(-normal_in_hull)];
-        let distance = (pos_plane_hull * deepest).dot(plane.normal);
-        (distance > prediction + CULL_MARGIN).then_some((plane.normal, -normal_in_hull))
+    let reach = prediction + CULL_MARGIN;
+    // `pos_plane_shape` maps the shape's frame into the plane's; the normals are parry's
+    // expressions for them (`normal1_2` in `contact_manifold_halfspace_pfm`).
+    let out_of_reach = |plane: &HalfSpace, shape: &dyn Shape, pos_plane_shape: &Pose| {
+        let normal_in_shape = pos_plane_shape.rotation.inverse() * plane.normal;
+        let normals = (plane.normal, -normal_in_shape);
+        if let Some(hull) = shape.as_shape::<GraphHull>() {
+            if box_distance(
+                pos_plane_shape,
+                plane.normal,
+                normal_in_shape,
+                &hull.compute_local_aabb(),
+            ) > reach
+            {
+                return Some(normals);
+            }
+            let deepest = hull.polyhedron().points()[hull.support_vertex(-normal_in_shape)];
+            let distance = (pos_plane_shape * deepest).dot(plane.normal);
+            (distance > reach).then_some(normals)
+        } else if let Some(cuboid) = shape.as_shape::<Cuboid>() {
+            let aabb = Aabb::new(-cuboid.half_extents, cuboid.half_extents);
+            (box_distance(pos_plane_shape, plane.normal, normal_in_shape, &aabb) > reach)
+                .then_some(normals)
+        } else {
+            None
+        }
     };
-    if let (Some(plane), Some(hull)) = (g1.as_shape::<HalfSpace>(), g2.as_shape::<GraphHull>()) {
-        out_of_reach(plane, hull, pos12)
-    } else if let (Some(hull), Some(plane)) =
-        (g1.as_shape::<GraphHull>(), g2.as_shape::<HalfSpace>())
-    {
-        out_of_reach(plane, hull, &pos12.inverse()).map(|(n_plane, n_hull)| (n_hull, n_plane))
+    if let Some(plane) = g1.as_shape::<HalfSpace>() {
+        out_of_reach(plane, g2, pos12)
+    } else if let Some(plane) = g2.as_shape::<HalfSpace>() {
+        out_of_reach(plane, g1, &pos12.inverse()).map(|(n_plane, n_shape)| (n_shape, n_plane))
     } else {
         None
     }
+}
+
+/// Signed distance (m) above the plane through the origin of the plane's frame with unit
+/// `normal` of the deepest corner of `aabb` (a box in the shape's frame, `pos_plane_shape`
+/// mapping that frame into the plane's; `normal_in_shape` is `normal` in the shape's frame).
+fn box_distance(
+    pos_plane_shape: &Pose,
+    normal: Vector,
+    normal_in_shape: Vector,
+    aabb: &Aabb,
+) -> f32 {
+    let centre = (pos_plane_shape * aabb.center()).dot(normal);
+    centre - (aabb.half_extents() * normal_in_shape).abs().element_sum()
 }
 
 /// Empties `manifold` and gives it the normals, as parry's half-space manifold does when no
@@ -142,6 +179,53 @@ mod tests {
     #[test]
     fn culled_manifolds_equal_parrys_above_at_and_through_the_plane() {
         let hull = link_hull();
+        let (culled, touching) = compare_with_parry(&hull);
+        assert!(culled > 200, "the shortcut was taken {culled} times");
+        assert!(touching > 50, "only {touching} poses touched the plane");
+    }
+
+    #[test]
+    fn culled_cuboid_manifolds_equal_parrys() {
+        // A finger-pad-sized box (m).
+        let pad = Cuboid::new(Vector::new(0.01, 0.004, 0.026));
+        let (culled, touching) = compare_with_parry(&pad);
+        assert!(culled > 200, "the shortcut was taken {culled} times");
+        assert!(touching > 30, "only {touching} poses touched the plane");
+    }
+
+    #[test]
+    fn the_box_test_alone_culls_a_hull_far_above_the_plane() {
+        let hull = link_hull();
+        let plane = HalfSpace::new(Vector::Z);
+        let pose = Pose::from_parts(
+            Vector::new(0.0, 0.0, 0.5),
+            Rotation::from_scaled_axis(Vector::new(0.3, -0.2, 1.0)),
+        );
+        let normal_in_hull = pose.rotation.inverse() * plane.normal;
+        let aabb = hull.compute_local_aabb();
+        assert!(box_distance(&pose, plane.normal, normal_in_hull, &aabb) > 0.3);
+        // The box never claims more clearance than the hull's deepest vertex has.
+        for i in 0..200 {
+            let a = i as f32 * 0.37;
+            let pose = Pose::from_parts(
+                Vector::new(0.0, 0.0, 0.02 * i as f32),
+                Rotation::from_scaled_axis(Vector::new(a, 0.5 * a, -a)),
+            );
+            let n = pose.rotation.inverse() * plane.normal;
+            let deepest = hull.polyhedron().points()[hull.support_vertex(-n)];
+            let exact = (pose * deepest).dot(plane.normal);
+            assert!(
+                box_distance(&pose, plane.normal, n, &aabb) <= exact + 1e-6,
+                "pose {i}"
+            );
+        }
+    }
+
+    /// Compares the chained dispatcher's manifolds with parry's for `shape` at 400 poses from
+    /// 5 cm through the plane to 30 cm above it, both ways round; returns how many were culled
+    /// and how many touched.
+    fn compare_with_parry(shape: &dyn Shape) -> (usize, usize) {
+        let hull = shape;
         let plane = HalfSpace::new(Vector::Z);
         let chained = HalfSpaceCullDispatcher.chain(DefaultQueryDispatcher);
         let (mut culled, mut touching) = (0, 0);
@@ -154,12 +238,8 @@ mod tests {
                 Rotation::from_scaled_axis(Vector::new(a, -0.7 * a, 0.3 * a)),
             );
             for (g1, g2, pos12) in [
-                (&plane as &dyn Shape, &hull as &dyn Shape, pose_plane_hull),
-                (
-                    &hull as &dyn Shape,
-                    &plane as &dyn Shape,
-                    pose_plane_hull.inverse(),
-                ),
+                (&plane as &dyn Shape, hull, pose_plane_hull),
+                (hull, &plane as &dyn Shape, pose_plane_hull.inverse()),
             ] {
                 let ours = manifolds(&chained, &pos12, g1, g2);
                 let parrys = manifolds(&DefaultQueryDispatcher, &pos12, g1, g2);
@@ -175,7 +255,6 @@ mod tests {
                 }
             }
         }
-        assert!(culled > 200, "the shortcut was taken {culled} times");
-        assert!(touching > 50, "only {touching} poses touched the plane");
+        (culled, touching)
     }
 }
