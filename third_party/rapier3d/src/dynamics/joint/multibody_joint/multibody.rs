@@ -153,6 +153,10 @@ pub struct Multibody {
     /// instead of solving for them again (see [`Multibody::unit_inv_mass_column`]).
     /// Empty when not valid for the current factorisation.
     unit_inv_columns: DVector,
+    /// Set once mass-matrix reuse was turned on: from then on every factorisation solves
+    /// `unit_inv_columns` (the rebuilding steps of a caller that alternates reuse on and off
+    /// need them as much as the reusing ones).
+    unit_inv_columns_wanted: bool,
 }
 
 /// What a multibody's mass matrices depend on besides its configuration and velocities.
@@ -200,6 +204,7 @@ impl Multibody {
             reuse_mass_matrix: None,
             mass_matrix_built_for: None,
             unit_inv_columns: DVector::zeros(0),
+            unit_inv_columns_wanted: false,
             root_is_dynamic: false,
             self_contacts_enabled,
             couplings: Vec::new(),
@@ -905,6 +910,7 @@ impl Multibody {
     /// before a rebuilding step continues bit for bit.
     pub fn set_reuse_mass_matrix(&mut self, max_displacement: Option<Real>) {
         self.reuse_mass_matrix = max_displacement;
+        self.unit_inv_columns_wanted |= max_displacement.is_some();
     }
 
     /// The joint displacement within which [`Multibody::set_reuse_mass_matrix`] lets steps
@@ -1310,15 +1316,15 @@ impl Multibody {
         self.update_unit_inv_columns(effective_dim);
     }
 
-    /// Solves `M⁻¹ eᵢ` for every dof once per factorisation while mass-matrix reuse is on (the
-    /// factorisation then serves several steps, each of which needs these columns for its
-    /// unit joint constraints); forgets them otherwise (a step that rebuilds without reuse
-    /// forgets them, and the first step that reuses its factorisation solves them). Each column is solved exactly as
+    /// Solves `M⁻¹ eᵢ` for every dof once per factorisation once mass-matrix reuse was turned
+    /// on (the factorisation then serves several steps, each of which needs these columns for
+    /// its unit joint constraints); forgets them for a multibody that never reused its matrix
+    /// (upstream's behaviour and cost). Each column is solved exactly as
     /// [`write_unit_dof_jacobians`](super::unit_multibody_joint) solves it (same LU, same
     /// right-hand side, same view type), so copies of it are bit-identical to a fresh solve.
     fn update_unit_inv_columns(&mut self, effective_dim: usize) {
         let n = self.ndofs;
-        if self.reuse_mass_matrix.is_none() || effective_dim != n {
+        if !self.unit_inv_columns_wanted || effective_dim != n {
             self.unit_inv_columns = DVector::zeros(0);
             return;
         }
