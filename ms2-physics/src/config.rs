@@ -51,7 +51,28 @@ pub struct SolverConfig {
     /// some pairs of prisms with parallel faces (phantom contacts millimetres apart). Off by
     /// default (the tasks built before it keep their contacts); AssemblingKits sets it.
     pub sat_convex_contacts: bool,
+    /// How far (as a fraction of [`prediction_distance`](Self::prediction_distance), in
+    /// `[0, 1]`) two colliders **without contacts** whose pair has a cached contact filter (the
+    /// links of an articulation, bodies given
+    /// [`World::set_collision_between`](crate::World::set_collision_between)) may move relative
+    /// to each other before the narrow phase looks at them again; until then it reuses its
+    /// last answer (no contacts). `0` looks at them every substep. A pair that comes within the
+    /// prediction distance meanwhile gets its first, speculative contact up to that drift later
+    /// (it cannot have touched: the window is at most the prediction distance); pairs with
+    /// contacts are always updated. The default is [`DEFAULT_FILTERED_PAIR_RECYCLING`]; values
+    /// above 0 need the feature `rapier-filter-epoch` (the cached verdicts live in ms2's
+    /// vendored rapier3d), and [`WorldConfig::validate`] refuses them without it.
+    pub filtered_pair_recycling: f32,
 }
+
+/// [`SolverConfig::filtered_pair_recycling`]'s default: 1 (a whole prediction distance) in builds
+/// with the feature `rapier-filter-epoch`, 0 (every substep, upstream rapier's behaviour)
+/// without it.
+pub const DEFAULT_FILTERED_PAIR_RECYCLING: f32 = if cfg!(feature = "rapier-filter-epoch") {
+    1.0
+} else {
+    0.0
+};
 
 impl Default for SolverConfig {
     fn default() -> Self {
@@ -64,6 +85,7 @@ impl Default for SolverConfig {
             prediction_distance: 0.002,
             max_corrective_velocity: 1.0,
             sat_convex_contacts: false,
+            filtered_pair_recycling: DEFAULT_FILTERED_PAIR_RECYCLING,
         }
     }
 }
@@ -156,6 +178,21 @@ impl WorldConfig {
                     s.prediction_distance, s.max_corrective_velocity
                 ),
                 expected: "prediction >= 0 m and corrective velocity > 0 m/s",
+            });
+        }
+        let recycling = s.filtered_pair_recycling;
+        if !(recycling.is_finite() && (0.0..=1.0).contains(&recycling)) {
+            return Err(PhysicsError::InvalidParameter {
+                name: "filtered_pair_recycling",
+                value: recycling.to_string(),
+                expected: "a fraction of the prediction distance in [0, 1]",
+            });
+        }
+        if recycling > 0.0 && !cfg!(feature = "rapier-filter-epoch") {
+            return Err(PhysicsError::InvalidParameter {
+                name: "filtered_pair_recycling",
+                value: recycling.to_string(),
+                expected: "0 in a build without the feature rapier-filter-epoch",
             });
         }
         Ok(())

@@ -77,7 +77,7 @@ pub mod urdf;
 pub mod world;
 
 pub use actor::{ActorDesc, ActorKind};
-pub use config::{GroundConfig, SolverConfig, WorldConfig};
+pub use config::{GroundConfig, SolverConfig, WorldConfig, DEFAULT_FILTERED_PAIR_RECYCLING};
 pub use contact::{ContactPoint, ContactReport};
 pub use description::{
     ArticulationDesc, ArticulationOptions, DriveParams, Inertial, JointDesc, JointInfo, JointType,

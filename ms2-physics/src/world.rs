@@ -160,6 +160,10 @@ impl World {
         params.friction_in_bias_pass = s.friction_in_bias_pass;
         params.normalized_prediction_distance = s.prediction_distance;
         params.normalized_max_corrective_velocity = s.max_corrective_velocity;
+        #[cfg(feature = "rapier-filter-epoch")]
+        {
+            params.filtered_pair_recycling = s.filtered_pair_recycling;
+        }
         let mut world = World {
             params,
             pipeline: PhysicsPipeline::new(),

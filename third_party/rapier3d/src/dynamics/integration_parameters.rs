@@ -314,6 +314,18 @@ pub struct IntegrationParameters {
     /// be recycled instead of fully updated (default: `0.05`, i.e. ten times the linear slop,
     /// multiplied by [`Self::length_unit`]). Only used when [`Self::contact_recycling`] is enabled.
     pub normalized_contact_recycle_distance: Real,
+    /// Contact recycling for the contact-free pairs that [`Self::contact_recycling`] leaves
+    /// out because a hook is involved, when that hook is only a contact filter whose verdict
+    /// is cached for the current epoch ([`crate::pipeline::PhysicsHooks::contact_pair_filter_epoch`],
+    /// so it would answer the same): such a pair without contacts skips contact determination
+    /// while its relative pose drifted by less than this fraction of the prediction distance
+    /// since its last full update (default: `0.0`, never). A pair with contacts always gets
+    /// its full update. A half-space pair is measured in the half-space's frame by the other
+    /// shape's extent (a half-space's own extent is unbounded). Trade-off: a pair that comes
+    /// within the prediction distance while recycled gets its first (speculative) contact up
+    /// to that drift later than with a full update every step; it cannot have touched, the
+    /// fraction being at most `1.0`. Only used when [`Self::contact_recycling`] is enabled.
+    pub filtered_pair_recycling: Real,
     /// If `false`, friction is only solved during the unbiased (relax) pass of each substep instead
     /// of both passes (default: `false`, the "no friction when applying bias" rule).
     /// This makes contact kernels much cheaper and is load-bearing for tall stacks: friction
@@ -425,6 +437,7 @@ impl Default for IntegrationParameters {
             contact_clustering: true,
             contact_recycling: true,
             normalized_contact_recycle_distance: 0.05,
+            filtered_pair_recycling: 0.0,
             friction_in_bias_pass: false,
             warmstart_joints: false,
             length_unit: 1.0,

@@ -367,8 +367,15 @@ impl RigidPairContacts {
 #[derive(Copy, Clone, Debug)]
 #[cfg_attr(feature = "serde-serialize", derive(Serialize, Deserialize))]
 pub(crate) struct ContactRecycleState {
-    /// Pose of the second collider relative to the first at the last full update.
+    /// Pose of the second collider relative to the first at the last full update (of the
+    /// first relative to the second if `plane2`).
     pub pos12: Pose,
+    /// The first collider is a half-space and `max_extent` is the second collider's alone
+    /// (a half-space's own extent is unbounded; set for filtered-pair recycling only).
+    pub plane1: bool,
+    /// The second collider is a half-space and `pos12`, `max_extent` describe the first
+    /// collider in its frame (set for filtered-pair recycling only).
+    pub plane2: bool,
     /// World rotation of the first collider at the last full update. The frozen world-space anchors
     /// ([`ContactData::solver_dp1`]) mean recycling must also bound each body's *absolute* rotation:
     /// rotating rigidly together keeps the relative pose but invalidates world-frozen arms (bound: `cos Δθ > 0.98`, ~11.5°).

@@ -30,6 +30,9 @@ impl NarrowPhase {
         contact_clustering: bool,
         // Contact-recycling drift threshold; `0.0` disables recycling.
         contact_recycle_distance: Real,
+        // Recycling window of contact-free pairs with a cached filter verdict, as a fraction of
+        // the prediction distance (`IntegrationParameters::filtered_pair_recycling`).
+        filtered_pair_recycling: Real,
         islands: &mut IslandManager,
         bodies: &mut RigidBodySet,
         colliders: &ColliderSet,
@@ -107,6 +110,7 @@ impl NarrowPhase {
                 dt,
                 contact_clustering,
                 contact_recycle_distance,
+                filtered_pair_recycling,
                 bodies,
                 colliders,
                 impulse_joints,
@@ -134,6 +138,7 @@ impl NarrowPhase {
                 dt,
                 contact_clustering,
                 contact_recycle_distance,
+                filtered_pair_recycling,
                 bodies,
                 colliders,
                 impulse_joints,

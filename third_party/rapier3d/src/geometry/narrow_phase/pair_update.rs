@@ -75,6 +75,9 @@ pub(super) fn process_pair(
     contact_clustering: bool,
     // Contact-recycling drift threshold; `0.0` disables recycling.
     contact_recycle_distance: Real,
+    // Recycling window of contact-free pairs whose only hook is a contact filter with a cached
+    // verdict, as a fraction of the prediction distance; `0.0`: such pairs are never recycled.
+    filtered_pair_recycling: Real,
     bodies: &RigidBodySet,
     colliders: &ColliderSet,
     impulse_joints: &ImpulseJointSet,
@@ -145,10 +148,22 @@ pub(super) fn process_pair(
             let recycle_safe = ColliderChanges::IN_MODIFIED_SET
                 | ColliderChanges::POSITION
                 | ColliderChanges::LOCAL_MASS_PROPERTIES;
-            let hooks_involved = !(co1.flags.active_hooks | co2.flags.active_hooks).is_empty();
+            // Pairs relying on per-step user hooks are never recycled, except a pair whose only
+            // hook is a contact filter with a verdict cached for the current epoch (which
+            // allowed the pair: the hook would answer the same now), if the caller allows it.
+            let active_hooks = co1.flags.active_hooks | co2.flags.active_hooks;
+            let hooks_involved = !active_hooks.is_empty()
+                && !(filtered_pair_recycling > 0.0
+                    && active_hooks == ActiveHooks::FILTER_CONTACT_PAIRS
+                    && matches!(pair.filter_verdict,
+                        Some((epoch, Some(_))) if hooks.contact_pair_filter_epoch() == Some(epoch)));
 
             if ((co1.changes | co2.changes) & !recycle_safe).is_empty() && !hooks_involved {
-                let pos12 = co1.pos.inv_mul(&co2.pos);
+                let pos12 = if state.plane2 {
+                    co2.pos.inv_mul(&co1.pos)
+                } else {
+                    co1.pos.inv_mul(&co2.pos)
+                };
                 // Conservative bound on how far any contact point moved in
                 // the pair's local space since the last full update (chord
                 // form, no `atan2`; see `relative_pose_drift`).
@@ -772,26 +787,47 @@ pub(super) fn process_pair(
             // shape does, so reuse the previous full update's value.
             let shapes_changed =
                 (co1.changes | co2.changes).contains(crate::geometry::ColliderChanges::SHAPE);
+            let hooked = !(co1.flags.active_hooks | co2.flags.active_hooks).is_empty();
+            let is_plane = |co: &crate::geometry::Collider| co.shape.as_halfspace().is_some();
+            // Hooked pairs (recycled only without contacts) measure a half-space pair in the
+            // half-space's frame, by the other shape's extent.
+            let (plane1, plane2) = if hooked && filtered_pair_recycling > 0.0 {
+                (is_plane(co1), !is_plane(co1) && is_plane(co2))
+            } else {
+                (false, false)
+            };
             let max_extent = match &rigid.recycle_state {
-                Some(state) if !shapes_changed => state.max_extent,
+                Some(state) if !shapes_changed && (state.plane1, state.plane2) == (plane1, plane2) => {
+                    state.max_extent
+                }
                 _ => {
                     let origin_radius = |co: &crate::geometry::Collider| {
                         let aabb = co.shape.compute_local_aabb();
                         aabb.mins.length().max(aabb.maxs.length())
                     };
-                    origin_radius(co1).max(origin_radius(co2))
+                    if plane1 {
+                        origin_radius(co2)
+                    } else if plane2 {
+                        origin_radius(co1)
+                    } else {
+                        origin_radius(co1).max(origin_radius(co2))
+                    }
                 }
             };
             // A pair without contacts has an (unknown) separation larger than
             // the prediction distance. Cap its recycle window by the
             // prediction distance so an incoming contact can't be missed.
             let max_drift = if rigid.has_any_active_contact() {
-                contact_recycle_distance
+                if hooked { -1.0 } else { contact_recycle_distance }
+            } else if hooked {
+                contact_recycle_distance.min(prediction_distance) * filtered_pair_recycling
             } else {
                 contact_recycle_distance.min(prediction_distance)
             };
             rigid.recycle_state = Some(crate::geometry::ContactRecycleState {
-                pos12,
+                pos12: if plane2 { co2.pos.inv_mul(&co1.pos) } else { pos12 },
+                plane1,
+                plane2,
                 rot1: co1.pos.rotation,
                 rot2: co2.pos.rotation,
                 max_extent,

@@ -136,6 +136,7 @@ impl PhysicsPipeline {
             } else {
                 0.0
             },
+            integration_parameters.filtered_pair_recycling,
             islands,
             bodies,
             colliders,
