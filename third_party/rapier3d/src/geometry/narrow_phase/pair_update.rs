@@ -797,7 +797,9 @@ pub(super) fn process_pair(
                 (false, false)
             };
             let max_extent = match &rigid.recycle_state {
-                Some(state) if !shapes_changed && (state.plane1, state.plane2) == (plane1, plane2) => {
+                Some(state)
+                    if !shapes_changed && (state.plane1, state.plane2) == (plane1, plane2) =>
+                {
                     state.max_extent
                 }
                 _ => {
@@ -818,14 +820,22 @@ pub(super) fn process_pair(
             // the prediction distance. Cap its recycle window by the
             // prediction distance so an incoming contact can't be missed.
             let max_drift = if rigid.has_any_active_contact() {
-                if hooked { -1.0 } else { contact_recycle_distance }
+                if hooked {
+                    -1.0
+                } else {
+                    contact_recycle_distance
+                }
             } else if hooked {
                 contact_recycle_distance.min(prediction_distance) * filtered_pair_recycling
             } else {
                 contact_recycle_distance.min(prediction_distance)
             };
             rigid.recycle_state = Some(crate::geometry::ContactRecycleState {
-                pos12: if plane2 { co2.pos.inv_mul(&co1.pos) } else { pos12 },
+                pos12: if plane2 {
+                    co2.pos.inv_mul(&co1.pos)
+                } else {
+                    pos12
+                },
                 plane1,
                 plane2,
                 rot1: co1.pos.rotation,

@@ -422,3 +422,123 @@ pub fn filter_verdicts_are_cached_per_epoch() {
     assert!(!touching(&cloned));
     assert_eq!(hooks.calls.load(Ordering::Relaxed), 8);
 }
+
+/// How many of `steps` steps gave a ball's pair with the ground (a half-space) a full
+/// narrow-phase update, the ball kinematic at `height` (m) rising at `speed` (m/s), with
+/// `filtered_pair_recycling` and a cached filter on both colliders (`epoch` 0: none).
+#[cfg(feature = "dim3")]
+fn full_updates_of_a_rising_ball(
+    filtered_pair_recycling: crate::math::Real,
+    epoch: u64,
+    height: crate::math::Real,
+    speed: crate::math::Real,
+    steps: usize,
+) -> usize {
+    use crate::pipeline::ActiveHooks;
+    let mut bodies = RigidBodySet::new();
+    let mut colliders = ColliderSet::new();
+    let ground = bodies.insert(RigidBodyBuilder::fixed());
+    colliders.insert_with_parent(
+        ColliderBuilder::new(crate::geometry::SharedShape::halfspace(Vector::Z))
+            .active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS)
+            .build(),
+        ground,
+        &mut bodies,
+    );
+    let ball = bodies.insert(
+        RigidBodyBuilder::kinematic_velocity_based()
+            .translation(Vector::new(0.0, 0.0, height))
+            .linvel(Vector::new(0.0, 0.0, speed)),
+    );
+    colliders.insert_with_parent(
+        ColliderBuilder::ball(0.5)
+            .active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS)
+            .active_collision_types(crate::geometry::ActiveCollisionTypes::all())
+            .build(),
+        ball,
+        &mut bodies,
+    );
+    let params = IntegrationParameters {
+        filtered_pair_recycling,
+        ..IntegrationParameters::default()
+    };
+    let hooks = CountingFilter {
+        calls: 0.into(),
+        epoch: epoch.into(),
+        reject: false.into(),
+    };
+    let mut pipeline = PhysicsPipeline::new();
+    let mut islands = IslandManager::new();
+    let mut broad_phase = DefaultBroadPhase::new();
+    let mut narrow_phase = NarrowPhase::new();
+    let mut impulse_joints = ImpulseJointSet::new();
+    let mut multibody_joints = MultibodyJointSet::new();
+    let mut soft_bodies = SoftBodySet::new();
+    let mut ccd = CCDSolver::new();
+    let mut last_pose = None;
+    let mut full_updates = 0;
+    for _ in 0..steps {
+        pipeline.step(
+            Vector::ZERO,
+            &params,
+            &mut islands,
+            &mut broad_phase,
+            &mut narrow_phase,
+            &mut bodies,
+            &mut colliders,
+            &mut impulse_joints,
+            &mut multibody_joints,
+            &mut soft_bodies,
+            &mut ccd,
+            &hooks,
+            &(),
+        );
+        // A full update records the pair's relative pose; a recycled step keeps the old one.
+        let pair = narrow_phase
+            .contact_pairs()
+            .next()
+            .expect("the ball's pair");
+        let pose = pair
+            .rigid()
+            .and_then(|r| r.recycle_state.as_ref())
+            .map(|s| s.pos12.translation);
+        if pose != last_pose {
+            full_updates += 1;
+        }
+        last_pose = pose;
+    }
+    full_updates
+}
+
+/// `IntegrationParameters::filtered_pair_recycling`: a contact-free pair with a cached filter
+/// verdict skips its narrow phase while it drifts less than the window (a half-space pair
+/// measured by the other shape's extent), and not otherwise: without the option, without a
+/// cached verdict, or with contacts.
+#[cfg(feature = "dim3")]
+#[test]
+pub fn filtered_pairs_without_contacts_are_recycled_within_the_window() {
+    // The default prediction distance is 2 cm; 1 mm/s at 60 Hz moves 1/60 mm per step.
+    let steps = 120;
+    // Off (the default): a full update at every step.
+    assert_eq!(
+        full_updates_of_a_rising_ball(0.0, 1, 1.0, 1e-3, steps),
+        steps
+    );
+    // No cached verdict (no epoch): every step, as upstream.
+    assert_eq!(
+        full_updates_of_a_rising_ball(1.0, 0, 1.0, 1e-3, steps),
+        steps
+    );
+    // Cached verdict, no contact: the ball moves 2 mm in 120 steps, within half the 2 cm
+    // window, so only the first update is full.
+    assert_eq!(full_updates_of_a_rising_ball(0.5, 1, 1.0, 1e-3, steps), 1);
+    // Faster (0.6 m/s: 1 cm per step) with the whole 2 cm window: a full update every
+    // second or third step.
+    let fast = full_updates_of_a_rising_ball(1.0, 1, 1.0, 0.6, steps);
+    assert!((steps / 3..steps).contains(&fast), "{fast} full updates");
+    // Touching the ground (the ball's centre 0.49 m up): updated at every step.
+    assert_eq!(
+        full_updates_of_a_rising_ball(1.0, 1, 0.49, 1e-3, steps),
+        steps
+    );
+}

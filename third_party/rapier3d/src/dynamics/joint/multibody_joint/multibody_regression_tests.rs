@@ -648,3 +648,71 @@ fn joint_friction_bounds_the_joint_force() {
         "an oversized friction bound must stay inert, not chatter: {extreme}"
     );
 }
+
+/// ms2's round 6 (PATCHES.md): once mass-matrix reuse was turned on, each factorisation
+/// solves `M⁻¹ eᵢ` for every dof, and the unit joint constraints copy those columns. A copy
+/// must equal a fresh solve through the current factorisation bit for bit, on the steps
+/// that rebuild the matrix as on those that reuse it; a multibody that never reused its
+/// matrix keeps no columns (upstream's path).
+#[test]
+#[cfg(feature = "dim3")]
+fn unit_inverse_mass_columns_equal_fresh_solves() {
+    let mut world = PhysicsWorld::new();
+    let root = world.insert_body(RigidBodyBuilder::fixed());
+    let mut parent = root;
+    let mut last = None;
+    for i in 0..3 {
+        let link = world.insert_body(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.3 * (i + 1) as Real, 0.0, 0.0))
+                .additional_mass(1.0 + i as Real),
+        );
+        let axis = if i % 2 == 0 { Vector::Z } else { Vector::Y };
+        let joint = RevoluteJointBuilder::new(axis)
+            .local_anchor1(if i == 0 {
+                Vector::ZERO
+            } else {
+                Vector::new(0.15, 0.0, 0.0)
+            })
+            .local_anchor2(Vector::new(-0.15, 0.0, 0.0))
+            .limits([-2.0, 2.0])
+            .motor_position(0.3, 100.0, 10.0);
+        last = world.insert_multibody_joint(parent, link, joint);
+        parent = link;
+    }
+    let handle = last.expect("the chain's last joint");
+    let columns_match = |world: &PhysicsWorld| {
+        let (multibody, _) = world.multibody_joints.get(handle).expect("multibody");
+        let n = multibody.ndofs();
+        assert_eq!(n, 3);
+        (0..n).all(|i| {
+            let mut e = DVector::zeros(n);
+            e[i] = 1.0;
+            multibody.inv_augmented_mass().solve_mut(&mut e);
+            let cached = multibody.unit_inv_mass_column(i).expect("a cached column");
+            cached
+                .iter()
+                .map(|v| v.to_bits())
+                .eq(e.iter().map(|v| v.to_bits()))
+        })
+    };
+    for _ in 0..3 {
+        world.step();
+    }
+    let (multibody, _) = world.multibody_joints.get(handle).expect("multibody");
+    assert!(
+        multibody.unit_inv_mass_column(0).is_none(),
+        "reuse never on: no columns"
+    );
+    for step in 0..12 {
+        // Rebuild on every third step, reuse on the others, as ms2 does within a control step.
+        let reuse = (step % 3 != 0).then_some(Real::MAX);
+        let (multibody, _) = world.multibody_joints.get_mut(handle).expect("multibody");
+        multibody.set_reuse_mass_matrix(reuse);
+        world.step();
+        // From the first reusing step on (step 0 rebuilds before reuse was ever on).
+        if step > 0 {
+            assert!(columns_match(&world), "step {step}");
+        }
+    }
+}

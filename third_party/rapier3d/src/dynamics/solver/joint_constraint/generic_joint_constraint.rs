@@ -558,4 +558,64 @@ mod tests {
             }
         }
     }
+
+    /// ms2's round 6: an inactive constraint (impulse bounds both zero: a joint limit away from
+    /// its bounds) returns before its PGS step. It writes exactly what that step would write
+    /// (which clamps the impulse to zero and adds `±0 · w` to the velocities) whenever no
+    /// velocity is an exact zero, and it leaves the velocities and its impulse untouched.
+    #[test]
+    fn an_inactive_constraint_changes_nothing() {
+        let mut seed = 13;
+        let n = 9;
+        let mut compared = 0;
+        for round in 0..400 {
+            let i = round % n;
+            let mut v = values(&mut seed, n);
+            if round % 2 == 0 {
+                v.iter_mut().filter(|x| **x == 0.0).for_each(|x| *x = 0.25);
+            }
+            let mut jacobians = DVector::zeros(2 * n);
+            jacobians[i] = 1.0;
+            for (k, w) in values(&mut seed, n).into_iter().enumerate() {
+                jacobians[n + k] = w;
+            }
+            let mut constraint = GenericJointConstraint {
+                ndofs1: 0,
+                solver_vel2: 0,
+                ndofs2: n,
+                j_id2: 0,
+                unit_jacobian2: i as u32,
+                impulse: 0.0,
+                impulse_bounds: [-0.0, 0.0],
+                inv_lhs: 1.0 + value(&mut seed).abs(),
+                rhs: value(&mut seed),
+                cfm_gain: 0.01,
+                ..GenericJointConstraint::invalid()
+            };
+            // The PGS step the shortcut skips.
+            let mut expected = v.clone();
+            let mut full = constraint;
+            let delta = full.update_impulse(expected[i] + 0.0);
+            axpy_unless_no_change(&mut expected, -delta, &jacobians.as_slice()[n..]);
+
+            let mut generic = DVector::from_vec(v.clone());
+            constraint.solve(&jacobians, &mut SolverBodies::default(), &mut generic);
+            let bits = |v: &[Real]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(
+                bits(generic.as_slice()),
+                bits(&v),
+                "round {round}: velocities"
+            );
+            assert_eq!(constraint.impulse, 0.0);
+            assert_eq!(full.impulse, 0.0);
+            if !v.contains(&0.0) {
+                assert_eq!(bits(generic.as_slice()), bits(&expected), "round {round}");
+                compared += 1;
+            }
+        }
+        assert!(
+            compared >= 200,
+            "compared {compared} rounds with the full step"
+        );
+    }
 }
