@@ -52,11 +52,11 @@ pub struct SolverConfig {
     /// default (the tasks built before it keep their contacts); AssemblingKits sets it.
     pub sat_convex_contacts: bool,
     /// How far (as a fraction of [`prediction_distance`](Self::prediction_distance), in
-    /// `[0, 1]`) two colliders **without contacts** whose pair has a cached contact filter (the
-    /// links of an articulation, bodies given
-    /// [`World::set_collision_between`](crate::World::set_collision_between)) may move relative
-    /// to each other before the narrow phase looks at them again; until then it reuses its
-    /// last answer (no contacts). `0` looks at them every substep. A pair that comes within the
+    /// `[0, 1]`) two colliders **without contacts**, each of them an articulation link (or a
+    /// body given [`World::set_collision_between`](crate::World::set_collision_between): the
+    /// colliders with a cached contact filter) or the ground, may move relative to each other
+    /// before the narrow phase looks at them again; until then it reuses its last answer (no
+    /// contacts). Pairs with any other body (the task's objects) are looked at every substep. `0` looks at them every substep. A pair that comes within the
     /// prediction distance meanwhile gets its first, speculative contact up to that drift later
     /// (it cannot have touched: the window is at most the prediction distance); pairs with
     /// contacts are always updated. The default is [`DEFAULT_FILTERED_PAIR_RECYCLING`]; values

@@ -317,7 +317,9 @@ pub struct IntegrationParameters {
     /// Contact recycling for the contact-free pairs that [`Self::contact_recycling`] leaves
     /// out because a hook is involved, when that hook is only a contact filter whose verdict
     /// is cached for the current epoch ([`crate::pipeline::PhysicsHooks::contact_pair_filter_epoch`],
-    /// so it would answer the same): such a pair without contacts skips contact determination
+    /// so it would answer the same) and each of the two colliders either carries that filter
+    /// or is a half-space (a robot's links and the ground, say, but not a robot link and a
+    /// collider without hooks): such a pair without contacts skips contact determination
     /// while its relative pose drifted by less than this fraction of the prediction distance
     /// since its last full update (default: `0.0`, never). A pair with contacts always gets
     /// its full update. A half-space pair is measured in the half-space's frame by the other

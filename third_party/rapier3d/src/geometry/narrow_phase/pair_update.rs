@@ -826,7 +826,20 @@ pub(super) fn process_pair(
                     contact_recycle_distance
                 }
             } else if hooked {
-                contact_recycle_distance.min(prediction_distance) * filtered_pair_recycling
+                // Only between colliders that each carry the filter or are a half-space (in
+                // ms2: robot links and the ground), not with a collider free of hooks.
+                let filtered = |co: &crate::geometry::Collider| {
+                    is_plane(co)
+                        || co
+                            .flags
+                            .active_hooks
+                            .contains(ActiveHooks::FILTER_CONTACT_PAIRS)
+                };
+                if filtered(co1) && filtered(co2) {
+                    contact_recycle_distance.min(prediction_distance) * filtered_pair_recycling
+                } else {
+                    -1.0
+                }
             } else {
                 contact_recycle_distance.min(prediction_distance)
             };
