@@ -60,9 +60,6 @@ pub struct VecEnv {
     /// Whether state steps of these (rigid) envs run on `vec_pool`'s spinning pool rather than
     /// rayon's (always false for soft-body envs, whose MPM step uses rayon's pool itself).
     spinning_pool: bool,
-    /// Wall time of each env's last command on the spinning pool, in nanoseconds (0 before
-    /// the first): the next vector step hands the envs out longest first.
-    last_cost_nanos: Vec<u64>,
 }
 
 impl VecEnv {
@@ -86,7 +83,6 @@ impl VecEnv {
             action_dim,
             pipelined: true,
             spinning_pool,
-            last_cost_nanos: vec![0; num_envs],
         })
     }
 
@@ -189,7 +185,7 @@ impl VecEnv {
             return self.run_visual(commands, layout, robot_seg);
         }
         let pool = if self.spinning_pool && self.envs.len() > 1 {
-            Pool::Spinning(&mut self.last_cost_nanos)
+            Pool::Spinning
         } else {
             Pool::Rayon
         };
@@ -252,14 +248,12 @@ fn has_soft_bodies(env: &Env) -> bool {
 }
 
 /// The thread pool a vector step's physics runs on.
-#[derive(Debug, PartialEq)]
-enum Pool<'a> {
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Pool {
     /// rayon's global pool.
     Rayon,
-    /// `vec_pool`'s: the caller helps, idle workers spin before sleeping. The envs are handed
-    /// out one at a time, longest first by these costs (each env's last command's wall time, in
-    /// nanoseconds), which are updated with this step's.
-    Spinning(&'a mut [u64]),
+    /// `vec_pool`'s: the caller helps, idle workers spin before sleeping.
+    Spinning,
 }
 
 /// One env's output of [`simulate`].
@@ -271,7 +265,7 @@ type Simulation<C> = Result<Option<(StepOutput, C)>, EnvError>;
 fn simulate<C: Send>(
     envs: &mut [Env],
     commands: &[EnvCommand<'_>],
-    pool: Pool<'_>,
+    pool: Pool,
     prepare: impl Fn(&mut Env) -> Result<C, EnvError> + Sync,
 ) -> Result<Vec<Option<(StepOutput, C)>>, EnvError> {
     let run = |env: &mut Env, command: &EnvCommand<'_>| -> Simulation<C> {
@@ -298,32 +292,17 @@ fn simulate<C: Send>(
             .zip(commands.par_iter())
             .map(|(env, command)| run(env, command))
             .collect(),
-        Pool::Spinning(costs) => {
-            // A vector step lasts until its last env is done: with the envs that took longest
-            // last time taken first, the threads run out of envs at about the same time (each
-            // env's step cost follows its contacts, which change slowly over an episode).
-            let order = crate::vec_pool::schedule(costs);
-            type Job<'e, 'c, C> = (
-                &'e mut Env,
-                &'e EnvCommand<'c>,
-                &'e mut u64,
-                Option<Simulation<C>>,
-            );
-            let mut jobs: Vec<Job<'_, '_, C>> = envs
+        Pool::Spinning => {
+            let mut jobs: Vec<(&mut Env, &EnvCommand<'_>, Option<Simulation<C>>)> = envs
                 .iter_mut()
                 .zip(commands)
-                .zip(costs.iter_mut())
-                .map(|((env, command), cost)| (env, command, cost, None))
+                .map(|(env, command)| (env, command, None))
                 .collect();
-            crate::vec_pool::for_each(&mut jobs, &order, &|(env, command, cost, out)| {
-                let started = std::time::Instant::now();
+            crate::vec_pool::for_each(&mut jobs, &|(env, command, out)| {
                 *out = Some(run(env, command));
-                if !matches!(command, EnvCommand::Keep) {
-                    **cost = u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX);
-                }
             });
             jobs.into_iter()
-                .map(|(_, _, _, out)| {
+                .map(|(_, _, out)| {
                     // `vec_pool::for_each` runs every job; never report a skipped env as kept.
                     out.unwrap_or_else(|| {
                         Err(EnvError::InvalidConfig(
