@@ -6,7 +6,7 @@
 
 use ms2_tasks::{Array, ArrayData, BoxSpace, DType, Info, InfoValue, ObsValue, Space};
 use numpy::ndarray::{ArrayD, IxDyn};
-use numpy::PyArray;
+use numpy::{PyArray, PyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use pyo3::IntoPyObjectExt;
@@ -272,7 +272,7 @@ pub fn vec_info_to_py<'py>(
                         };
                     }
                 }
-                owned_array(py, &[num_envs], out)?
+                PyArray1::from_slice(py, &out).into_any()
             }
             InfoValue::F64(_) => {
                 let mut out = vec![0.0f64; num_envs];
@@ -286,7 +286,7 @@ pub fn vec_info_to_py<'py>(
                         };
                     }
                 }
-                owned_array(py, &[num_envs], out)?
+                PyArray1::from_slice(py, &out).into_any()
             }
             InfoValue::I64(_) => {
                 let mut out = vec![0i64; num_envs];
@@ -300,11 +300,11 @@ pub fn vec_info_to_py<'py>(
                         };
                     }
                 }
-                owned_array(py, &[num_envs], out)?
+                PyArray1::from_slice(py, &out).into_any()
             }
         };
         dict.set_item(key, values)?;
-        dict.set_item(format!("_{key}"), owned_array(py, &[num_envs], mask)?)?;
+        dict.set_item(format!("_{key}"), PyArray1::from_slice(py, &mask))?;
     }
     Ok(dict)
 }

@@ -243,9 +243,9 @@ impl NativeVecEnv {
             py,
             [
                 obs,
-                PyArray1::from_vec(py, rewards).into_any(),
-                PyArray1::from_vec(py, terminated).into_any(),
-                PyArray1::from_vec(py, truncated).into_any(),
+                PyArray1::from_slice(py, &rewards).into_any(),
+                PyArray1::from_slice(py, &terminated).into_any(),
+                PyArray1::from_slice(py, &truncated).into_any(),
                 vec_info_to_py(py, &infos)?.into_any(),
             ],
         )

@@ -48,6 +48,19 @@ def test_action_dtypes_and_layouts_are_accepted(env):
         env.step(["a"] * d)
 
 
+def test_real_array_takes_float32_as_is_and_casts_the_rest():
+    from ms2.envs import real_array
+
+    view = np.arange(12, dtype=np.float32).reshape(3, 4)[:, ::2]  # float32, not contiguous
+    out = real_array(view, "a")
+    assert out.dtype == np.float32 and out.flags.c_contiguous
+    np.testing.assert_array_equal(out, view)
+    # A cast beyond float32's range gives inf (refused by the native step), without a warning.
+    assert real_array(np.array([1e39, 2.0]), "a").tolist() == [np.inf, 2.0]
+    with pytest.raises(ValueError, match="real numbers"):
+        real_array(np.array([1j]), "a")
+
+
 def test_unknown_env_id_lists_valid_ones():
     with pytest.raises(ValueError, match=ENV_IDS[0]) as err:
         ms2.Ms2Env("NoSuchTask-v0")

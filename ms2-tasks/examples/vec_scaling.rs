@@ -14,7 +14,12 @@
 //!   env step timed. A vector step lasts as long as its slowest env's (every env must finish
 //!   before the batch of observations returns), so with one env per core the best possible
 //!   ratio is `num_envs · mean(step) / mean(max over the envs of step)`, whatever the threading.
-//!   The spread of single-step costs (contacts come and go under random actions) sets it;
+//!   The spread of single-step costs (contacts come and go under random actions) sets it.
+//!   With more envs than threads, also the bound for the envs split over the threads as the
+//!   spinning pool splits them (contiguous halves; each thread's steps summed, the busiest
+//!   thread's sum per vector step): envs are not moved between threads to balance the load,
+//!   since an env stepped on another core than its last step runs slower (its state is in the
+//!   other core's cache);
 //! - the threaded loop's breakdown: per vector step, its wall time, its slowest env's own step
 //!   (against the lockstep's: the envs slowing each other down), when the last env started
 //!   (waking a worker) and how long the return took after the last env ended.
@@ -27,6 +32,20 @@ use ms2_tasks::seeding::episode_rng;
 use ms2_tasks::{make_env, EnvCommand, EnvConfig, EnvError, EpisodeRng, VecEnv};
 use rand::Rng;
 use rayon::prelude::*;
+
+/// The longest of the sums of `times` over the parts the spinning pool gives its threads:
+/// `times` halved (contiguous halves, the first rounded down, as `vec_pool` splits a vector
+/// step) until there are at least `threads` parts or single envs. With no more envs than threads
+/// that is the slowest env; with more, the slowest thread's share if no env moves between
+/// threads (the pool moves one only when a thread runs out of its own).
+fn busiest_part(times: &[f64], threads: usize) -> f64 {
+    if threads <= 1 || times.len() <= 1 {
+        return times.iter().sum();
+    }
+    let (first, second) = times.split_at(times.len() / 2);
+    let rest = threads.div_ceil(2);
+    busiest_part(first, threads / 2).max(busiest_part(second, rest))
+}
 
 fn random_action(rng: &mut EpisodeRng, dim: usize) -> Vec<f32> {
     (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect()
@@ -54,12 +73,15 @@ fn main() -> Result<(), EnvError> {
     }
     let dim = envs[0].action_space().size();
     let rounds = steps.div_ceil(num_envs);
+    let threads = rayon::current_num_threads();
     let mut sum_mean = 0.0f64;
     let mut sum_max = 0.0f64;
+    let mut sum_busiest = 0.0f64;
+    let mut times = vec![0.0f64; num_envs];
     for _ in 0..rounds {
         let mut slowest = 0.0f64;
         let mut total = 0.0f64;
-        for (env, rng) in envs.iter_mut().zip(&mut rngs) {
+        for ((env, rng), time) in envs.iter_mut().zip(&mut rngs).zip(&mut times) {
             let action = random_action(rng, dim);
             let t = Instant::now();
             let out = env.step(&action)?;
@@ -67,13 +89,16 @@ fn main() -> Result<(), EnvError> {
                 env.reset(None, false)?;
             }
             let dt = t.elapsed().as_secs_f64();
+            *time = dt;
             slowest = slowest.max(dt);
             total += dt;
         }
         sum_mean += total / num_envs as f64;
         sum_max += slowest;
+        sum_busiest += busiest_part(&times, threads);
     }
     let bound = num_envs as f64 * sum_mean / sum_max;
+    let split_bound = num_envs as f64 * sum_mean / sum_busiest;
     drop(envs);
 
     // One env alone.
@@ -183,7 +208,8 @@ fn main() -> Result<(), EnvError> {
     println!(
         "{env_id} {mode}, {} threads: single {single:.0} env steps/s; VecEnv({num_envs}) \
          {vector:.0} env steps/s = {:.2}x single (on rayon's pool {vector_rayon:.0} = {:.2}x); \
-         lockstep bound (one env per thread) {bound:.2}x (mean env step {:.0} µs, mean slowest of {num_envs} {:.0} µs)",
+         lockstep bound (one env per thread) {bound:.2}x (mean env step {:.0} µs, mean slowest of {num_envs} {:.0} µs); \
+         with the envs split over {threads} threads as the spinning pool splits them {split_bound:.2}x",
         rayon::current_num_threads(),
         vector / single,
         vector_rayon / single,

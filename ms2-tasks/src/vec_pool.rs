@@ -16,6 +16,15 @@
 //! that another runnable thread needs. `MS2_VEC_POOL=rayon` ([`POOL_VARIABLE`]) selects rayon's
 //! pool for every vector env of the process.
 //!
+//! The envs are split in contiguous halves (each half a job of `join`, down to single envs), so
+//! with more envs than threads each thread steps the same envs from one vector step to the next
+//! and an env moves to another thread only when one thread runs out of its own. Handing the envs
+//! out one at a time instead, the longest last step first (which balances the threads better on
+//! paper: 1.94 against 1.93x for four envs, 1.96 against 1.95x for eight, from traced step costs),
+//! was slower on 2026-11-29: by 3-4 % with four and eight envs in `pd_ee_delta_pose`, 1-2 % in
+//! `pd_joint_delta_pos` (PickCube-v0, medians of seven interleaved runs; docs/benchmarks.md), as
+//! an env stepped on another core than its last step finds its state in the other core's cache.
+//!
 //! Soft-body envs keep rayon: their MPM step runs on rayon's pool itself, and a spinning worker
 //! of another pool would take a core from it. Visual steps keep rayon too (the software
 //! renderer's threads need the cores between physics phases).

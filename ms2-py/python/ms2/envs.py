@@ -90,6 +90,8 @@ def real_array(value: Any, what: str) -> np.ndarray:
     """``value`` as a contiguous float32 array; ``ValueError`` for complex, string, bytes or
     object data (which a float32 cast would silently mangle or fail on obscurely)."""
     array = np.asarray(value)
+    if array.dtype == np.float32:  # no cast (the common case; errstate costs ~0.6 µs a call)
+        return np.ascontiguousarray(array)
     if array.dtype.kind not in "biuf":
         raise ValueError(f"{what} must hold real numbers, got dtype {array.dtype}")
     with np.errstate(over="ignore"):  # values beyond float32 become inf, refused natively
