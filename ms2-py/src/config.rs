@@ -12,7 +12,7 @@ use crate::cameras::camera_updates_from_py;
 /// ManiSkill2's `gym.make` names. A missing key or a `None` value takes the default
 /// (ManiSkill2's `state` obs mode, then [`EnvConfig::new`]'s: the task's control/reward mode, 500 Hz / 20 Hz, the task's
 /// episode limit, no render mode, the task's default robot and cameras, the soft-body task's MPM frequency).
-pub const ENV_KWARGS: [&str; 16] = [
+pub const ENV_KWARGS: [&str; 17] = [
     "obs_mode",
     "robot",
     "control_mode",
@@ -28,6 +28,7 @@ pub const ENV_KWARGS: [&str; 16] = [
     "bg_name",
     "exact_restore",
     "mass_matrix_substeps",
+    "filtered_pair_recycling",
     "model_ids",
 ];
 
@@ -168,6 +169,22 @@ pub fn config_from_kwargs(env_id: &str, kwargs: Option<&Bound<'_, PyDict>>) -> P
                         })?,
                 );
             }
+            "filtered_pair_recycling" => {
+                let expected = "a real number (a fraction of the prediction distance)";
+                if value.is_instance_of::<PyBool>() {
+                    return Err(PyTypeError::new_err(format!(
+                        "{key} must be {expected}, got bool {value}"
+                    )));
+                }
+                let f: f64 = extract_kwarg(&key, &value, expected)?;
+                if !(f.is_finite() && (0.0..=1.0).contains(&f)) {
+                    return Err(PyValueError::new_err(format!(
+                        "filtered_pair_recycling must be a fraction of the prediction distance \
+                         in [0, 1], got {f}"
+                    )));
+                }
+                cfg.filtered_pair_recycling = Some(f as f32);
+            }
             "bg_name" => cfg.bg_name = Some(extract_kwarg(&key, &value, "a str")?),
             "model_ids" => cfg.model_ids = Some(extract_model_ids(&value)?),
             other => {
@@ -197,6 +214,7 @@ pub fn config_to_py<'py>(py: Python<'py>, cfg: &EnvConfig) -> PyResult<Bound<'py
     dict.set_item("bg_name", &cfg.bg_name)?;
     dict.set_item("exact_restore", cfg.exact_restore)?;
     dict.set_item("mass_matrix_substeps", cfg.mass_matrix_substeps)?;
+    dict.set_item("filtered_pair_recycling", cfg.filtered_pair_recycling)?;
     dict.set_item("model_ids", &cfg.model_ids)?;
     Ok(dict)
 }

@@ -124,8 +124,8 @@ pub fn episode_from_py(env_id: &str, dict: &Bound<'_, PyDict>) -> PyResult<DemoE
 /// The keyword arguments that rebuild env `env_id` made with `env_kwargs`, as a trajectory
 /// file's `env_info` records them, resolved by making the env: `{"obs_mode", "control_mode",
 /// "reward_mode", "sim_freq", "control_freq", "max_episode_steps"}` plus `"mpm_freq"` (Hz) for
-/// soft-body envs, `"exact_restore": True` when set and `"mass_matrix_substeps"` when not the
-/// task's default. `ValueError` for an unknown id or bad `env_kwargs`.
+/// soft-body envs, `"exact_restore": True` when set and `"mass_matrix_substeps"` and
+/// `"filtered_pair_recycling"` when not the task's default. `ValueError` for an unknown id or bad `env_kwargs`.
 #[pyfunction]
 #[pyo3(signature = (env_id, env_kwargs=None))]
 pub fn recorded_env_kwargs<'py>(
@@ -156,6 +156,12 @@ pub fn recorded_env_kwargs<'py>(
         .is_none_or(|n| n == task_default)
     {
         dict.del_item("mass_matrix_substeps")?;
+    }
+    if resolved
+        .filtered_pair_recycling
+        .is_none_or(|f| f == ms2_tasks::default_filtered_pair_recycling())
+    {
+        dict.del_item("filtered_pair_recycling")?;
     }
     Ok(dict)
 }

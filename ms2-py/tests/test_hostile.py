@@ -532,6 +532,43 @@ def test_mass_matrix_substeps_is_checked_recorded_when_not_default_and_changes_t
     assert float(np.abs(reused - rebuilt).max()) < 0.05
 
 
+def test_filtered_pair_recycling_is_checked_recorded_when_not_default_and_repeatable():
+    """Issue #21: ``filtered_pair_recycling`` (ms2's own keyword) must be a number in [0, 1];
+    the default agrees with the native one; the resolved value reaches the env's config; a
+    trajectory records it only when it is not the default; runs with it off or on repeat."""
+    from ms2 import _native
+    from ms2.envs import DEFAULT_FILTERED_PAIR_RECYCLING
+
+    env = ms2.Ms2Env("PickCube-v0", obs_mode="state")
+    assert env.filtered_pair_recycling == DEFAULT_FILTERED_PAIR_RECYCLING
+    assert env._native.config()["filtered_pair_recycling"] == DEFAULT_FILTERED_PAIR_RECYCLING
+    off = ms2.Ms2Env("PickCube-v0", obs_mode="state", filtered_pair_recycling=0)
+    assert off.filtered_pair_recycling == 0.0
+    for bad in ("1", True, [0.5]):
+        with pytest.raises(TypeError, match="filtered_pair_recycling must be a real number"):
+            ms2.Ms2Env("PickCube-v0", filtered_pair_recycling=bad)
+    for bad in (-0.1, 1.5, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match=r"filtered_pair_recycling must be a fraction .* got"):
+            ms2.Ms2Env("PickCube-v0", filtered_pair_recycling=bad)
+    default = _native.recorded_env_kwargs("PickCube-v0", {"obs_mode": "state"})
+    assert "filtered_pair_recycling" not in default
+    zero = _native.recorded_env_kwargs(
+        "PickCube-v0", {"obs_mode": "state", "filtered_pair_recycling": 0.0}
+    )
+    assert zero["filtered_pair_recycling"] == 0.0
+
+    def run(f):
+        e = ms2.Ms2Env("StackCube-v0", obs_mode="state", filtered_pair_recycling=f)
+        e.reset(seed=3)
+        rng = np.random.default_rng(1)
+        for _ in range(20):
+            e.step(rng.uniform(-1, 1, e.action_space.shape).astype(np.float32))
+        return e.get_state()
+
+    np.testing.assert_array_equal(run(0.0), run(0.0))
+    np.testing.assert_array_equal(run(None), run(None))
+
+
 def test_soak_runs_every_obs_mode_of_a_task_in_worker_processes(capsys):
     """``ms2 bench --soak --jobs 2`` in small: every obs mode of PickCube soaked with resets and
     set_state, no NaN handed out, no errors; image modes get the small soak cameras."""

@@ -81,6 +81,17 @@ pub struct EnvConfig {
     /// on in the Python module): without it the default is 1 and a larger value is an
     /// [`EnvError::InvalidConfig`]. At least 1.
     pub mass_matrix_substeps: Option<u32>,
+    /// How far (a fraction of the solver's prediction distance, in `[0, 1]`) a contact-free pair
+    /// of robot links, or of a robot link and the ground, may drift before the narrow phase
+    /// looks at it again ([`ms2_physics::SolverConfig::filtered_pair_recycling`]); `None` = the
+    /// task's default ([`default_filtered_pair_recycling`]). 0 looks at every pair every
+    /// substep, as upstream rapier does. Pairs with contacts and pairs with the task's objects
+    /// are always updated; what the recycling changes is when a robot link that approaches the
+    /// floor or another link gets its first speculative contact (ms2-physics/README.md, "Round
+    /// 6"). A value above 0 needs the `rapier-filter-epoch` feature (ms2's vendored rapier3d,
+    /// on in the Python module): without it the default is 0 and a larger value is an
+    /// [`EnvError::InvalidConfig`].
+    pub filtered_pair_recycling: Option<f32>,
     /// ManiSkill2's `model_ids` of the object-variation tasks (`PickSingleYCB-v0`,
     /// `PickSingleEGAD-v0`, `PickClutterYCB-v0`): the model ids episodes draw from; `None` (or
     /// empty) = every model of the task's info json. An id not in the json is an error naming
@@ -109,6 +120,7 @@ impl Default for EnvConfig {
             bg_name: None,
             exact_restore: false,
             mass_matrix_substeps: None,
+            filtered_pair_recycling: None,
             model_ids: None,
         }
     }
@@ -175,7 +187,29 @@ impl EnvConfig {
                 )));
             }
         }
+        if let Some(f) = self.filtered_pair_recycling {
+            if !(f.is_finite() && (0.0..=1.0).contains(&f)) {
+                return Err(EnvError::InvalidConfig(format!(
+                    "filtered_pair_recycling must be a fraction of the prediction distance in \
+                     [0, 1], got {f}"
+                )));
+            }
+            if f > 0.0 && !cfg!(feature = "rapier-filter-epoch") {
+                return Err(EnvError::InvalidConfig(format!(
+                    "filtered_pair_recycling = {f} needs ms2-tasks' feature \
+                     `rapier-filter-epoch` (ms2's vendored rapier3d); this build updates every \
+                     pair every substep: use 0 or None"
+                )));
+            }
+        }
         self.substeps().map(|_| ())
+    }
+
+    /// [`EnvConfig::filtered_pair_recycling`], or the task's default when `None`
+    /// ([`default_filtered_pair_recycling`]).
+    pub fn resolved_filtered_pair_recycling(&self) -> f32 {
+        self.filtered_pair_recycling
+            .unwrap_or_else(default_filtered_pair_recycling)
     }
 
     /// [`EnvConfig::mass_matrix_substeps`], or the task's default when `None`
@@ -241,6 +275,13 @@ pub fn default_mass_matrix_substeps(soft_bodies: bool) -> u32 {
         DEFAULT_MASS_MATRIX_SUBSTEPS
     }
 }
+/// The default [`EnvConfig::filtered_pair_recycling`] of every task: ms2-physics'
+/// [`DEFAULT_FILTERED_PAIR_RECYCLING`](ms2_physics::DEFAULT_FILTERED_PAIR_RECYCLING), 1 (a whole
+/// prediction distance) in builds with the `rapier-filter-epoch` feature, 0 without it.
+pub fn default_filtered_pair_recycling() -> f32 {
+    ms2_physics::DEFAULT_FILTERED_PAIR_RECYCLING
+}
+
 /// Most MPM substeps per env step (`mpm_freq / control_freq`; 100 at the default, ManiSkill2's
 /// 2 kHz): bounds the time one soft-body `step` takes (a few seconds at most).
 pub const MAX_MPM_SUBSTEPS: u32 = 2000;
@@ -483,6 +524,38 @@ mod tests {
                 "{msg}"
             );
         }
+        for bad in [-0.5, 1.5, f32::NAN, f32::INFINITY] {
+            let msg = EnvConfig {
+                filtered_pair_recycling: Some(bad),
+                ..EnvConfig::default()
+            }
+            .check_bounds()
+            .unwrap_err()
+            .to_string();
+            assert!(
+                msg.contains("filtered_pair_recycling") && msg.contains(&format!("got {bad}")),
+                "{msg}"
+            );
+        }
+        let off = EnvConfig {
+            filtered_pair_recycling: Some(0.0),
+            ..EnvConfig::default()
+        };
+        assert!(off.check_bounds().is_ok());
+        assert_eq!(off.resolved_filtered_pair_recycling(), 0.0);
+        assert_eq!(
+            EnvConfig::default().resolved_filtered_pair_recycling(),
+            default_filtered_pair_recycling()
+        );
+        let half = EnvConfig {
+            filtered_pair_recycling: Some(0.5),
+            ..EnvConfig::default()
+        };
+        // Above 0 only where the vendored rapier3d's cached verdicts exist.
+        assert_eq!(
+            half.check_bounds().is_ok(),
+            cfg!(feature = "rapier-filter-epoch")
+        );
         assert!(EnvConfig::default().check_bounds().is_ok());
     }
 

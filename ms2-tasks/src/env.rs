@@ -163,6 +163,7 @@ impl Env {
         let resolved = EnvConfig {
             mpm_freq: backend.mpm_freq(),
             mass_matrix_substeps: Some(cfg.resolved_mass_matrix_substeps(spec.soft_bodies)),
+            filtered_pair_recycling: Some(cfg.resolved_filtered_pair_recycling()),
             robot: robot.map(str::to_owned),
             control_mode: Some(backend.control_mode().to_owned()),
             reward_mode: Some(reward_mode.as_str().to_owned()),

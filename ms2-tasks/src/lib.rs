@@ -71,8 +71,8 @@ mod vec_env;
 mod vec_pool;
 
 pub use config::{
-    default_mass_matrix_substeps, EnvConfig, ObsMode, RewardMode, DEFAULT_MASS_MATRIX_SUBSTEPS,
-    MAX_EPISODE_STEPS, MAX_SUBSTEPS,
+    default_filtered_pair_recycling, default_mass_matrix_substeps, EnvConfig, ObsMode, RewardMode,
+    DEFAULT_MASS_MATRIX_SUBSTEPS, MAX_EPISODE_STEPS, MAX_SUBSTEPS,
 };
 pub use env::{make_env, Env, StepOutput};
 pub use error::EnvError;

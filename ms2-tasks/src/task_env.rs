@@ -118,9 +118,11 @@ impl TaskEnv {
             sim_freq_hz: cfg.sim_freq,
         };
         let defaults = WorldConfig::default();
+        let mut solver = task.solver_config(defaults.solver);
+        solver.filtered_pair_recycling = cfg.resolved_filtered_pair_recycling();
         let world_config = WorldConfig {
             timestep: (1.0 / cfg.sim_freq) as f32,
-            solver: task.solver_config(defaults.solver),
+            solver,
             ..defaults
         };
         let mut rng = episode_rng(BUILD_SEED);

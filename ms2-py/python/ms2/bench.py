@@ -33,9 +33,10 @@ from .bench_peer import run_peer
 
 #: ManiSkill2 0.5.3 measured on the same kind of 2-core machine, PickCube-v0, state obs,
 #: 500/20 Hz: single-env steps/s per control mode (medians of 5 interleaved rounds,
-#: 2026-11-29, docs/benchmarks.md; the host of that day, about twice as fast as 11-25's), and
-#: its peak RSS. A stored figure: a ratio counts only against a peer run in the same session.
-MANISKILL2_SINGLE_STEPS_PER_S = {"pd_ee_delta_pose": 737.0, "pd_joint_delta_pos": 847.0}
+#: 2026-11-29 04:21 UTC, docs/benchmarks.md; the host of that day, about twice as fast as
+#: 11-25's), and its peak RSS. A stored figure: a ratio counts only against a peer run in the
+#: same session.
+MANISKILL2_SINGLE_STEPS_PER_S = {"pd_ee_delta_pose": 818.0, "pd_joint_delta_pos": 934.0}
 #: When the figures above were measured.
 MANISKILL2_SINGLE_MEASURED = "2026-11-29"
 MANISKILL2_PEAK_RSS_MB = 336.0

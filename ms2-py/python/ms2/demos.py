@@ -487,6 +487,7 @@ def replay(
                 "mpm_freq",
                 "exact_restore",
                 "mass_matrix_substeps",
+                "filtered_pair_recycling",
             )
             if key in env_kwargs
         }

@@ -29,6 +29,12 @@ UNLIMITED_EPISODE_STEPS = 2**31 - 1
 DEFAULT_MASS_MATRIX_SUBSTEPS = 3
 
 
+#: Fraction of the solver's prediction distance a contact-free pair of robot links (or of a
+#: robot link and the ground) may drift before the narrow phase looks at it again, unless
+#: ``filtered_pair_recycling`` says otherwise (the native default; a test checks they agree).
+DEFAULT_FILTERED_PAIR_RECYCLING = 1.0
+
+
 def default_mass_matrix_substeps(soft_bodies: bool) -> int:
     """A task's default ``mass_matrix_substeps``: 1 with soft bodies, else
     ``DEFAULT_MASS_MATRIX_SUBSTEPS``."""
@@ -38,7 +44,7 @@ def default_mass_matrix_substeps(soft_bodies: bool) -> int:
 def adopt_config(env: Any, config: dict[str, Any]) -> None:
     """Sets ``env_id``, ``obs_mode``, ``control_mode``, ``reward_mode``, ``render_mode``,
     ``sim_freq``, ``control_freq``, ``mpm_freq`` (``None`` without soft bodies) and
-    ``exact_restore`` and ``mass_matrix_substeps`` on ``env``
+    ``exact_restore``, ``mass_matrix_substeps`` and ``filtered_pair_recycling`` on ``env``
     from a native env's resolved ``config()`` (task defaults filled in)."""
     for key in (
         "env_id",
@@ -52,6 +58,7 @@ def adopt_config(env: Any, config: dict[str, Any]) -> None:
         "mpm_freq",
         "exact_restore",
         "mass_matrix_substeps",
+        "filtered_pair_recycling",
     ):
         setattr(env, key, config[key])
 
@@ -166,6 +173,13 @@ class Ms2Env(gym.Env):
             about a sixth of the CPU time of a rigid env step; 1 for the soft-body tasks). 1
             rebuilds it every substep, as upstream rapier. ms2's own keyword; an int in
             ``[1, 1000]``, else ``TypeError`` / ``ValueError``.
+        filtered_pair_recycling: how far (a fraction of the 2 mm prediction distance) a pair of
+            robot links, or a robot link and the ground, without contacts may drift before the
+            narrow phase looks at it again; ``None`` = the default, 1. 0 looks at every pair at
+            every substep, as upstream rapier (with ``mass_matrix_substeps=1``: the dynamics of
+            trajectories recorded before 2026-11-29). Pairs in contact and pairs with the
+            task's objects are always updated. ms2's own keyword; a number in ``[0, 1]``, else
+            ``TypeError`` / ``ValueError``.
         model_ids: the object models episodes draw from in the object-variation tasks
             (``PickSingleYCB-v0``, ``PickSingleEGAD-v0``; ``PickClutterYCB-v0``'s procedural
             clutters), ManiSkill2's keyword: one id or a list; ``None`` = every model of the
@@ -195,6 +209,7 @@ class Ms2Env(gym.Env):
         bg_name: str | None = None,
         exact_restore: bool = False,
         mass_matrix_substeps: int | None = None,
+        filtered_pair_recycling: float | None = None,
         model_ids: str | list[str] | None = None,
     ) -> None:
         _assets.register_installed_packages()
@@ -215,6 +230,7 @@ class Ms2Env(gym.Env):
             bg_name=bg_name,
             exact_restore=exact_restore,
             mass_matrix_substeps=mass_matrix_substeps,
+            filtered_pair_recycling=filtered_pair_recycling,
             model_ids=model_ids,
         )
         adopt_config(self, self._native.config())

@@ -38,7 +38,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from .envs import default_mass_matrix_substeps
+from .envs import DEFAULT_FILTERED_PAIR_RECYCLING, default_mass_matrix_substeps
 from .visualization import put_info_on_image
 
 #: Render modes whose frames ``RecordEpisode`` can save as video.
@@ -110,6 +110,12 @@ def _env_info(env: gym.Env) -> dict[str, Any]:
                 {"mass_matrix_substeps": unwrapped.mass_matrix_substeps}
                 if getattr(unwrapped, "mass_matrix_substeps", None)
                 not in (None, default_mass_matrix_substeps(unwrapped.mpm_freq is not None))
+                else {}
+            ),
+            **(
+                {"filtered_pair_recycling": unwrapped.filtered_pair_recycling}
+                if getattr(unwrapped, "filtered_pair_recycling", None)
+                not in (None, DEFAULT_FILTERED_PAIR_RECYCLING)
                 else {}
             ),
         },
