@@ -56,10 +56,10 @@ pub struct SolverConfig {
     /// body given [`World::set_collision_between`](crate::World::set_collision_between): the
     /// colliders with a cached contact filter) or the ground, may move relative to each other
     /// before the narrow phase looks at them again; until then it reuses its last answer (no
-    /// contacts). Pairs with any other body (the task's objects) are looked at every substep. `0` looks at them every substep. A pair that comes within the
+    /// contacts). `0` looks at every pair every substep. Pairs with contacts, and pairs with
+    /// any other body (the task's objects), are always updated. A pair that comes within the
     /// prediction distance meanwhile gets its first, speculative contact up to that drift later
-    /// (it cannot have touched: the window is at most the prediction distance); pairs with
-    /// contacts are always updated. The default is [`DEFAULT_FILTERED_PAIR_RECYCLING`]; values
+    /// (it cannot have touched: the window is at most the prediction distance). The default is [`DEFAULT_FILTERED_PAIR_RECYCLING`]; values
     /// above 0 need the feature `rapier-filter-epoch` (the cached verdicts live in ms2's
     /// vendored rapier3d), and [`WorldConfig::validate`] refuses them without it.
     pub filtered_pair_recycling: f32,

@@ -1,5 +1,5 @@
-//! A narrow-phase shortcut for the ground: a half-space and a [`GraphHull`] out of reach of each
-//! other get their (empty) contact manifold from one graph walk.
+//! A narrow-phase shortcut for the ground: a half-space and a [`GraphHull`] (or a cuboid) out of
+//! reach of each other get their (empty) contact manifold from a box test or one graph walk.
 //!
 //! The ground is a half-space, whose bounding box is infinite: the broad phase pairs it with
 //! every collider in the world, so each substep parry builds a half-space manifold for every
