@@ -160,6 +160,8 @@ impl World {
         params.friction_in_bias_pass = s.friction_in_bias_pass;
         params.normalized_prediction_distance = s.prediction_distance;
         params.normalized_max_corrective_velocity = s.max_corrective_velocity;
+        // rapier's default is one CCD pass per step; 0 skips continuous collision detection.
+        params.max_ccd_substeps = usize::from(s.continuous_collision);
         #[cfg(feature = "rapier-filter-epoch")]
         {
             params.filtered_pair_recycling = s.filtered_pair_recycling;

@@ -28,6 +28,12 @@ mod viewer;
 
 use pyo3::prelude::*;
 
+/// The extension's Rust allocations (not Python's) go through mimalloc: an env step allocates
+/// and frees many small per-substep buffers, 4-6 % of its time with glibc's malloc
+/// (docs/benchmarks.md, 2026-11-29).
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// The registered env ids, e.g. `["PickCube-v0", ...]`.
 #[pyfunction]
 fn env_ids() -> PyResult<Vec<String>> {

@@ -796,7 +796,24 @@ pub(super) fn process_pair(
             } else {
                 (false, false)
             };
+            // Hooked pairs (recycled only without contacts, by their separation) bound their
+            // shapes by the farthest corner of the local AABB: unlike the corner of largest
+            // coordinates below (upstream's bound, kept for the other pairs), it holds for
+            // every point of the shape.
+            let corner_radius = |co: &crate::geometry::Collider| {
+                let aabb = co.shape.compute_local_aabb();
+                aabb.mins.abs().max(aabb.maxs.abs()).length()
+            };
             let max_extent = match &rigid.recycle_state {
+                _ if hooked && filtered_pair_recycling > 0.0 => {
+                    if plane1 {
+                        corner_radius(co2)
+                    } else if plane2 {
+                        corner_radius(co1)
+                    } else {
+                        corner_radius(co1).max(corner_radius(co2))
+                    }
+                }
                 Some(state)
                     if !shapes_changed && (state.plane1, state.plane2) == (plane1, plane2) =>
                 {
@@ -836,7 +853,17 @@ pub(super) fn process_pair(
                             .contains(ActiveHooks::FILTER_CONTACT_PAIRS)
                 };
                 if filtered(co1) && filtered(co2) {
-                    contact_recycle_distance.min(prediction_distance) * filtered_pair_recycling
+                    // No contact point within the prediction distance: until the pair has
+                    // drifted by its separation less the prediction distance, a full update
+                    // could not find one either. Beyond that, the window of the option.
+                    let window =
+                        contact_recycle_distance.min(prediction_distance) * filtered_pair_recycling;
+                    match query_dispatcher.distance(&pos12, &*co1.shape, &*co2.shape) {
+                        Ok(separation) if separation.distance.is_finite() => {
+                            window.max(separation.distance - prediction_distance)
+                        }
+                        _ => window,
+                    }
                 } else {
                     -1.0
                 }

@@ -424,16 +424,17 @@ pub fn filter_verdicts_are_cached_per_epoch() {
 }
 
 /// How many of `steps` steps gave a ball's pair with the ground (a half-space) a full
-/// narrow-phase update, the ball kinematic at `height` (m) rising at `speed` (m/s), with
+/// narrow-phase update, and the first step after which the pair had a contact, the ball
+/// kinematic at `height` (m) moving up at `speed` (m/s; negative: falling), with
 /// `filtered_pair_recycling` and a cached filter on both colliders (`epoch` 0: none).
 #[cfg(feature = "dim3")]
-fn full_updates_of_a_rising_ball(
+fn ball_over_the_ground(
     filtered_pair_recycling: crate::math::Real,
     epoch: u64,
     height: crate::math::Real,
     speed: crate::math::Real,
     steps: usize,
-) -> usize {
+) -> (usize, Option<usize>) {
     use crate::pipeline::ActiveHooks;
     let mut bodies = RigidBodySet::new();
     let mut colliders = ColliderSet::new();
@@ -477,7 +478,8 @@ fn full_updates_of_a_rising_ball(
     let mut ccd = CCDSolver::new();
     let mut last_pose = None;
     let mut full_updates = 0;
-    for _ in 0..steps {
+    let mut first_contact = None;
+    for step in 0..steps {
         pipeline.step(
             Vector::ZERO,
             &params,
@@ -506,8 +508,23 @@ fn full_updates_of_a_rising_ball(
             full_updates += 1;
         }
         last_pose = pose;
+        if first_contact.is_none() && pair.has_any_active_contact() {
+            first_contact = Some(step);
+        }
     }
-    full_updates
+    (full_updates, first_contact)
+}
+
+/// [`ball_over_the_ground`]'s full updates alone.
+#[cfg(feature = "dim3")]
+fn full_updates_of_a_rising_ball(
+    filtered_pair_recycling: crate::math::Real,
+    epoch: u64,
+    height: crate::math::Real,
+    speed: crate::math::Real,
+    steps: usize,
+) -> usize {
+    ball_over_the_ground(filtered_pair_recycling, epoch, height, speed, steps).0
 }
 
 /// `IntegrationParameters::filtered_pair_recycling`: a contact-free pair with a cached filter
@@ -532,13 +549,33 @@ pub fn filtered_pairs_without_contacts_are_recycled_within_the_window() {
     // Cached verdict, no contact: the ball moves 2 mm in 120 steps, within half the 2 cm
     // window, so only the first update is full.
     assert_eq!(full_updates_of_a_rising_ball(0.5, 1, 1.0, 1e-3, steps), 1);
-    // Faster (0.6 m/s: 1 cm per step) with the whole 2 cm window: a full update every
-    // second or third step.
+    // Faster (0.6 m/s: 1 cm per step) but 0.5 m above the ground and rising: the window is
+    // the separation less the prediction distance (48 cm at the first update, then more), so
+    // two more full updates in 120 steps (72 cm), where the 2 cm window alone would need one
+    // every second or third step.
     let fast = full_updates_of_a_rising_ball(1.0, 1, 1.0, 0.6, steps);
-    assert!((steps / 3..steps).contains(&fast), "{fast} full updates");
+    assert!((2..=4).contains(&fast), "{fast} full updates");
     // Touching the ground (the ball's centre 0.49 m up): updated at every step.
     assert_eq!(
         full_updates_of_a_rising_ball(1.0, 1, 0.49, 1e-3, steps),
         steps
     );
+}
+
+/// A contact-free pair that comes closer gets its first contact at the step it would get it
+/// without recycling: the window by separation ends before the pair can come within the
+/// prediction distance, and the whole-prediction window is not used up before touching.
+#[cfg(feature = "dim3")]
+#[test]
+pub fn filtered_pairs_coming_closer_get_their_first_contact_in_time() {
+    let steps = 120;
+    // Falling at 0.6 m/s (1 cm per step) from 0.5 m above the ground to touch it at step ~50.
+    let (updates_off, contact_off) = ball_over_the_ground(0.0, 1, 1.0, -0.6, steps);
+    let (updates_on, contact_on) = ball_over_the_ground(1.0, 1, 1.0, -0.6, steps);
+    assert!(contact_off.is_some_and(|s| (45..55).contains(&s)), "{contact_off:?}");
+    assert_eq!(contact_on, contact_off);
+    assert_eq!(updates_off, steps);
+    // Recycled for most of the fall (the windows halve as the gap closes), then updated at
+    // every step once in contact.
+    assert!(updates_on < updates_off - 30, "{updates_on} full updates");
 }
