@@ -43,6 +43,13 @@ pub struct IkOptions {
     pub restarts: usize,
     /// Seed of the random restarts (deterministic).
     pub restart_seed: u64,
+    /// An attempt that has run 30 iterations and cut its error (`‖Δp‖ + ‖Δθ‖`) by less than
+    /// this fraction over its last ten ends as not converged: at that pace the iterations left
+    /// could not reach the tolerances. `0.0` never ends an attempt early. Default `0.01`: on
+    /// the Panda, attempts that converge do so in 2-54 iterations (sometimes after a plateau
+    /// of ten); of 40,000 `pd_ee_delta_pose` random actions the 1 % cutoff ended 480 attempts
+    /// early and changed no verdict (docs/controllers.md).
+    pub creep_cutoff: f64,
 }
 
 impl Default for IkOptions {
@@ -56,6 +63,7 @@ impl Default for IkOptions {
             respect_joint_limits: true,
             restarts: 0,
             restart_seed: 0,
+            creep_cutoff: 0.01,
         }
     }
 }
@@ -209,7 +217,13 @@ fn attempt(
     const STALL_GAIN: f64 = 1e-9;
     /// Consecutive accepted steps without progress that end an attempt.
     const STALL_STEPS: usize = 5;
+    /// Iterations before an attempt can end creeping ([`IkOptions::creep_cutoff`]).
+    const CREEP_AFTER: usize = 30;
+    /// Iterations over which an attempt's progress is measured against the creep cutoff.
+    const CREEP_WINDOW: usize = 10;
     let mut stalled_steps = 0;
+    // The score at the start of each of the last CREEP_WINDOW iterations (a ring).
+    let mut recent_scores = [f64::INFINITY; CREEP_WINDOW];
     let n = chain.dof();
     let mut q = start.to_vec();
     let mut jac_full = Matrix6xX::zeros(n);
@@ -229,6 +243,11 @@ fn attempt(
         e.position_m <= opts.position_tolerance_m && e.rotation_rad <= opts.rotation_tolerance_rad
     };
     while !converged(&e) && iterations < opts.max_iterations {
+        let slot = &mut recent_scores[iterations % CREEP_WINDOW];
+        if iterations >= CREEP_AFTER && score(&e) > (1.0 - opts.creep_cutoff) * *slot {
+            break; // creeping: the iterations left cannot converge at this pace
+        }
+        *slot = score(&e);
         iterations += 1;
         for (k, &j) in free.iter().enumerate() {
             jac_free.set_column(k, &jac_full.column(j));
