@@ -858,11 +858,15 @@ pub(super) fn process_pair(
                     // could not find one either. Beyond that, the window of the option.
                     let window =
                         contact_recycle_distance.min(prediction_distance) * filtered_pair_recycling;
-                    match query_dispatcher.distance(&pos12, &*co1.shape, &*co2.shape) {
-                        Ok(separation) if separation.distance.is_finite() => {
-                            window.max(separation.distance - prediction_distance)
+                    if filtered_pair_recycling > 0.0 {
+                        match query_dispatcher.distance(&pos12, &*co1.shape, &*co2.shape) {
+                            Ok(separation) if separation.distance.is_finite() => {
+                                window.max(separation.distance - prediction_distance)
+                            }
+                            _ => window,
                         }
-                        _ => window,
+                    } else {
+                        window // never used: without the option such a pair is not recycled
                     }
                 } else {
                     -1.0
