@@ -57,9 +57,13 @@ pub struct SolverConfig {
     /// colliders with a cached contact filter) or the ground, may move relative to each other
     /// before the narrow phase looks at them again; until then it reuses its last answer (no
     /// contacts). `0` looks at every pair every substep. Pairs with contacts, and pairs with
-    /// any other body (the task's objects), are always updated. A pair that comes within the
-    /// prediction distance meanwhile gets its first, speculative contact up to that drift later
-    /// (it cannot have touched: the window is at most the prediction distance). The default is [`DEFAULT_FILTERED_PAIR_RECYCLING`]; values
+    /// any other body (the task's objects), are always updated. A pair farther apart than twice
+    /// the prediction distance at its last look may drift by its separation less the
+    /// prediction distance instead (it cannot come within the prediction distance meanwhile,
+    /// so that part is exact). A pair that comes within the prediction distance during the
+    /// fraction's window gets its first, speculative contact up to that drift later (it cannot
+    /// have touched: that window is at most the prediction distance). The default is
+    /// [`DEFAULT_FILTERED_PAIR_RECYCLING`]; values
     /// above 0 need the feature `rapier-filter-epoch` (the cached verdicts live in ms2's
     /// vendored rapier3d), and [`WorldConfig::validate`] refuses them without it.
     pub filtered_pair_recycling: f32,

@@ -175,7 +175,8 @@ class Ms2Env(gym.Env):
             ``[1, 1000]``, else ``TypeError`` / ``ValueError``.
         filtered_pair_recycling: how far (a fraction of the 2 mm prediction distance) a pair of
             robot links, or a robot link and the ground, without contacts may drift before the
-            narrow phase looks at it again; ``None`` = the default, 1. 0 looks at every pair at
+            narrow phase looks at it again (a pair farther apart: its separation less 2 mm);
+            ``None`` = the default, 1. 0 looks at every pair at
             every substep, as upstream rapier (with ``mass_matrix_substeps=1``: the dynamics of
             trajectories recorded before 2026-11-29). Pairs in contact and pairs with the
             task's objects are always updated. ms2's own keyword; a number in ``[0, 1]``, else
