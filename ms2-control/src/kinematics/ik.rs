@@ -47,7 +47,7 @@ pub struct IkOptions {
     /// this fraction over its last ten ends as not converged: at that pace the iterations left
     /// could not reach the tolerances. `0.0` never ends an attempt early. Default `0.01`: on
     /// the Panda, attempts that converge do so in 2-54 iterations (sometimes after a plateau
-    /// of ten); of 40,000 `pd_ee_delta_pose` random actions the 1 % cutoff ended 480 attempts
+    /// of ten); of 40,000 `pd_ee_delta_pose` random actions the 1 % cutoff ended 479 attempts
     /// early and changed no verdict (docs/controllers.md).
     pub creep_cutoff: f64,
 }
