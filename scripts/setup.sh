@@ -26,6 +26,10 @@ APT_PACKAGES=(mesa-vulkan-drivers libvulkan1 libegl1 libgl1-mesa-dri pkg-config)
 if ! "$PY" -c 'import venv, ensurepip' >/dev/null 2>&1; then
   APT_PACKAGES+=(python3-venv)
 fi
+# A C compiler: rustc links with `cc`, and the Python extension compiles mimalloc (its allocator).
+if ! command -v cc >/dev/null 2>&1; then
+  APT_PACKAGES+=(gcc libc6-dev)
+fi
 missing=()
 for p in "${APT_PACKAGES[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
