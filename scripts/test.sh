@@ -92,7 +92,8 @@ echo "[test] the vendored rapier3d's patches: kernels bit for bit, cached filter
 cargo test --release --manifest-path third_party/rapier3d/Cargo.toml --lib -- \
     multibody_kernels generic_joint_constraint::tests filter_verdicts_are_cached_per_epoch \
     filtered_pairs_without_contacts_are_recycled_within_the_window \
-    filtered_pairs_coming_closer_get_their_first_contact_in_time unit_inverse_mass_columns_equal_fresh_solves
+    filtered_pairs_coming_closer_get_their_first_contact_in_time \
+    filtered_and_plain_colliders_are_recycled_by_their_separating_gap unit_inverse_mass_columns_equal_fresh_solves
 stage "ms2-tasks feature combinations"
 echo "[test] ms2-tasks feature combinations (clippy --all-targets each; state-only tests)"
 # Every feature combination of ms2-tasks must build (lints only, not builds), and the

@@ -56,13 +56,18 @@ pub struct SolverConfig {
     /// body given [`World::set_collision_between`](crate::World::set_collision_between): the
     /// colliders with a cached contact filter) or the ground, may move relative to each other
     /// before the narrow phase looks at them again; until then it reuses its last answer (no
-    /// contacts). `0` looks at every pair every substep. Pairs with contacts, and pairs with
-    /// any other body (the task's objects), are always updated. A pair farther apart than twice
-    /// the prediction distance at its last look may drift by its separation less the
-    /// prediction distance instead (it cannot come within the prediction distance meanwhile,
-    /// so that part is exact). A pair that comes within the prediction distance during the
-    /// fraction's window gets its first, speculative contact up to that drift later (it cannot
-    /// have touched: that window is at most the prediction distance). The default is
+    /// contacts). `0` looks at every pair every substep. Pairs with contacts are always
+    /// updated. A pair farther apart than twice the prediction distance at its last look may
+    /// drift by its separation less the prediction distance instead (it cannot come within the
+    /// prediction distance meanwhile, so that part is exact). A pair that comes within the
+    /// prediction distance during the fraction's window gets its first, speculative contact up
+    /// to that drift later (it cannot have touched: that window is at most the prediction
+    /// distance). A link (or ground-filtered body) and one of the task's convex objects
+    /// without contacts get no fraction window, only the exact one: their gap along a
+    /// separating axis less the prediction distance, less what the two bodies' current
+    /// speeds can close within the substep (so the solver's speculative contacts come at the
+    /// same substep as without recycling); an object without a support map (a compound, a
+    /// mesh) is updated at every substep. The default is
     /// [`DEFAULT_FILTERED_PAIR_RECYCLING`]; values
     /// above 0 need the feature `rapier-filter-epoch` (the cached verdicts live in ms2's
     /// vendored rapier3d), and [`WorldConfig::validate`] refuses them without it.

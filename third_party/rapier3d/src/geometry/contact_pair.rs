@@ -389,6 +389,11 @@ pub(crate) struct ContactRecycleState {
     /// precomputed at the last full update (it depends on whether the pair had
     /// active contacts, which recycling doesn't change).
     pub max_drift: Real,
+    /// For a contact-free pair recycled by its separating gap (a filtered collider against
+    /// one without hooks): the farthest distance of a point of each collider from its body's
+    /// centre of mass. At each recycling the distance the bodies' current velocities can
+    /// close within the step is taken off the window too (`None`: no such margin).
+    pub speed_radii: Option<(Real, Real)>,
 }
 
 /// `cos Δθ` between two world rotations (in 3D, computed from the quaternion dot

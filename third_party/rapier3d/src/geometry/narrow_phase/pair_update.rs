@@ -182,7 +182,14 @@ pub(super) fn process_pair(
                             &co2.pos.rotation,
                         ));
 
-                if drift <= state.max_drift && rot_cos > 0.98 {
+                // A pair recycled by its separation (`speed_radii`) keeps the distance its
+                // points can close within this step clear as well: a full update now would
+                // keep a contact that the relative velocity brings within the prediction
+                // distance by the end of the step (the solver's speculative contacts).
+                let speed_margin = state.speed_radii.map_or(0.0, |(r1, r2)| {
+                    dt * relative_speed_bound(bodies, co1, co2, r1, r2)
+                });
+                if drift + speed_margin <= state.max_drift && rot_cos > 0.98 {
                     // Recycling can't change the qualified-manifold count: only recompute
                     // a count-cleared hint (pair slept, or state was deserialized).
                     // SAFETY: each pair is processed at most once per update (disjoint slots).
@@ -868,6 +875,16 @@ pub(super) fn process_pair(
                     } else {
                         window // never used: without the option such a pair is not recycled
                     }
+                } else if filtered_pair_recycling > 0.0 && mixed_filtered_pair(co1, co2) {
+                    // A filtered collider against one without hooks (in ms2: a robot link and
+                    // an object): no contact can appear while the pair stays farther apart
+                    // than the prediction distance, and a separating axis bounds how long it
+                    // does. The bodies' speeds (the solver's speculative contacts) are taken
+                    // off at each recycling (`ContactRecycleState::speed_radii`).
+                    match separating_gap(query_dispatcher, &pos12, &*co1.shape, &*co2.shape) {
+                        Some(gap) => gap - prediction_distance,
+                        None => -1.0,
+                    }
                 } else {
                     -1.0
                 }
@@ -886,6 +903,22 @@ pub(super) fn process_pair(
                 rot2: co2.pos.rotation,
                 max_extent,
                 max_drift,
+                speed_radii: (hooked
+                    && filtered_pair_recycling > 0.0
+                    && max_drift > 0.0
+                    && !rigid.has_any_active_contact()
+                    && mixed_filtered_pair(co1, co2))
+                .then(|| {
+                    let radius = |co: &crate::geometry::Collider| {
+                        let aabb = co.shape.compute_local_aabb();
+                        let corner = aabb.mins.abs().max(aabb.maxs.abs()).length();
+                        let arm = co.parent.map_or(0.0, |p| {
+                            (co.pos.translation - bodies[p.handle].center_of_mass()).length()
+                        });
+                        corner + arm
+                    };
+                    (radius(co1), radius(co2))
+                }),
             });
         }
     }
@@ -955,4 +988,67 @@ pub(super) fn process_pair(
         return OUTCOME_FULL_CLEAN;
     }
     outcome
+}
+
+/// Whether exactly one of the two colliders carries a contact filter as its only hook and the
+/// other has no hook at all (neither is a half-space, and neither is a soft-body surface or
+/// has a contact skin): the pairs recycled by their separating gap (`separating_gap`).
+fn mixed_filtered_pair(co1: &crate::geometry::Collider, co2: &crate::geometry::Collider) -> bool {
+    let plain = |co: &crate::geometry::Collider| {
+        co.shape.as_halfspace().is_none()
+            && co.deformable_mesh_ref.is_none()
+            && !co.is_deformable_collider()
+            && co.contact_skin() == 0.0
+    };
+    let (h1, h2) = (co1.flags.active_hooks, co2.flags.active_hooks);
+    plain(co1)
+        && plain(co2)
+        && ((h1 == ActiveHooks::FILTER_CONTACT_PAIRS && h2.is_empty())
+            || (h2 == ActiveHooks::FILTER_CONTACT_PAIRS && h1.is_empty()))
+}
+
+/// A lower bound of the distance between two convex shapes (`pos12`: the second's pose in
+/// the first's frame): their gap along the direction of the closest points the dispatcher
+/// reports, measured with the shapes' support maps. The gap along any axis is at most the
+/// distance, so the bound holds even where the closest-points query misjudges a pair (a poor
+/// direction only gives a smaller gap). `None` for shapes without a support map (composite
+/// shapes), intersecting shapes or an unsupported query.
+fn separating_gap(
+    query_dispatcher: &dyn PersistentQueryDispatcher<ContactManifoldData, ContactData>,
+    pos12: &crate::math::Pose,
+    g1: &dyn parry::shape::Shape,
+    g2: &dyn parry::shape::Shape,
+) -> Option<Real> {
+    let (s1, s2) = (g1.as_support_map()?, g2.as_support_map()?);
+    let axis = match query_dispatcher.closest_points(pos12, g1, g2, Real::MAX) {
+        Ok(parry::query::ClosestPoints::WithinMargin(p1, p2)) => {
+            (pos12.transform_point(p2) - p1).try_normalize()?
+        }
+        _ => return None,
+    };
+    let farthest1 = axis.dot(s1.local_support_point(axis));
+    let nearest2 = axis.dot(s2.support_point(pos12, -axis));
+    let gap = nearest2 - farthest1;
+    gap.is_finite().then_some(gap)
+}
+
+/// An upper bound of the relative speed of any two points of the colliders' bodies: the
+/// difference of their centres of mass' velocities plus each angular speed times `r1` / `r2`
+/// (the farthest distance of a point of each collider from its body's centre of mass). A
+/// collider without a parent body does not move.
+fn relative_speed_bound(
+    bodies: &RigidBodySet,
+    co1: &crate::geometry::Collider,
+    co2: &crate::geometry::Collider,
+    r1: Real,
+    r2: Real,
+) -> Real {
+    let motion = |co: &crate::geometry::Collider| {
+        co.parent.map_or((Default::default(), 0.0), |p| {
+            let rb = &bodies[p.handle];
+            (rb.linvel(), rb.angvel().length())
+        })
+    };
+    let ((v1, w1), (v2, w2)) = (motion(co1), motion(co2));
+    (v1 - v2).length() + w1 * r1 + w2 * r2
 }

@@ -572,10 +572,163 @@ pub fn filtered_pairs_coming_closer_get_their_first_contact_in_time() {
     // Falling at 0.6 m/s (1 cm per step) from 0.5 m above the ground to touch it at step ~50.
     let (updates_off, contact_off) = ball_over_the_ground(0.0, 1, 1.0, -0.6, steps);
     let (updates_on, contact_on) = ball_over_the_ground(1.0, 1, 1.0, -0.6, steps);
-    assert!(contact_off.is_some_and(|s| (45..55).contains(&s)), "{contact_off:?}");
+    assert!(
+        contact_off.is_some_and(|s| (45..55).contains(&s)),
+        "{contact_off:?}"
+    );
     assert_eq!(contact_on, contact_off);
     assert_eq!(updates_off, steps);
     // Recycled for most of the fall (the windows halve as the gap closes), then updated at
     // every step once in contact.
     assert!(updates_on < updates_off - 30, "{updates_on} full updates");
+}
+
+/// How many of `steps` steps gave the pair of a ball (radius 0.5 m, kinematic, from `start`
+/// at `velocity`, m and m/s) and a fixed box (half-extents 1 × 1 × 0.1 m at the origin) a
+/// full narrow-phase update, and the first step after which the pair had a contact. The ball
+/// carries a contact filter with a cached verdict (a robot link in ms2), the box no hook (an
+/// object); `compound_box` makes the box a compound of one cuboid (no support map).
+#[cfg(feature = "dim3")]
+fn filtered_ball_near_a_plain_box(
+    filtered_pair_recycling: crate::math::Real,
+    start: Vector,
+    velocity: Vector,
+    steps: usize,
+    compound_box: bool,
+) -> (usize, Option<usize>) {
+    use crate::pipeline::ActiveHooks;
+    let mut bodies = RigidBodySet::new();
+    let mut colliders = ColliderSet::new();
+    let ground = bodies.insert(RigidBodyBuilder::fixed());
+    let box_collider = if compound_box {
+        ColliderBuilder::compound(vec![(
+            crate::math::Pose::IDENTITY,
+            crate::geometry::SharedShape::cuboid(1.0, 1.0, 0.1),
+        )])
+    } else {
+        ColliderBuilder::cuboid(1.0, 1.0, 0.1)
+    };
+    colliders.insert_with_parent(box_collider.build(), ground, &mut bodies);
+    let ball = bodies.insert(
+        RigidBodyBuilder::kinematic_velocity_based()
+            .translation(start)
+            .linvel(velocity),
+    );
+    colliders.insert_with_parent(
+        ColliderBuilder::ball(0.5)
+            .active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS)
+            .active_collision_types(crate::geometry::ActiveCollisionTypes::all())
+            .build(),
+        ball,
+        &mut bodies,
+    );
+    let params = IntegrationParameters {
+        filtered_pair_recycling,
+        ..IntegrationParameters::default()
+    };
+    let hooks = CountingFilter {
+        calls: 0.into(),
+        epoch: 1.into(),
+        reject: false.into(),
+    };
+    let mut pipeline = PhysicsPipeline::new();
+    let mut islands = IslandManager::new();
+    let mut broad_phase = DefaultBroadPhase::new();
+    let mut narrow_phase = NarrowPhase::new();
+    let mut impulse_joints = ImpulseJointSet::new();
+    let mut multibody_joints = MultibodyJointSet::new();
+    let mut soft_bodies = SoftBodySet::new();
+    let mut ccd = CCDSolver::new();
+    let mut last_pose = None;
+    let mut full_updates = 0;
+    let mut first_contact = None;
+    for step in 0..steps {
+        pipeline.step(
+            Vector::ZERO,
+            &params,
+            &mut islands,
+            &mut broad_phase,
+            &mut narrow_phase,
+            &mut bodies,
+            &mut colliders,
+            &mut impulse_joints,
+            &mut multibody_joints,
+            &mut soft_bodies,
+            &mut ccd,
+            &hooks,
+            &(),
+        );
+        let Some(pair) = narrow_phase.contact_pairs().next() else {
+            continue; // the bounding boxes are apart
+        };
+        let pose = pair
+            .rigid()
+            .and_then(|r| r.recycle_state.as_ref())
+            .map(|s| s.pos12.translation);
+        if pose != last_pose {
+            full_updates += 1;
+        }
+        last_pose = pose;
+        if first_contact.is_none() && pair.has_any_active_contact() {
+            first_contact = Some(step);
+        }
+    }
+    (full_updates, first_contact)
+}
+
+/// A contact-free pair of a filtered collider and one without hooks is recycled while the
+/// gap along a separating axis, less the prediction distance and the distance the bodies'
+/// speeds close within a step, covers its drift: a ball moving towards a box's vertical edge
+/// inside the box's bounding box gets its first contact at the same step as without
+/// recycling, at any approach speed; a shape without a support map is never recycled.
+#[cfg(feature = "dim3")]
+#[test]
+pub fn filtered_and_plain_colliders_are_recycled_by_their_separating_gap() {
+    let steps = 120;
+    // 0.69 m from the edge (x = y = 1): a 0.19 m gap, bounding boxes overlapping.
+    let start = Vector::new(1.49, 1.49, 0.0);
+    let towards_edge = Vector::new(-1.0, -1.0, 0.0).normalize();
+    for speed in [0.3, 0.6, 1.2, 2.4] {
+        let velocity = towards_edge * speed;
+        let (updates_off, contact_off) =
+            filtered_ball_near_a_plain_box(0.0, start, velocity, steps, false);
+        let (updates_on, contact_on) =
+            filtered_ball_near_a_plain_box(1.0, start, velocity, steps, false);
+        assert!(contact_off.is_some(), "no contact at {speed} m/s");
+        assert_eq!(contact_on, contact_off, "first contact at {speed} m/s");
+        assert_eq!(
+            updates_off,
+            steps.min(updates_off),
+            "off: every step in the broad phase"
+        );
+        // Fewer full updates before the contact (every step once in contact).
+        assert!(
+            updates_on < updates_off,
+            "{updates_on} full updates against {updates_off} at {speed} m/s"
+        );
+        if speed <= 0.3 {
+            let before = contact_off.unwrap_or(0);
+            assert!(
+                updates_on + before / 2 < updates_off,
+                "{updates_on} against {updates_off}"
+            );
+        }
+    }
+    // Moving away from the edge from a 7 cm gap.
+    let away = Vector::new(1.40, 1.40, 0.0);
+    let (away_on, _) = filtered_ball_near_a_plain_box(1.0, away, -towards_edge * 0.3, steps, false);
+    let (away_off, _) =
+        filtered_ball_near_a_plain_box(0.0, away, -towards_edge * 0.3, steps, false);
+    assert!(away_off > 40, "{away_off} full updates without recycling");
+    assert!(away_on <= 5, "{away_on} full updates");
+    // A compound box (no support map): updated at every step, as without the option.
+    let (compound_on, contact_on) =
+        filtered_ball_near_a_plain_box(1.0, start, towards_edge * 0.3, steps, true);
+    let (compound_off, contact_off) =
+        filtered_ball_near_a_plain_box(0.0, start, towards_edge * 0.3, steps, true);
+    assert!(
+        compound_off > 100,
+        "{compound_off} full updates of the compound"
+    );
+    assert_eq!((compound_on, contact_on), (compound_off, contact_off));
 }
