@@ -446,19 +446,51 @@ fn ball_over_the_ground(
         ground,
         &mut bodies,
     );
+    insert_filtered_ball(
+        &mut bodies,
+        &mut colliders,
+        Vector::new(0.0, 0.0, height),
+        Vector::new(0.0, 0.0, speed),
+    );
+    recycled_pair_history(bodies, colliders, filtered_pair_recycling, epoch, steps)
+}
+
+/// Adds a kinematic ball (radius 0.5 m) at `start` moving at `velocity` (m, m/s) whose
+/// collider carries a contact filter and collides with fixed bodies too.
+#[cfg(feature = "dim3")]
+fn insert_filtered_ball(
+    bodies: &mut RigidBodySet,
+    colliders: &mut ColliderSet,
+    start: Vector,
+    velocity: Vector,
+) {
     let ball = bodies.insert(
         RigidBodyBuilder::kinematic_velocity_based()
-            .translation(Vector::new(0.0, 0.0, height))
-            .linvel(Vector::new(0.0, 0.0, speed)),
+            .translation(start)
+            .linvel(velocity),
     );
     colliders.insert_with_parent(
         ColliderBuilder::ball(0.5)
-            .active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS)
+            .active_hooks(crate::pipeline::ActiveHooks::FILTER_CONTACT_PAIRS)
             .active_collision_types(crate::geometry::ActiveCollisionTypes::all())
             .build(),
         ball,
-        &mut bodies,
+        bodies,
     );
+}
+
+/// Steps a scene of one colliding pair `steps` times with `filtered_pair_recycling` and a
+/// [`CountingFilter`] with `epoch` (0: none); returns how many steps gave the pair a full
+/// narrow-phase update (a full update records the pair's relative pose, a recycled step keeps
+/// the old one) and the first step after which it had a contact.
+#[cfg(feature = "dim3")]
+fn recycled_pair_history(
+    mut bodies: RigidBodySet,
+    mut colliders: ColliderSet,
+    filtered_pair_recycling: crate::math::Real,
+    epoch: u64,
+    steps: usize,
+) -> (usize, Option<usize>) {
     let params = IntegrationParameters {
         filtered_pair_recycling,
         ..IntegrationParameters::default()
@@ -495,11 +527,9 @@ fn ball_over_the_ground(
             &hooks,
             &(),
         );
-        // A full update records the pair's relative pose; a recycled step keeps the old one.
-        let pair = narrow_phase
-            .contact_pairs()
-            .next()
-            .expect("the ball's pair");
+        let Some(pair) = narrow_phase.contact_pairs().next() else {
+            continue; // the bounding boxes are apart
+        };
         let pose = pair
             .rigid()
             .and_then(|r| r.recycle_state.as_ref())
@@ -596,7 +626,6 @@ fn filtered_ball_near_a_plain_box(
     steps: usize,
     compound_box: bool,
 ) -> (usize, Option<usize>) {
-    use crate::pipeline::ActiveHooks;
     let mut bodies = RigidBodySet::new();
     let mut colliders = ColliderSet::new();
     let ground = bodies.insert(RigidBodyBuilder::fixed());
@@ -609,71 +638,8 @@ fn filtered_ball_near_a_plain_box(
         ColliderBuilder::cuboid(1.0, 1.0, 0.1)
     };
     colliders.insert_with_parent(box_collider.build(), ground, &mut bodies);
-    let ball = bodies.insert(
-        RigidBodyBuilder::kinematic_velocity_based()
-            .translation(start)
-            .linvel(velocity),
-    );
-    colliders.insert_with_parent(
-        ColliderBuilder::ball(0.5)
-            .active_hooks(ActiveHooks::FILTER_CONTACT_PAIRS)
-            .active_collision_types(crate::geometry::ActiveCollisionTypes::all())
-            .build(),
-        ball,
-        &mut bodies,
-    );
-    let params = IntegrationParameters {
-        filtered_pair_recycling,
-        ..IntegrationParameters::default()
-    };
-    let hooks = CountingFilter {
-        calls: 0.into(),
-        epoch: 1.into(),
-        reject: false.into(),
-    };
-    let mut pipeline = PhysicsPipeline::new();
-    let mut islands = IslandManager::new();
-    let mut broad_phase = DefaultBroadPhase::new();
-    let mut narrow_phase = NarrowPhase::new();
-    let mut impulse_joints = ImpulseJointSet::new();
-    let mut multibody_joints = MultibodyJointSet::new();
-    let mut soft_bodies = SoftBodySet::new();
-    let mut ccd = CCDSolver::new();
-    let mut last_pose = None;
-    let mut full_updates = 0;
-    let mut first_contact = None;
-    for step in 0..steps {
-        pipeline.step(
-            Vector::ZERO,
-            &params,
-            &mut islands,
-            &mut broad_phase,
-            &mut narrow_phase,
-            &mut bodies,
-            &mut colliders,
-            &mut impulse_joints,
-            &mut multibody_joints,
-            &mut soft_bodies,
-            &mut ccd,
-            &hooks,
-            &(),
-        );
-        let Some(pair) = narrow_phase.contact_pairs().next() else {
-            continue; // the bounding boxes are apart
-        };
-        let pose = pair
-            .rigid()
-            .and_then(|r| r.recycle_state.as_ref())
-            .map(|s| s.pos12.translation);
-        if pose != last_pose {
-            full_updates += 1;
-        }
-        last_pose = pose;
-        if first_contact.is_none() && pair.has_any_active_contact() {
-            first_contact = Some(step);
-        }
-    }
-    (full_updates, first_contact)
+    insert_filtered_ball(&mut bodies, &mut colliders, start, velocity);
+    recycled_pair_history(bodies, colliders, filtered_pair_recycling, 1, steps)
 }
 
 /// A contact-free pair of a filtered collider and one without hooks is recycled while the
