@@ -840,6 +840,9 @@ pub(super) fn process_pair(
                     }
                 }
             };
+            // A filtered collider against one without hooks (in ms2: a robot link and an
+            // object), recycled (without contacts) by its separating gap alone.
+            let mixed = hooked && filtered_pair_recycling > 0.0 && mixed_filtered_pair(co1, co2);
             // A pair without contacts has an (unknown) separation larger than
             // the prediction distance. Cap its recycle window by the
             // prediction distance so an incoming contact can't be missed.
@@ -875,7 +878,7 @@ pub(super) fn process_pair(
                     } else {
                         window // never used: without the option such a pair is not recycled
                     }
-                } else if filtered_pair_recycling > 0.0 && mixed_filtered_pair(co1, co2) {
+                } else if mixed {
                     // A filtered collider against one without hooks (in ms2: a robot link and
                     // an object): no contact can appear while the pair stays farther apart
                     // than the prediction distance, and a separating axis bounds how long it
@@ -903,19 +906,12 @@ pub(super) fn process_pair(
                 rot2: co2.pos.rotation,
                 max_extent,
                 max_drift,
-                speed_radii: (hooked
-                    && filtered_pair_recycling > 0.0
-                    && max_drift > 0.0
-                    && !rigid.has_any_active_contact()
-                    && mixed_filtered_pair(co1, co2))
-                .then(|| {
+                speed_radii: (mixed && max_drift > 0.0).then(|| {
                     let radius = |co: &crate::geometry::Collider| {
-                        let aabb = co.shape.compute_local_aabb();
-                        let corner = aabb.mins.abs().max(aabb.maxs.abs()).length();
                         let arm = co.parent.map_or(0.0, |p| {
                             (co.pos.translation - bodies[p.handle].center_of_mass()).length()
                         });
-                        corner + arm
+                        corner_radius(co) + arm
                     };
                     (radius(co1), radius(co2))
                 }),
