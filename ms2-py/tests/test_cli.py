@@ -84,3 +84,31 @@ def test_bench_of_a_mobile_task_uses_its_base_control_mode():
     # ... steps/s, x our single, x MS2 single, peak RSS MB, load
     fields = rows[0].split()
     assert float(fields[-5]) > 0 and fields[-3] == "-", out
+
+
+def test_bench_rounds_end_with_medians_against_each_rounds_single_env():
+    out = _bench_stdout(
+        "--steps", "20", "--num-envs", "2", "--env-id", MAIN_ID, "--rounds", "2",
+        "--control-modes", "pd_joint_delta_pos",
+    )  # fmt: skip
+    lines = out.splitlines()
+    assert "round 1 of 2" in lines and "round 2 of 2" in lines, out
+    at = next(i for i, line in enumerate(lines) if line.startswith("medians over 2 rounds"))
+    measured = [line for line in lines[:at] if line.startswith("pd_joint_delta_pos")]
+    medians = [line for line in lines[at + 1 :] if line.startswith("pd_joint_delta_pos")]
+    assert len(measured) == 4 and len(medians) == 2, out
+    # The single env's row is its own baseline; make_vec(2)'s ratio is the median of the two
+    # rounds' ratios (each against its own round's single env), within their range.
+    assert medians[0].split()[-2:] == ["1.00", "1.00-1.00"], out
+    vec_ratios = sorted(float(line.split()[-4]) for line in measured if "make_vec(2)" in line)
+    ratio, spread = float(medians[1].split()[-2]), medians[1].split()[-1]
+    low, high = (float(x) for x in spread.split("-"))
+    assert low <= ratio <= high and low > 0, out
+    assert abs(low - vec_ratios[0]) < 0.006 and abs(high - vec_ratios[1]) < 0.006, out
+
+
+def test_bench_rounds_must_be_positive_and_state_only(capsys):
+    assert main(["bench", "--rounds", "0"]) == 2
+    assert "--rounds must be at least 1, got 0" in capsys.readouterr().err
+    assert main(["bench", "--visual", "--rounds", "3"]) == 2
+    assert "--rounds is for the state rows" in capsys.readouterr().err

@@ -6,7 +6,11 @@ the timing is the env's); episodes that end are reset inside the timed loop, as 
 would. Observations are ``state`` by default; ``ms2 bench --visual`` measures the visual obs
 modes (``rgbd`` and ``pointcloud``, ManiSkill2's two 128×128 cameras) and also prints the
 triangles drawn per camera and the render adapter. Every row shows the 1-minute load average
-at its start, since other processes on the machine change the figures.
+at its start, since other processes on the machine change the figures. ``--rounds K`` runs every
+state row K times, a round's rows in order so that the configurations interleave, and ends with
+each row's medians: on a shared machine one run's rows can move by a few percent between rows
+a few seconds apart, and the median of the per-round ratios to the single env is the steadier
+figure.
 
 ``--policy scripted`` drives single envs with the task's scripted solution instead of random
 actions (the soft-body tasks need it to move clay). The soft-body comparison with the paper is
@@ -22,6 +26,7 @@ import argparse
 import json
 import os
 import resource
+import statistics
 import subprocess
 import sys
 import time
@@ -257,6 +262,10 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     if args.soak:
         return _soak(args)
     num_envs_list = [int(n) for n in args.num_envs.split(",") if n]
+    if args.rounds < 1:
+        raise ValueError(f"--rounds must be at least 1, got {args.rounds}")
+    if args.visual and args.rounds != 1:
+        raise ValueError(f"--rounds is for the state rows (--visual runs once), got {args.rounds}")
     if args.visual:
         return _bench_visual(args, num_envs_list)
     steps = args.steps or 4000
@@ -296,7 +305,14 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         {"control_mode": control_mode, "obs_mode": "state", "policy": args.policy}
         for control_mode in control_modes
     ]
-    rows = _run_rows(args.env_id, steps, specs, num_envs_list, state_row)
+    rows = []
+    for round_index in range(1, args.rounds + 1):
+        if args.rounds > 1:
+            print(f"round {round_index} of {args.rounds}", flush=True)
+        round_rows = _run_rows(args.env_id, steps, specs, num_envs_list, state_row)
+        rows.extend({**row, "round": round_index} for row in round_rows)
+    if args.rounds > 1:
+        _print_round_medians(_round_medians(rows), args.rounds, mode_width)
     if stored:
         print(
             "x MS2 single: against ManiSkill2 0.5.3's stored figures "
@@ -312,6 +328,52 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         )
     _write_json(args.json, rows)
     return 0
+
+
+def _round_medians(rows: list[dict]) -> list[dict]:
+    """Per row (control mode and runner) over the rounds of ``rows`` (each with its ``round``):
+    the median steps/s, and the median, lowest and highest ratio to the single env of the same
+    round and control mode. In the order the rows first appear."""
+    singles = {
+        (row["round"], row["control_mode"]): row["steps_per_s"]
+        for row in rows
+        if row["kind"] == "single"
+    }
+    grouped: dict[tuple[str, str, int], list[tuple[float, float]]] = {}
+    for row in rows:
+        key = (row["control_mode"], row["kind"], row["num_envs"])
+        single = singles[(row["round"], row["control_mode"])]
+        grouped.setdefault(key, []).append((row["steps_per_s"], row["steps_per_s"] / single))
+    medians = []
+    for (control_mode, kind, num_envs), values in grouped.items():
+        ratios = [ratio for _, ratio in values]
+        medians.append(
+            {
+                "control_mode": control_mode,
+                "kind": kind,
+                "num_envs": num_envs,
+                "rounds": len(values),
+                "median_steps_per_s": statistics.median(v for v, _ in values),
+                "median_ratio": statistics.median(ratios),
+                "min_ratio": min(ratios),
+                "max_ratio": max(ratios),
+            }
+        )
+    return medians
+
+
+def _print_round_medians(medians: list[dict], rounds: int, mode_width: int) -> None:
+    """Prints :func:`_round_medians`' table."""
+    print(
+        f"medians over {rounds} rounds ('x our single': against the same round's single env; "
+        "lowest-highest)"
+    )
+    for m in medians:
+        runner = _runner_name(m["kind"], m["num_envs"])
+        print(
+            f"{m['control_mode']:<{mode_width}} {runner:<18} {m['median_steps_per_s']:>9.0f} "
+            f"{m['median_ratio']:>12.2f}   {m['min_ratio']:.2f}-{m['max_ratio']:.2f}"
+        )
 
 
 def _bench_visual(args: argparse.Namespace, num_envs_list: list[int]) -> int:
@@ -469,6 +531,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         type=int,
         default=1,
         help="--soak: worker processes soaking (task, obs mode) pairs in parallel",
+    )
+    p.add_argument(
+        "--rounds",
+        type=int,
+        default=1,
+        help="state rows: run every row this many times, the rows of a round in order (so the "
+        "configurations interleave), and end with each row's medians over the rounds: steps/s "
+        "and 'x our single' against the same round's single env, with its range",
     )
     p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     p.add_argument("--worker", default=None, help=argparse.SUPPRESS)
