@@ -24,10 +24,11 @@
 //! was slower on 2026-11-29: by 3-4 % with four and eight envs in `pd_ee_delta_pose`, 1-2 % in
 //! `pd_joint_delta_pos` (PickCube-v0, medians of seven interleaved runs; docs/benchmarks.md), as
 //! an env stepped on another core than its last step finds its state in the other core's cache.
-//! The other way round, one contiguous chunk of envs per thread with no env ever moving was
-//! 0-3.4 % slower than these halves with four and eight envs (PickCube-v0, both control modes,
-//! the two pools' vector envs alternating in blocks of 100 steps in one process, 2 × 20 blocks
-//! each; session 25): taking the other thread's next env pays for its cold cache.
+//! The other way round, one contiguous chunk of envs per thread with no env ever moving was up to
+//! 3.4 % slower than these halves with four and eight envs, 7 of 8 rows slower or equal
+//! (PickCube-v0, both control modes, the two pools' vector envs alternating in blocks of 100
+//! steps in one process, 2 × 20 blocks each; session 25): a thread that takes the other's next
+//! env gains more than that env's cold cache costs.
 //!
 //! Soft-body envs keep rayon: their MPM step runs on rayon's pool itself, and a spinning worker
 //! of another pool would take a core from it. Visual steps keep rayon too (the software
