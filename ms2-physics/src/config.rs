@@ -62,9 +62,9 @@ pub struct SolverConfig {
     /// prediction distance meanwhile, so that part is exact). A pair that comes within the
     /// prediction distance during the fraction's window gets its first, speculative contact up
     /// to that drift later (it cannot have touched: that window is at most the prediction
-    /// distance). A link (or ground-filtered body) and one of the task's convex objects
-    /// without contacts get no fraction window, only the exact one: their gap along a
-    /// separating axis less the prediction distance, less what the two bodies' current
+    /// distance). A filtered collider and a collider without the filter (a link and one of the
+    /// task's objects), without contacts, get no fraction window, only an exact one: their gap
+    /// along a separating axis less the prediction distance, less what the two bodies' current
     /// speeds can close within the substep (so the solver's speculative contacts come at the
     /// same substep as without recycling); an object without a support map (a compound, a
     /// mesh) is updated at every substep. The default is
